@@ -1,0 +1,189 @@
+#include "app/info_command.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstdio>
+#include <iomanip>
+#include <sstream>
+
+#include "app/defaults.h"
+#include "app/process_stats.h"
+#include "scene/collision_world.h"
+#include "scene/level.h"
+
+namespace sandbox::app {
+namespace {
+
+using scene::Level;
+
+struct LoadFigures {
+  double level_s{0.0};            // files read and converted
+  double collision_world_s{0.0};  // Bullet shapes and BVHs built
+  double peak_memory_mib{0.0};
+  int collision_objects{0};
+};
+
+std::string JsonString(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\', out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof(escaped), "\\u%04x", c);
+      out += escaped;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+std::string JsonVector(const Eigen::Vector3d& v) {
+  std::ostringstream out;
+  out << std::setprecision(9) << "[" << v.x() << ", " << v.y() << ", " << v.z() << "]";
+  return out.str();
+}
+
+// Empty bounds (an actor without meshes) print as zeros.
+Eigen::Vector3d Lo(const Eigen::AlignedBox3d& b) { return b.isEmpty() ? Eigen::Vector3d::Zero() : b.min(); }
+Eigen::Vector3d Hi(const Eigen::AlignedBox3d& b) { return b.isEmpty() ? Eigen::Vector3d::Zero() : b.max(); }
+
+void PrintJson(const Level& level, const LoadFigures& figures, std::ostream& out) {
+  std::size_t vertices = 0, collision_actors = 0, movable_actors = 0;
+  out << "{\n  \"level\": {\"name\": " << JsonString(level.name)
+      << ", \"file\": " << JsonString(level.file.string()) << "},\n  \"actors\": [";
+  for (std::size_t i = 0; i < level.actors.size(); ++i) {
+    const scene::Actor& a = level.actors[i];
+    vertices += a.num_vertices();
+    collision_actors += a.collision ? 1 : 0;
+    movable_actors += a.movable ? 1 : 0;
+    out << (i > 0 ? ",\n" : "\n") << "    {\"name\": " << JsonString(a.name)
+        << ", \"triangles\": " << a.num_triangles() << ", \"vertices\": " << a.num_vertices()
+        << ", \"collision\": " << (a.collision ? "true" : "false")
+        << ", \"movable\": " << (a.movable ? "true" : "false")
+        << ", \"bounds_min\": " << JsonVector(Lo(a.bounds_W))
+        << ", \"bounds_max\": " << JsonVector(Hi(a.bounds_W)) << "}";
+  }
+  out << "\n  ],\n  \"totals\": {\"actors\": " << level.actors.size()
+      << ", \"collision_actors\": " << collision_actors << ", \"movable_actors\": " << movable_actors
+      << ", \"triangles\": " << level.num_triangles() << ", \"vertices\": " << vertices
+      << ", \"materials\": " << level.materials.size() << ", \"textures\": " << level.textures.size()
+      << ", \"collision_objects\": " << figures.collision_objects
+      << ", \"bounds_min\": " << JsonVector(Lo(level.bounds_W()))
+      << ", \"bounds_max\": " << JsonVector(Hi(level.bounds_W())) << "},\n";
+  out << std::fixed << std::setprecision(4) << "  \"load\": {\"level_s\": " << figures.level_s
+      << ", \"collision_world_s\": " << figures.collision_world_s
+      << ", \"total_s\": " << figures.level_s + figures.collision_world_s << std::setprecision(1)
+      << ", \"peak_memory_mib\": " << figures.peak_memory_mib << "},\n  \"warnings\": [";
+  for (std::size_t i = 0; i < level.warnings.size(); ++i) {
+    out << (i > 0 ? ", " : "") << JsonString(level.warnings[i]);
+  }
+  out << "]\n}\n";
+}
+
+void PrintText(const Level& level, const LoadFigures& figures, std::ostream& out) {
+  std::size_t name_width = 5;
+  for (const scene::Actor& a : level.actors) name_width = std::max(name_width, a.name.size());
+  name_width = std::min<std::size_t>(name_width, 48);
+  out << "level " << level.name << " (" << level.file.string() << ")\n\n";
+  out << std::left << std::setw(static_cast<int>(name_width)) << "actor" << std::right
+      << std::setw(11) << "triangles" << "  collision  movable  bounds min .. max (m)\n";
+  out << std::fixed << std::setprecision(2);
+  for (const scene::Actor& a : level.actors) {
+    const Eigen::Vector3d lo = Lo(a.bounds_W), hi = Hi(a.bounds_W);
+    out << std::left << std::setw(static_cast<int>(name_width)) << a.name << std::right
+        << std::setw(11) << a.num_triangles() << "  " << std::left << std::setw(9)
+        << (a.collision ? "yes" : "no") << "  " << std::setw(7) << (a.movable ? "yes" : "no")
+        << std::right << "  (" << lo.x() << ", " << lo.y() << ", " << lo.z() << ") .. ("
+        << hi.x() << ", " << hi.y() << ", " << hi.z() << ")\n";
+  }
+  const Eigen::AlignedBox3d bounds = level.bounds_W();
+  const Eigen::Vector3d size = Hi(bounds) - Lo(bounds);
+  out << "\ntotal " << level.actors.size() << " actors, " << level.num_triangles()
+      << " triangles, " << level.materials.size() << " materials, " << level.textures.size()
+      << " embedded textures, " << figures.collision_objects << " collision objects\n";
+  out << "size  " << size.x() << " x " << size.y() << " x " << size.z() << " m, from ("
+      << Lo(bounds).x() << ", " << Lo(bounds).y() << ", " << Lo(bounds).z() << ") to ("
+      << Hi(bounds).x() << ", " << Hi(bounds).y() << ", " << Hi(bounds).z() << ")\n";
+  out << std::setprecision(3) << "load  " << figures.level_s + figures.collision_world_s
+      << " s (files " << figures.level_s << " s, collision world " << figures.collision_world_s
+      << " s), peak memory " << std::setprecision(1) << figures.peak_memory_mib << " MiB\n";
+  for (const std::string& warning : level.warnings) out << "warning: " << warning << "\n";
+}
+
+const char* kUsage =
+    "usage: sandbox info [LEVEL] [--json] [--up AXIS] [--unit-scale METRES]\n"
+    "  LEVEL         a level manifest (.toml) or any scene file assimp reads\n"
+    "                (default: the bundled sample level)\n"
+    "  --json        machine-readable output (docs/info-json.md)\n"
+    "  --up AXIS     up axis of a scene file that does not say: x, -x, y, -y, z, -z\n"
+    "  --unit-scale  metres per unit of a scene file that does not say\n";
+
+}  // namespace
+
+int RunInfo(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  std::string file = kDefaultLevel;
+  bool json = false;
+  scene::AssetConversion conversion;
+  bool have_file = false;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    const bool has_value = i + 1 < args.size();
+    if (arg == "--json") {
+      json = true;
+    } else if (arg == "--help" || arg == "-h") {
+      out << kUsage;
+      return 0;
+    } else if (arg == "--up" && has_value) {
+      conversion.up = scene::ParseUpAxis(args[++i]);
+      if (!conversion.up) {
+        err << "sandbox info: --up must be one of x, -x, y, -y, z, -z, got '" << args[i] << "'\n";
+        return 2;
+      }
+    } else if (arg == "--unit-scale" && has_value) {
+      char* end = nullptr;
+      const double value = std::strtod(args[++i].c_str(), &end);
+      if (*end != '\0' || !(value > 0.0) || !std::isfinite(value)) {
+        err << "sandbox info: --unit-scale must be a positive number, got '" << args[i] << "'\n";
+        return 2;
+      }
+      conversion.unit_scale_m = value;
+    } else if (!arg.empty() && arg[0] == '-') {
+      err << "sandbox info: unknown or incomplete option '" << arg << "'\n" << kUsage;
+      return 2;
+    } else if (!have_file) {
+      file = arg;
+      have_file = true;
+    } else {
+      err << "sandbox info: more than one level given ('" << file << "', '" << arg << "')\n";
+      return 2;
+    }
+  }
+
+  using Clock = std::chrono::steady_clock;
+  try {
+    LoadFigures figures;
+    const auto start = Clock::now();
+    const Level level = scene::LoadLevel(file, conversion);
+    const auto loaded = Clock::now();
+    const scene::CollisionWorld world(level);
+    const auto built = Clock::now();
+    figures.level_s = std::chrono::duration<double>(loaded - start).count();
+    figures.collision_world_s = std::chrono::duration<double>(built - loaded).count();
+    figures.peak_memory_mib = PeakResidentMiB();
+    figures.collision_objects = world.num_collision_objects();
+    if (json) {
+      PrintJson(level, figures, out);
+    } else {
+      PrintText(level, figures, out);
+    }
+    return 0;
+  } catch (const scene::LevelError& error) {
+    err << "sandbox info: " << error.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace sandbox::app

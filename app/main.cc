@@ -1,0 +1,34 @@
+// The `sandbox` program: one subcommand per job.
+
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "app/info_command.h"
+
+namespace {
+
+const char* kUsage =
+    "usage: sandbox COMMAND [ARGS]\n"
+    "commands:\n"
+    "  info [LEVEL] [--json]   actors, triangles, bounds, load time and memory of a level\n"
+    "run 'sandbox COMMAND --help' for a command's options\n";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
+    std::cout << kUsage;
+    return args.empty() ? 2 : 0;
+  }
+  const std::vector<std::string> rest(args.begin() + 1, args.end());
+  try {
+    if (args[0] == "info") return sandbox::app::RunInfo(rest, std::cout, std::cerr);
+  } catch (const std::exception& error) {
+    std::cerr << "sandbox " << args[0] << ": " << error.what() << "\n";
+    return 1;
+  }
+  std::cerr << "sandbox: unknown command '" << args[0] << "'\n" << kUsage;
+  return 2;
+}

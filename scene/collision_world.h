@@ -1,0 +1,74 @@
+#pragma once
+// The Bullet collision world of a level, used only for queries: physics
+// stepping is never used (no stepSimulation, no masses, nothing integrates).
+// Every transform comes from the level file or from outside (SetActorPose).
+//
+// Precision: Bullet is the float build. Positions cross this interface in
+// double and are taken relative to a floating origin (SetOrigin) before they
+// reach Bullet, so queries near the origin keep sub-millimetre precision
+// however far the world extends (see docs/levels.md).
+//
+// Threads: one thread (the loop thread) owns the world; CastRay uses
+// btCollisionWorld::rayTest, which is not safe to call from several threads.
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+
+#include <Eigen/Geometry>
+
+#include "scene/level.h"
+
+namespace sandbox::scene {
+
+// Collision channels; a ray's mask selects which it sees.
+enum CollisionGroup : std::uint32_t {
+  kWorldStatic = 1u << 0,
+  kWorldMovable = 1u << 1,
+  kRobot = 1u << 2,
+  kAllGroups = kWorldStatic | kWorldMovable | kRobot,
+};
+
+struct RayHit {
+  Eigen::Vector3d point_W;
+  Eigen::Vector3d normal_W;  // unit, facing the ray
+  double distance_m{0.0};    // from the ray's start
+  int actor{-1};             // index into Level::actors
+};
+
+class CollisionWorld {
+ public:
+  // Builds triangle-mesh shapes (quantized BVH) for every actor with collision
+  // on: movable actors in kWorldMovable, the rest in kWorldStatic. The meshes
+  // are referenced, not copied: `level` must outlive the world. Meshes are split
+  // to respect Bullet's limits (2^21 triangles a part, 1024 parts a shape).
+  explicit CollisionWorld(const Level& level);
+  ~CollisionWorld();
+  CollisionWorld(const CollisionWorld&) = delete;
+  CollisionWorld& operator=(const CollisionWorld&) = delete;
+
+  // The first hit on the segment from `from_W` to `to_W` among objects whose
+  // group is in `group_mask`, skipping actor `ignore_actor` (-1: none).
+  std::optional<RayHit> CastRay(const Eigen::Vector3d& from_W, const Eigen::Vector3d& to_W,
+                                std::uint32_t group_mask = kAllGroups,
+                                int ignore_actor = -1) const;
+
+  // Places a movable actor. Throws std::invalid_argument for an unknown index,
+  // a static actor or a non-finite pose (the previous pose stays).
+  void SetActorPose(int actor, const Eigen::Isometry3d& X_WA);
+  const Eigen::Isometry3d& actor_pose(int actor) const;
+
+  // Moves the floating origin to `p_WO` (world coordinates kept in double).
+  void SetOrigin(const Eigen::Vector3d& p_WO);
+  const Eigen::Vector3d& origin() const { return p_WO_; }
+
+  int num_collision_objects() const;
+  int num_parts() const;  // Bullet mesh parts over all shapes
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  Eigen::Vector3d p_WO_{Eigen::Vector3d::Zero()};
+};
+
+}  // namespace sandbox::scene

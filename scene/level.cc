@@ -1,0 +1,159 @@
+#include "scene/level.h"
+
+#include <algorithm>
+#include <numeric>
+
+#include "scene/asset_import.h"
+#include "scene/heightmap.h"
+#include "scene/manifest.h"
+
+namespace sandbox::scene {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The rigid part of an affine map: its translation and the nearest rotation
+// of its linear part. Actors have rigid poses; scale and shear stay in the mesh.
+Eigen::Isometry3d RigidPart(const Eigen::Affine3d& X) {
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  out.translation() = X.translation();
+  Eigen::Matrix3d rotation, scaling;
+  X.computeRotationScaling(&rotation, &scaling);
+  out.linear() = rotation;
+  return out;
+}
+
+void ComputeBounds(Actor* actor) {
+  actor->bounds_W.setEmpty();
+  for (const Mesh& mesh : actor->meshes) {
+    for (const Eigen::Vector3f& p_A : mesh.positions_A) {
+      actor->bounds_W.extend(actor->X_WA * p_A.cast<double>());
+    }
+  }
+}
+
+// Appends an asset's materials and textures to the level's, renumbering the
+// references of `meshes` (of this asset) accordingly.
+void MergeMaterials(ImportedAsset* asset, Level* level) {
+  const int material_base = static_cast<int>(level->materials.size());
+  const int texture_base = static_cast<int>(level->textures.size());
+  for (Material& material : asset->materials) {
+    if (material.base_color_texture_embedded >= 0) {
+      material.base_color_texture_embedded += texture_base;
+    }
+    level->materials.push_back(std::move(material));
+  }
+  for (EmbeddedTexture& texture : asset->textures) level->textures.push_back(std::move(texture));
+  for (ImportedNode& node : asset->nodes) {
+    for (Mesh& mesh : node.meshes) {
+      if (mesh.material >= 0) mesh.material += material_base;
+    }
+  }
+  for (std::string& warning : asset->warnings) level->warnings.push_back(std::move(warning));
+}
+
+// A scene file as a level: one actor per node with meshes, posed at the
+// node's rigid transform.
+Level LoadSceneFile(const fs::path& file, const AssetConversion& conversion) {
+  ImportedAsset asset = ImportAsset(file, conversion);
+  Level level;
+  level.file = file;
+  level.name = file.stem().string();
+  MergeMaterials(&asset, &level);
+  for (ImportedNode& node : asset.nodes) {
+    Actor actor;
+    actor.name = node.path;
+    actor.source = file.string() + ":" + node.path;
+    actor.X_WA = RigidPart(node.X_RN);
+    const Eigen::Affine3d X_AN = actor.X_WA.inverse() * node.X_RN;
+    for (Mesh& mesh : node.meshes) {
+      TransformMesh(X_AN, &mesh);
+      actor.meshes.push_back(std::move(mesh));
+    }
+    level.actors.push_back(std::move(actor));
+  }
+  return level;
+}
+
+// A manifest as a level: one actor per [[actor]], all of its asset's nodes
+// merged into it, scaled in the asset root frame and then placed.
+Level LoadManifest(const fs::path& file) {
+  const LevelManifest manifest = ParseManifest(file);
+  Level level;
+  level.file = file;
+  level.name = manifest.name;
+  for (const ActorSpec& spec : manifest.actors) {
+    ImportedAsset asset;
+    try {
+      asset = spec.is_heightmap ? ImportHeightmapImage(spec.file, spec.heightmap_size_m)
+                                : ImportAsset(spec.file, spec.conversion);
+    } catch (const LevelError& error) {
+      throw LevelError(file.string() + ":" + std::to_string(spec.line) + ": actor '" + spec.name +
+                       "': " + error.what());
+    }
+    MergeMaterials(&asset, &level);
+    Actor actor;
+    actor.name = spec.name;
+    actor.source = spec.file.string();
+    actor.collision = spec.collision;
+    actor.movable = spec.movable;
+    actor.X_WA = Eigen::Translation3d(spec.position_m) * spec.rotation;
+    for (ImportedNode& node : asset.nodes) {
+      const Eigen::Affine3d X_AN = Eigen::Scaling(spec.scale) * node.X_RN;
+      for (Mesh& mesh : node.meshes) {
+        TransformMesh(X_AN, &mesh);
+        actor.meshes.push_back(std::move(mesh));
+      }
+    }
+    level.actors.push_back(std::move(actor));
+  }
+  return level;
+}
+
+std::string LowerExtension(const fs::path& file) {
+  std::string ext = file.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+}  // namespace
+
+std::size_t Actor::num_triangles() const {
+  return std::accumulate(meshes.begin(), meshes.end(), std::size_t{0},
+                         [](std::size_t sum, const Mesh& m) { return sum + m.num_triangles(); });
+}
+
+std::size_t Actor::num_vertices() const {
+  return std::accumulate(meshes.begin(), meshes.end(), std::size_t{0},
+                         [](std::size_t sum, const Mesh& m) { return sum + m.positions_A.size(); });
+}
+
+int Level::FindActor(std::string_view actor_name) const {
+  for (std::size_t i = 0; i < actors.size(); ++i) {
+    if (actors[i].name == actor_name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+std::size_t Level::num_triangles() const {
+  return std::accumulate(actors.begin(), actors.end(), std::size_t{0},
+                         [](std::size_t sum, const Actor& a) { return sum + a.num_triangles(); });
+}
+
+Eigen::AlignedBox3d Level::bounds_W() const {
+  Eigen::AlignedBox3d bounds;
+  for (const Actor& actor : actors) {
+    if (!actor.bounds_W.isEmpty()) bounds.extend(actor.bounds_W);
+  }
+  return bounds;
+}
+
+Level LoadLevel(const fs::path& file, const AssetConversion& conversion) {
+  if (!fs::exists(file)) throw LevelError(file.string() + ": no such file");
+  Level level = LowerExtension(file) == ".toml" ? LoadManifest(file)
+                                                 : LoadSceneFile(file, conversion);
+  for (Actor& actor : level.actors) ComputeBounds(&actor);
+  return level;
+}
+
+}  // namespace sandbox::scene

@@ -1,0 +1,70 @@
+#pragma once
+// A level: the actors of the world with their meshes and materials, loaded once
+// from a scene file or a TOML level manifest and converted to the world frame
+// (Z up, metres). A Level is constant after loading; run-time placements of
+// movable actors live in CollisionWorld.
+
+#include <cstddef>
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "scene/frames.h"
+#include "scene/mesh.h"
+
+namespace sandbox::scene {
+
+// Thrown for every problem with a level or asset file. what() names the file,
+// the line or node where known, and what is wrong: "level.toml:12: actor 'gate':
+// scale must be positive, got -1".
+class LevelError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct Actor {
+  std::string name;    // unique in the level
+  std::string source;  // the file (and node path) it came from
+  Eigen::Isometry3d X_WA{Eigen::Isometry3d::Identity()};  // pose at load time
+  bool collision{true};  // false: drawn but invisible to rays
+  bool movable{false};   // true: may be placed from outside at run time
+  std::vector<Mesh> meshes;  // in frame A
+  Eigen::AlignedBox3d bounds_W;  // exact bounds of the meshes at X_WA; empty without meshes
+
+  std::size_t num_triangles() const;
+  std::size_t num_vertices() const;
+};
+
+struct Level {
+  std::filesystem::path file;
+  std::string name;
+  std::vector<Actor> actors;
+  std::vector<Material> materials;
+  std::vector<EmbeddedTexture> textures;
+  std::vector<std::string> warnings;  // problems that were handled, e.g. dropped faces
+
+  // Index of the actor called `name`, or -1.
+  int FindActor(std::string_view name) const;
+  std::size_t num_triangles() const;
+  Eigen::AlignedBox3d bounds_W() const;
+};
+
+// How to read a plain scene file given as a level (a manifest says it per actor).
+// Unset fields take the file's own statement or the format's convention
+// (docs/levels.md lists them).
+struct AssetConversion {
+  std::optional<UpAxis> up;
+  std::optional<double> unit_scale_m;  // metres per file unit
+};
+
+// Loads a level: a `.toml` file is a level manifest, anything else a scene file
+// that assimp reads (or a Terragen .ter terrain), in which every node with
+// meshes becomes an actor named after its node path. Throws LevelError.
+Level LoadLevel(const std::filesystem::path& file, const AssetConversion& conversion = {});
+
+}  // namespace sandbox::scene

@@ -1,0 +1,42 @@
+#pragma once
+// The TOML level manifest (docs/levels.md is the reference). Parsing only:
+// values are checked here, files are read by the level loader.
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "scene/level.h"
+
+namespace sandbox::scene {
+
+// One [[actor]] table: an asset file or a heightmap image placed in the world.
+struct ActorSpec {
+  std::string name;
+  std::filesystem::path file;       // resolved against the manifest's folder
+  bool is_heightmap{false};         // `heightmap = ...` instead of `file = ...`
+  Eigen::Vector3d heightmap_size_m{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d position_m{Eigen::Vector3d::Zero()};
+  Eigen::Quaterniond rotation{Eigen::Quaterniond::Identity()};
+  Eigen::Vector3d scale{Eigen::Vector3d::Ones()};
+  AssetConversion conversion;
+  bool collision{true};
+  bool movable{false};
+  int line{0};  // where the table starts, for messages
+};
+
+struct LevelManifest {
+  std::filesystem::path file;
+  std::string name;
+  std::vector<ActorSpec> actors;
+};
+
+// Throws LevelError "file:line: what" for a TOML syntax error, an unknown key,
+// a wrong type, a missing or duplicate name, a negative scale, a non-finite
+// number or a non-unit quaternion.
+LevelManifest ParseManifest(const std::filesystem::path& file);
+
+}  // namespace sandbox::scene
