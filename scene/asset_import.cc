@@ -131,13 +131,16 @@ Material ConvertMaterial(const aiScene& scene, const aiMaterial& in, const fs::p
   Material out;
   aiString name;
   if (in.Get(AI_MATKEY_NAME, name) == AI_SUCCESS) out.name = name.C_Str();
+  // PBR base colour (glTF) carries its alpha; older formats give a diffuse
+  // colour and a separate opacity.
   aiColor4D color;
-  if (in.Get(AI_MATKEY_BASE_COLOR, color) == AI_SUCCESS ||
-      in.Get(AI_MATKEY_COLOR_DIFFUSE, color) == AI_SUCCESS) {
-    out.base_color = {color.r, color.g, color.b, color.a};
-  }
   float opacity = 1.0f;
-  if (in.Get(AI_MATKEY_OPACITY, opacity) == AI_SUCCESS) out.base_color.w() *= opacity;
+  if (in.Get(AI_MATKEY_BASE_COLOR, color) == AI_SUCCESS) {
+    out.base_color = {color.r, color.g, color.b, color.a};
+  } else if (in.Get(AI_MATKEY_COLOR_DIFFUSE, color) == AI_SUCCESS) {
+    out.base_color = {color.r, color.g, color.b, 1.0f};
+    if (in.Get(AI_MATKEY_OPACITY, opacity) == AI_SUCCESS) out.base_color.w() = opacity;
+  }
   aiString texture;
   if (in.GetTexture(aiTextureType_BASE_COLOR, 0, &texture) == AI_SUCCESS ||
       in.GetTexture(aiTextureType_DIFFUSE, 0, &texture) == AI_SUCCESS) {

@@ -1,0 +1,141 @@
+// Every model of ../shared/assets loads with the right size and orientation.
+// Expected sizes come from each asset's STATS.txt (assimp's own bounding box,
+// in file units and axes), the URDF and the SDF, converted by hand.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "scene/collision_world.h"
+#include "scene/level.h"
+
+namespace sandbox::scene {
+namespace {
+
+namespace fs = std::filesystem;
+using Eigen::Vector3d;
+
+fs::path Shared(const std::string& relative) { return fs::path(SANDBOX_SHARED_ASSETS) / relative; }
+
+class SharedAssetsTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!fs::exists(SANDBOX_SHARED_ASSETS)) {
+      GTEST_SKIP() << "no " << SANDBOX_SHARED_ASSETS
+                   << " (the shared test assets sit beside the repository on the "
+                      "development machines only)";
+    }
+  }
+};
+
+// Loads, builds the Bullet world and checks the level's size to `tolerance_m`.
+Level ExpectSize(const fs::path& file, const Vector3d& size_m, double tolerance_m,
+                 const AssetConversion& conversion = {}) {
+  Level level = LoadLevel(file, conversion);
+  const CollisionWorld world(level);
+  EXPECT_GT(world.num_collision_objects(), 0);
+  const Vector3d size = level.bounds_W().sizes();
+  EXPECT_LT((size - size_m).cwiseAbs().maxCoeff(), tolerance_m)
+      << file << ": size " << size.transpose() << ", expected " << size_m.transpose();
+  return level;
+}
+
+TEST_F(SharedAssetsTest, Quake3MapDropsBadFacesOnceAndIsZUpInInches) {
+  // STATS: 3520 x 1536 x 4096 units, Z up; 1 unit = 0.0254 m.
+  const Level level = ExpectSize(Shared("q3-de4th-run1/de4th_run1.pk3"),
+                                 Vector3d(3520, 1536, 4096) * 0.0254, 0.01);
+  EXPECT_EQ(level.actors.size(), 61u);
+  ASSERT_EQ(level.warnings.size(), 1u);
+  EXPECT_NE(level.warnings[0].find("dropped 3 faces with out-of-range vertex indices"),
+            std::string::npos)
+      << level.warnings[0];
+  // Unnamed children get stable generated names.
+  EXPECT_GE(level.FindActor("node0"), 0);
+  EXPECT_GT(level.num_triangles(), 15000u);
+}
+
+TEST_F(SharedAssetsTest, GltfModelsAreYUp) {
+  // STATS sizes (x, y, z) in glTF axes become world (x, z, y).
+  ExpectSize(Shared("cesium-man/CesiumMan.glb"), {1.14, 0.31, 1.51}, 0.01);
+  ExpectSize(Shared("rigged-simple/RiggedSimple.glb"), {2, 2, 9.15}, 0.01);
+  ExpectSize(Shared("rigged-figure/RiggedFigure.glb"), {1.18, 0.33, 1.45}, 0.01);
+  ExpectSize(Shared("fox/Fox.glb"), {25.2, 154.7, 79.0}, 0.1);
+  ExpectSize(Shared("simple-skin/SimpleSkin.gltf"), {1, 0, 2}, 0.01);
+  ExpectSize(Shared("cesium-milk-truck/CesiumMilkTruck.glb"), {2.79, 4.87, 2.58}, 0.01);
+  ExpectSize(Shared("terrain-vulkan-samples/terrain.gltf"), {2, 2, 0.289}, 0.002);
+  ExpectSize(Shared("vulkan-subpass-scene/subpass_scene_opaque.gltf"), {22, 22, 10.2}, 0.01);
+  ExpectSize(Shared("vulkan-subpass-scene/subpass_scene_transparent.gltf"), {16.1, 16.1, 9.7},
+             0.02);
+  // A person stands on the ground: feet at z = 0, head up.
+  const Level man = LoadLevel(Shared("cesium-man/CesiumMan.glb"));
+  EXPECT_NEAR(man.bounds_W().min().z(), 0.0, 0.01);
+  EXPECT_EQ(man.textures.size(), 1u);  // the embedded skin texture
+}
+
+TEST_F(SharedAssetsTest, DeepHierarchyGivesOneActorPerMeshNode) {
+  const Level level =
+      ExpectSize(Shared("recursive-skeletons/RecursiveSkeletons.glb"), {10, 10, 90}, 0.01);
+  EXPECT_GT(level.actors.size(), 1u);
+  for (const Actor& actor : level.actors) EXPECT_EQ(level.FindActor(actor.name), &actor - &level.actors[0]);
+}
+
+TEST_F(SharedAssetsTest, ColladaUpAxisMatchesTheZUpCollisionMeshes) {
+  // The URDF uses each link's visual .dae and collision .stl in the same frame:
+  // with <up_axis> honoured their bounds agree (to the coarser STL's detail).
+  for (const std::string link : {"base_link", "link_1", "link_2", "link_3", "link_4", "link_5",
+                                 "link_6", "link_7"}) {
+    const Level visual = LoadLevel(Shared("kuka-iiwa/visual/" + link + ".dae"));
+    const Level collision = LoadLevel(Shared("kuka-iiwa/collision/" + link + ".stl"));
+    const Eigen::AlignedBox3d a = visual.bounds_W(), b = collision.bounds_W();
+    EXPECT_LT((a.min() - b.min()).cwiseAbs().maxCoeff(), 0.02) << link;
+    EXPECT_LT((a.max() - b.max()).cwiseAbs().maxCoeff(), 0.02) << link;
+  }
+}
+
+TEST_F(SharedAssetsTest, KukaArmPlacedByManifestStandsAboutOnePointThreeMetresTall) {
+  const Level level = LoadLevel(fs::path(SANDBOX_SOURCE_DIR) / "tests/data/kuka_iiwa.toml");
+  ASSERT_EQ(level.actors.size(), 8u);
+  const Eigen::AlignedBox3d box = level.bounds_W();
+  EXPECT_NEAR(box.min().z(), 0.0, 0.01);
+  EXPECT_NEAR(box.max().z(), 1.18 + 0.126, 0.03);  // flange at joint a7 + tool0 offset
+  EXPECT_LT(box.sizes().head<2>().maxCoeff(), 0.3);  // a straight arm
+  EXPECT_TRUE(level.actors[7].movable);
+}
+
+TEST_F(SharedAssetsTest, Px4ModelsInTheirSdfUnits) {
+  // SketchUp Collada, Z up, inches: STATS (Y-up after assimp) 7.6 x 2.6 x 11.0.
+  ExpectSize(Shared("px4-plane/meshes/body.dae"), {7.63, 11.03, 2.62}, 0.02);
+  ExpectSize(Shared("px4-iris/meshes/iris.stl"), {0.30, 0.48, 0.11}, 0.01);
+  for (const char* part : {"left_aileron", "right_aileron", "left_flap", "right_flap",
+                           "elevators", "rudder", "propeller_cw", "propeller_ccw"}) {
+    const Level level = LoadLevel(Shared(std::string("px4-plane/meshes/") + part + ".dae"));
+    EXPECT_GT(level.num_triangles(), 0u) << part;
+  }
+  // Heightmap through a manifest, as the SDF sizes it: 80 x 80 m, at most 2 m high.
+  const Level ground = LoadLevel(fs::path(SANDBOX_SOURCE_DIR) / "tests/data/px4_uneven_ground.toml");
+  const Vector3d size = ground.bounds_W().sizes();
+  EXPECT_NEAR(size.x(), 80.0, 1e-6);
+  EXPECT_NEAR(size.y(), 80.0, 1e-6);
+  EXPECT_GT(size.z(), 0.1);
+  EXPECT_LE(ground.bounds_W().max().z(), 2.0 + 1e-6);
+  EXPECT_EQ(ground.num_triangles(), 512u * 512u * 2u);
+}
+
+TEST_F(SharedAssetsTest, Terrains) {
+  // 3DGS HMP: STATS 160 x 160 x 40.
+  ExpectSize(Shared("assimp-terrain/terrain.hmp"), {160, 160, 40}, 0.01);
+  // Terragen (assimp 5.2.5 fails on it; read natively): 257 x 257 points, 30 m apart.
+  // Its header: heightscale 33, baseheight 13, SCAL 30 m, so every elevation lies in
+  // (13 +- 32768 * 33 / 65536) * 30 m = [-105, 885] m.
+  const Level ter = LoadLevel(Shared("assimp-terrain/RealisticTerrain.ter"));
+  EXPECT_EQ(ter.num_triangles(), 256u * 256u * 2u);
+  const Eigen::AlignedBox3d box = ter.bounds_W();
+  EXPECT_NEAR(box.sizes().x(), 7680.0, 1e-3);
+  EXPECT_NEAR(box.sizes().y(), 7680.0, 1e-3);
+  EXPECT_GE(box.min().z(), -105.0);
+  EXPECT_LE(box.max().z(), 885.0);
+  EXPECT_GT(box.sizes().z(), 100.0);
+}
+
+}  // namespace
+}  // namespace sandbox::scene
