@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <assimp/Exporter.hpp>
+#include <assimp/Importer.hpp>
+#include <assimp/scene.h>
+
 #include "scene/level.h"
 #include "tests/scene/obj_text.h"
 #include "tests/test_util.h"
@@ -108,6 +112,22 @@ TEST(LevelTest, DuplicateNodeNamesAreMadeUnique) {
   ExpectNear(level.actors[2].X_WA.translation(), {0, 0, 2}, "third");
 }
 
+TEST(LevelTest, FbxSaysItsAxesAndUnit) {
+  // assimp's ASCII FBX writer declares UpAxis = Y and UnitScaleFactor = 1 (cm):
+  // the 1 x 2 x 3 box becomes 0.01 x 0.03 x 0.02 m with (x, y, z) -> (x, -z, y).
+  TempDir dir;
+  const auto obj = dir.Write("box.obj", ObjBox("box", 1, 2, 3));
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(obj.string(), 0);
+  ASSERT_NE(scene, nullptr);
+  const auto fbx = dir.path() / "box.fbx";
+  Assimp::Exporter exporter;
+  ASSERT_EQ(exporter.Export(scene, "fbxa", fbx.string()), AI_SUCCESS) << exporter.GetErrorString();
+  const Level level = LoadLevel(fbx);
+  ExpectNear(level.bounds_W().min(), {0, -0.03, 0}, "min");
+  ExpectNear(level.bounds_W().max(), {0.01, 0, 0.02}, "max");
+}
+
 std::string LoadError(const std::filesystem::path& file) {
   try {
     LoadLevel(file);
@@ -137,7 +157,7 @@ TEST(LevelTest, BadFilesGiveOneClearMessage) {
 
   const auto no_meshes = dir.Write("lonely.gltf", R"({"asset": {"version": "2.0"}, "scene": 0,
       "scenes": [{"nodes": [0]}], "nodes": [{"name": "empty"}]})");
-  EXPECT_NE(LoadError(no_meshes).find(no_meshes.string() + ":"), std::string::npos);
+  EXPECT_EQ(LoadError(no_meshes), no_meshes.string() + ": has no triangle meshes");
 }
 
 }  // namespace
