@@ -2,8 +2,8 @@
 
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <iomanip>
 #include <sstream>
 
@@ -47,8 +47,12 @@ std::string JsonVector(const Eigen::Vector3d& v) {
 }
 
 // Empty bounds (an actor without meshes) print as zeros.
-Eigen::Vector3d Lo(const Eigen::AlignedBox3d& b) { return b.isEmpty() ? Eigen::Vector3d::Zero() : b.min(); }
-Eigen::Vector3d Hi(const Eigen::AlignedBox3d& b) { return b.isEmpty() ? Eigen::Vector3d::Zero() : b.max(); }
+Eigen::Vector3d Lo(const Eigen::AlignedBox3d& b) {
+  return b.isEmpty() ? Eigen::Vector3d::Zero() : b.min();
+}
+Eigen::Vector3d Hi(const Eigen::AlignedBox3d& b) {
+  return b.isEmpty() ? Eigen::Vector3d::Zero() : b.max();
+}
 
 void PrintJson(const Level& level, const LoadFigures& figures, std::ostream& out) {
   std::size_t vertices = 0, collision_actors = 0, movable_actors = 0;
@@ -67,9 +71,10 @@ void PrintJson(const Level& level, const LoadFigures& figures, std::ostream& out
         << ", \"bounds_max\": " << JsonVector(Hi(a.bounds_W)) << "}";
   }
   out << "\n  ],\n  \"totals\": {\"actors\": " << level.actors.size()
-      << ", \"collision_actors\": " << collision_actors << ", \"movable_actors\": " << movable_actors
-      << ", \"triangles\": " << level.num_triangles() << ", \"vertices\": " << vertices
-      << ", \"materials\": " << level.materials.size() << ", \"textures\": " << level.textures.size()
+      << ", \"collision_actors\": " << collision_actors
+      << ", \"movable_actors\": " << movable_actors << ", \"triangles\": " << level.num_triangles()
+      << ", \"vertices\": " << vertices << ", \"materials\": " << level.materials.size()
+      << ", \"textures\": " << level.textures.size()
       << ", \"collision_objects\": " << figures.collision_objects
       << ", \"bounds_min\": " << JsonVector(Lo(level.bounds_W()))
       << ", \"bounds_max\": " << JsonVector(Hi(level.bounds_W())) << "},\n";
@@ -89,21 +94,22 @@ void PrintText(const Level& level, const LoadFigures& figures, std::ostream& out
   name_width = std::min<std::size_t>(name_width, 48);
   out << "level " << level.name << " (" << level.file.string() << ")\n\n";
   out << std::left << std::setw(static_cast<int>(name_width)) << "actor" << std::right
-      << std::setw(11) << "triangles" << "  collision  movable  bounds min .. max (m)\n";
+      << std::setw(11) << "triangles"
+      << "  collision  movable  bounds min .. max (m)\n";
   out << std::fixed << std::setprecision(2);
   for (const scene::Actor& a : level.actors) {
     const Eigen::Vector3d lo = Lo(a.bounds_W), hi = Hi(a.bounds_W);
     out << std::left << std::setw(static_cast<int>(name_width)) << a.name << std::right
         << std::setw(11) << a.num_triangles() << "  " << std::left << std::setw(9)
         << (a.collision ? "yes" : "no") << "  " << std::setw(7) << (a.movable ? "yes" : "no")
-        << std::right << "  (" << lo.x() << ", " << lo.y() << ", " << lo.z() << ") .. ("
-        << hi.x() << ", " << hi.y() << ", " << hi.z() << ")\n";
+        << std::right << "  (" << lo.x() << ", " << lo.y() << ", " << lo.z() << ") .. (" << hi.x()
+        << ", " << hi.y() << ", " << hi.z() << ")\n";
   }
   const Eigen::AlignedBox3d bounds = level.bounds_W();
   const Eigen::Vector3d size = Hi(bounds) - Lo(bounds);
-  out << "\ntotal " << level.actors.size() << " actors, " << level.num_triangles()
-      << " triangles, " << level.materials.size() << " materials, " << level.textures.size()
-      << " embedded textures, " << figures.collision_objects << " collision objects\n";
+  out << "\ntotal " << level.actors.size() << " actors, " << level.num_triangles() << " triangles, "
+      << level.materials.size() << " materials, " << level.textures.size() << " embedded textures, "
+      << figures.collision_objects << " collision objects\n";
   out << "size  " << size.x() << " x " << size.y() << " x " << size.z() << " m, from ("
       << Lo(bounds).x() << ", " << Lo(bounds).y() << ", " << Lo(bounds).z() << ") to ("
       << Hi(bounds).x() << ", " << Hi(bounds).y() << ", " << Hi(bounds).z() << ")\n";

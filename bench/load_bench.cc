@@ -5,12 +5,14 @@
 //
 //   bench_load [--runs N] [--keep DIR]
 
+#include <assimp/scene.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <cmath>
+#include <assimp/Importer.hpp>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -18,9 +20,6 @@
 #include <functional>
 #include <string>
 #include <vector>
-
-#include <assimp/Importer.hpp>
-#include <assimp/scene.h>
 
 #include "assets/generators/gltf_writer.h"
 #include "scene/collision_world.h"
@@ -149,7 +148,8 @@ int main(int argc, char** argv) {
 
   std::printf("\n%-12s %10s %9s %9s %12s %11s %7s\n", "level", "triangles", "load s", "peak MiB",
               "assimp s", "assimp MiB", "ratio");
-  for (const auto& [name, file] : {std::pair{"sample", sample}, std::pair{"1M-triangle", million}}) {
+  for (const auto& [name, file] :
+       {std::pair{"sample", sample}, std::pair{"1M-triangle", million}}) {
     std::vector<double> load_s, peak, ref_s, ref_peak;
     double triangles = 0;
     for (int run = 0; run < runs; ++run) {
@@ -161,9 +161,11 @@ int main(int argc, char** argv) {
     std::printf("%-12s %10.0f %9.3f %9.1f %12.3f %11.1f %6.2fx\n", name, triangles, Median(load_s),
                 Median(peak), Median(ref_s), Median(ref_peak), Median(load_s) / Median(ref_s));
   }
-  std::printf("\nload: LoadLevel + CollisionWorld (import, conversion, BVH build), median of %d "
-              "runs, each in a fresh process;\nassimp: ReadFile of the same files without "
-              "post-processing; ratio = load / assimp.\n", runs);
+  std::printf(
+      "\nload: LoadLevel + CollisionWorld (import, conversion, BVH build), median of %d "
+      "runs, each in a fresh process;\nassimp: ReadFile of the same files without "
+      "post-processing; ratio = load / assimp.\n",
+      runs);
   if (keep.empty()) fs::remove_all(dir);
   return 0;
 }

@@ -1,16 +1,16 @@
 #include "scene/asset_import.h"
 
-#include <algorithm>
-#include <cctype>
-#include <fstream>
-#include <map>
-#include <sstream>
-
-#include <assimp/Importer.hpp>
 #include <assimp/config.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+
+#include <algorithm>
+#include <assimp/Importer.hpp>
+#include <cctype>
+#include <fstream>
+#include <map>
+#include <sstream>
 
 #include "scene/heightmap.h"
 
@@ -21,13 +21,6 @@ namespace fs = std::filesystem;
 
 // File formats whose up axis or unit is known by convention or declaration.
 enum class Format { kGltf, kCollada, kFbx, kQuake3, kTerragen, kOther };
-
-std::string LowerExtension(const fs::path& file) {
-  std::string ext = file.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
 
 Format FormatOf(const fs::path& file) {
   const std::string ext = LowerExtension(file);
@@ -234,8 +227,7 @@ class NodeCollector {
       const aiNode& child = *node.mChildren[c];
       std::string name = child.mName.C_Str();
       if (name.empty()) name = "node" + std::to_string(c);
-      Visit(child, path.empty() ? name : path + "/" + name,
-            G_FN * ToEigen(child.mTransformation));
+      Visit(child, path.empty() ? name : path + "/" + name, G_FN * ToEigen(child.mTransformation));
     }
   }
 
@@ -271,6 +263,13 @@ void CheckReadable(const fs::path& file) {
 }
 
 }  // namespace
+
+std::string LowerExtension(const fs::path& file) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
 
 void TransformMesh(const Eigen::Affine3d& T, Mesh* mesh) {
   const Eigen::Matrix3f linear = T.linear().cast<float>();
@@ -319,8 +318,7 @@ ImportedAsset ImportAsset(const fs::path& file, const AssetConversion& conversio
   }
   scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_GenSmoothNormals);
   if (scene == nullptr || scene->mRootNode == nullptr) {
-    throw LevelError(file.string() + ": assimp could not process it: " +
-                     importer.GetErrorString());
+    throw LevelError(file.string() + ": assimp could not process it: " + importer.GetErrorString());
   }
 
   // The file's (or format's) axes and unit, unless the caller overrides them.
@@ -328,17 +326,24 @@ ImportedAsset ImportAsset(const fs::path& file, const AssetConversion& conversio
   double unit_m = 1.0;
   double applied_unit_m = 1.0;  // what assimp already applied (Collada <unit>)
   switch (format) {
-    case Format::kGltf: up = UpAxis::kPosY; break;
+    case Format::kGltf:
+      up = UpAxis::kPosY;
+      break;
     case Format::kCollada: {
       const ColladaHeader header = ReadColladaHeader(file);
       up = header.up;
       unit_m = applied_unit_m = header.unit_m;
       break;
     }
-    case Format::kFbx: ReadFbxConvention(*scene, &up, &unit_m); break;
-    case Format::kQuake3: unit_m = 0.0254; break;  // Quake units are about an inch
+    case Format::kFbx:
+      ReadFbxConvention(*scene, &up, &unit_m);
+      break;
+    case Format::kQuake3:
+      unit_m = 0.0254;
+      break;  // Quake units are about an inch
     case Format::kTerragen:
-    case Format::kOther: break;
+    case Format::kOther:
+      break;
   }
   asset.up = conversion.up.value_or(up);
   asset.unit_scale_m = conversion.unit_scale_m.value_or(unit_m);

@@ -2,11 +2,10 @@
 // Reading one asset file into meshes in the world's axes and units. Used by the
 // level loader; scene-internal.
 
+#include <Eigen/Geometry>
 #include <filesystem>
 #include <string>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "scene/level.h"
 
@@ -34,6 +33,9 @@ struct ImportedAsset {
 // Throws LevelError naming the file when it is missing, unreadable, of an
 // unsupported format or has no triangles.
 ImportedAsset ImportAsset(const std::filesystem::path& file, const AssetConversion& conversion);
+
+// The file's extension in lower case, with its dot: ".glb".
+std::string LowerExtension(const std::filesystem::path& file);
 
 // Applies an affine map to a mesh: positions, normals (inverse transpose), and
 // the triangle winding when the map mirrors.

@@ -1,10 +1,10 @@
 #include "scene/collision_world.h"
 
+#include <btBulletCollisionCommon.h>
+
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <btBulletCollisionCommon.h>
 
 #include "scene/check.h"
 
@@ -95,7 +95,8 @@ CollisionWorld::CollisionWorld(const Level& level) : impl_(std::make_unique<Impl
     for (const Mesh& mesh : actor.meshes) {
       for (std::size_t first = 0; first < mesh.num_triangles(); first += kMaxTrianglesPerPart) {
         btIndexedMesh part;
-        part.m_numTriangles = static_cast<int>(std::min(kMaxTrianglesPerPart, mesh.num_triangles() - first));
+        part.m_numTriangles =
+            static_cast<int>(std::min(kMaxTrianglesPerPart, mesh.num_triangles() - first));
         part.m_triangleIndexBase = reinterpret_cast<const unsigned char*>(&mesh.indices[3 * first]);
         part.m_triangleIndexStride = 3 * sizeof(std::uint32_t);
         part.m_indexType = PHY_INTEGER;
@@ -130,8 +131,8 @@ CollisionWorld::CollisionWorld(const Level& level) : impl_(std::make_unique<Impl
 CollisionWorld::~CollisionWorld() = default;
 
 std::optional<RayHit> CollisionWorld::CastRay(const Eigen::Vector3d& from_W,
-                                              const Eigen::Vector3d& to_W,
-                                              std::uint32_t group_mask, int ignore_actor) const {
+                                              const Eigen::Vector3d& to_W, std::uint32_t group_mask,
+                                              int ignore_actor) const {
   const btVector3 from = ToBullet(from_W - p_WO_);
   const btVector3 to = ToBullet(to_W - p_WO_);
   ClosestHitIgnoring callback(from, to, ignore_actor);
@@ -151,7 +152,8 @@ std::optional<RayHit> CollisionWorld::CastRay(const Eigen::Vector3d& from_W,
 
 void CollisionWorld::SetActorPose(int actor, const Eigen::Isometry3d& X_WA) {
   if (actor < 0 || actor >= static_cast<int>(impl_->X_WA.size())) {
-    throw std::invalid_argument("CollisionWorld::SetActorPose(): no actor " + std::to_string(actor));
+    throw std::invalid_argument("CollisionWorld::SetActorPose(): no actor " +
+                                std::to_string(actor));
   }
   if (!impl_->movable[static_cast<std::size_t>(actor)]) {
     throw std::invalid_argument("CollisionWorld::SetActorPose(): actor " + std::to_string(actor) +
@@ -174,7 +176,9 @@ void CollisionWorld::SetOrigin(const Eigen::Vector3d& p_WO) {
   for (std::size_t a = 0; a < impl_->X_WA.size(); ++a) impl_->Place(static_cast<int>(a), p_WO_);
 }
 
-int CollisionWorld::num_collision_objects() const { return static_cast<int>(impl_->objects.size()); }
+int CollisionWorld::num_collision_objects() const {
+  return static_cast<int>(impl_->objects.size());
+}
 
 int CollisionWorld::num_parts() const { return impl_->num_parts; }
 

@@ -11,11 +11,10 @@
 // Threads: one thread (the loop thread) owns the world; CastRay uses
 // btCollisionWorld::rayTest, which is not safe to call from several threads.
 
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <memory>
 #include <optional>
-
-#include <Eigen/Geometry>
 
 #include "scene/level.h"
 
@@ -50,8 +49,7 @@ class CollisionWorld {
   // The first hit on the segment from `from_W` to `to_W` among objects whose
   // group is in `group_mask`, skipping actor `ignore_actor` (-1: none).
   std::optional<RayHit> CastRay(const Eigen::Vector3d& from_W, const Eigen::Vector3d& to_W,
-                                std::uint32_t group_mask = kAllGroups,
-                                int ignore_actor = -1) const;
+                                std::uint32_t group_mask = kAllGroups, int ignore_actor = -1) const;
 
   // Places a movable actor. Throws std::invalid_argument for an unknown index,
   // a static actor or a non-finite pose (the previous pose stays).

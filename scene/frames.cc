@@ -15,12 +15,18 @@ std::optional<UpAxis> ParseUpAxis(std::string_view text) {
 
 std::string ToString(UpAxis axis) {
   switch (axis) {
-    case UpAxis::kPosX: return "x";
-    case UpAxis::kNegX: return "-x";
-    case UpAxis::kPosY: return "y";
-    case UpAxis::kNegY: return "-y";
-    case UpAxis::kPosZ: return "z";
-    case UpAxis::kNegZ: return "-z";
+    case UpAxis::kPosX:
+      return "x";
+    case UpAxis::kNegX:
+      return "-x";
+    case UpAxis::kPosY:
+      return "y";
+    case UpAxis::kNegY:
+      return "-y";
+    case UpAxis::kPosZ:
+      return "z";
+    case UpAxis::kNegZ:
+      return "-z";
   }
   return "?";
 }
@@ -30,12 +36,18 @@ Eigen::Matrix3d UpAxisToWorld(UpAxis up) {
   using Eigen::Vector3d;
   const double half_pi = 0.5 * 3.14159265358979323846;
   switch (up) {
-    case UpAxis::kPosX: return AngleAxisd(-half_pi, Vector3d::UnitY()).toRotationMatrix();
-    case UpAxis::kNegX: return AngleAxisd(half_pi, Vector3d::UnitY()).toRotationMatrix();
-    case UpAxis::kPosY: return AngleAxisd(half_pi, Vector3d::UnitX()).toRotationMatrix();
-    case UpAxis::kNegY: return AngleAxisd(-half_pi, Vector3d::UnitX()).toRotationMatrix();
-    case UpAxis::kPosZ: return Eigen::Matrix3d::Identity();
-    case UpAxis::kNegZ: return AngleAxisd(2.0 * half_pi, Vector3d::UnitX()).toRotationMatrix();
+    case UpAxis::kPosX:
+      return AngleAxisd(-half_pi, Vector3d::UnitY()).toRotationMatrix();
+    case UpAxis::kNegX:
+      return AngleAxisd(half_pi, Vector3d::UnitY()).toRotationMatrix();
+    case UpAxis::kPosY:
+      return AngleAxisd(half_pi, Vector3d::UnitX()).toRotationMatrix();
+    case UpAxis::kNegY:
+      return AngleAxisd(-half_pi, Vector3d::UnitX()).toRotationMatrix();
+    case UpAxis::kPosZ:
+      return Eigen::Matrix3d::Identity();
+    case UpAxis::kNegZ:
+      return AngleAxisd(2.0 * half_pi, Vector3d::UnitX()).toRotationMatrix();
   }
   return Eigen::Matrix3d::Identity();
 }

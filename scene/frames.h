@@ -2,11 +2,10 @@
 // World frame conventions (../shared/DESIGN.md): right-handed, Z up, metres,
 // radians; roll-pitch-yaw means R = Rz(yaw) * Ry(pitch) * Rx(roll).
 
+#include <Eigen/Geometry>
 #include <optional>
 #include <string>
 #include <string_view>
-
-#include <Eigen/Geometry>
 
 namespace sandbox::scene {
 

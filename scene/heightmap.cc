@@ -1,13 +1,13 @@
 #include "scene/heightmap.h"
 
+#include <png.h>
+
 #include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <iterator>
 #include <memory>
 #include <string>
-
-#include <png.h>
 
 namespace sandbox::scene {
 namespace {
@@ -75,8 +75,8 @@ class TerragenReader {
 
  private:
   HeightGrid ReadHeights(int xpts, int ypts, const Eigen::Vector3d& scale_m) {
-    if (xpts < 2 || ypts < 2) Fail("grid of " + std::to_string(xpts) + " x " +
-                                   std::to_string(ypts) + " points");
+    if (xpts < 2 || ypts < 2)
+      Fail("grid of " + std::to_string(xpts) + " x " + std::to_string(ypts) + " points");
     const double height_scale = Int16();
     const double base_height = Int16();
     const std::size_t count = std::size_t(xpts) * std::size_t(ypts);
@@ -152,7 +152,8 @@ std::vector<float> ReadPgm(const fs::path& file, int* cols, int* rows) {
   }
   std::vector<float> values(count);
   for (std::size_t i = 0; i < count; ++i) {
-    const unsigned v = depth == 2 ? (bytes[at + 2 * i] << 8) | bytes[at + 2 * i + 1] : bytes[at + i];
+    const unsigned v =
+        depth == 2 ? (bytes[at + 2 * i] << 8) | bytes[at + 2 * i + 1] : bytes[at + i];
     values[i] = static_cast<float>(v) / static_cast<float>(max_value);
   }
   return values;
@@ -208,7 +209,8 @@ Mesh MeshFromHeightGrid(const HeightGrid& grid) {
       const float dz_dy = (height(c, r - 1) - height(c, r + 1)) /
                           (dy * static_cast<float>(std::min(r + 1, rows - 1) - std::max(r - 1, 0)));
       mesh.normals_A.push_back(Eigen::Vector3f(-dz_dx, -dz_dy, 1.0f).normalized());
-      mesh.uvs.emplace_back(static_cast<float>(c) / (cols - 1), 1.0f - static_cast<float>(r) / (rows - 1));
+      mesh.uvs.emplace_back(static_cast<float>(c) / (cols - 1),
+                            1.0f - static_cast<float>(r) / (rows - 1));
     }
   }
   mesh.indices.reserve(std::size_t(cols - 1) * (rows - 1) * 6);
@@ -233,8 +235,7 @@ ImportedAsset ImportTerragen(const fs::path& file, const AssetConversion& conver
 }
 
 ImportedAsset ImportHeightmapImage(const fs::path& file, const Eigen::Vector3d& size_m) {
-  std::string ext = file.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string ext = LowerExtension(file);
   int cols = 0, rows = 0;
   std::vector<float> values;
   if (ext == ".pgm") {

@@ -2,10 +2,9 @@
 // Terrains given as height grids: Terragen .ter files and heightmap images
 // (8- or 16-bit PNG, binary PGM) placed by a level manifest.
 
+#include <Eigen/Core>
 #include <filesystem>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "scene/asset_import.h"
 

@@ -110,12 +110,6 @@ Level LoadManifest(const fs::path& file) {
   return level;
 }
 
-std::string LowerExtension(const fs::path& file) {
-  std::string ext = file.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
-
 }  // namespace
 
 std::size_t Actor::num_triangles() const {
@@ -150,8 +144,8 @@ Eigen::AlignedBox3d Level::bounds_W() const {
 
 Level LoadLevel(const fs::path& file, const AssetConversion& conversion) {
   if (!fs::exists(file)) throw LevelError(file.string() + ": no such file");
-  Level level = LowerExtension(file) == ".toml" ? LoadManifest(file)
-                                                 : LoadSceneFile(file, conversion);
+  Level level =
+      LowerExtension(file) == ".toml" ? LoadManifest(file) : LoadSceneFile(file, conversion);
   for (Actor& actor : level.actors) ComputeBounds(&actor);
   return level;
 }

@@ -4,6 +4,7 @@
 // (Z up, metres). A Level is constant after loading; run-time placements of
 // movable actors live in CollisionWorld.
 
+#include <Eigen/Geometry>
 #include <cstddef>
 #include <filesystem>
 #include <optional>
@@ -11,8 +12,6 @@
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "scene/frames.h"
 #include "scene/mesh.h"
@@ -28,12 +27,12 @@ class LevelError : public std::runtime_error {
 };
 
 struct Actor {
-  std::string name;    // unique in the level
-  std::string source;  // the file (and node path) it came from
+  std::string name;                                       // unique in the level
+  std::string source;                                     // the file (and node path) it came from
   Eigen::Isometry3d X_WA{Eigen::Isometry3d::Identity()};  // pose at load time
-  bool collision{true};  // false: drawn but invisible to rays
-  bool movable{false};   // true: may be placed from outside at run time
-  std::vector<Mesh> meshes;  // in frame A
+  bool collision{true};                                   // false: drawn but invisible to rays
+  bool movable{false};           // true: may be placed from outside at run time
+  std::vector<Mesh> meshes;      // in frame A
   Eigen::AlignedBox3d bounds_W;  // exact bounds of the meshes at X_WA; empty without meshes
 
   std::size_t num_triangles() const;

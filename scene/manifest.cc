@@ -1,10 +1,10 @@
 #include "scene/manifest.h"
 
+#include <toml++/toml.h>
+
 #include <cmath>
 #include <set>
 #include <sstream>
-
-#include <toml++/toml.h>
 
 namespace sandbox::scene {
 namespace {
@@ -145,8 +145,8 @@ ActorSpec ParseActor(const fs::path& file, const toml::table& table, int index) 
       actor.scale.setConstant(read.Number(scale, "scale"));
     }
     if ((actor.scale.array() <= 0.0).any()) {
-      read.Fail(scale, "'scale' must be positive, got " +
-                           TableReader::Format(actor.scale.minCoeff()));
+      read.Fail(scale,
+                "'scale' must be positive, got " + TableReader::Format(actor.scale.minCoeff()));
     }
   }
 
@@ -175,8 +175,8 @@ LevelManifest ParseManifest(const fs::path& file) {
     root = toml::parse_file(file.string());
   } catch (const toml::parse_error& error) {
     std::ostringstream out;
-    out << file.string() << ":" << error.source().begin.line << ": TOML syntax error: "
-        << error.description();
+    out << file.string() << ":" << error.source().begin.line
+        << ": TOML syntax error: " << error.description();
     throw LevelError(out.str());
   }
   LevelManifest manifest;

@@ -2,12 +2,11 @@
 // The TOML level manifest (docs/levels.md is the reference). Parsing only:
 // values are checked here, files are read by the level loader.
 
+#include <Eigen/Geometry>
 #include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "scene/level.h"
 
@@ -16,8 +15,8 @@ namespace sandbox::scene {
 // One [[actor]] table: an asset file or a heightmap image placed in the world.
 struct ActorSpec {
   std::string name;
-  std::filesystem::path file;       // resolved against the manifest's folder
-  bool is_heightmap{false};         // `heightmap = ...` instead of `file = ...`
+  std::filesystem::path file;  // resolved against the manifest's folder
+  bool is_heightmap{false};    // `heightmap = ...` instead of `file = ...`
   Eigen::Vector3d heightmap_size_m{Eigen::Vector3d::Zero()};
   Eigen::Vector3d position_m{Eigen::Vector3d::Zero()};
   Eigen::Quaterniond rotation{Eigen::Quaterniond::Identity()};

@@ -1,11 +1,10 @@
 #pragma once
 // Render and collision geometry of the world, kept as plain contiguous arrays.
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace sandbox::scene {
 

@@ -42,8 +42,8 @@ void GeneratedMesh::ComputeNormals() {
   }
   normals.resize(positions.size());
   for (std::size_t v = 0; v < positions.size(); ++v) {
-    const double length = std::sqrt(sum[v][0] * sum[v][0] + sum[v][1] * sum[v][1] +
-                                     sum[v][2] * sum[v][2]);
+    const double length =
+        std::sqrt(sum[v][0] * sum[v][0] + sum[v][1] * sum[v][1] + sum[v][2] * sum[v][2]);
     for (int j = 0; j < 3; ++j) {
       normals[v][j] = length > 0.0 ? static_cast<float>(sum[v][j] / length) : (j == 2 ? 1.f : 0.f);
     }
@@ -103,10 +103,11 @@ void WriteGltf(const std::filesystem::path& file, const std::vector<GeneratedMes
               << ",\"componentType\":5126,\"count\":" << positions.size()
               << ",\"type\":\"VEC3\",\"min\":[" << lo[0] << "," << lo[1] << "," << lo[2]
               << "],\"max\":[" << hi[0] << "," << hi[1] << "," << hi[2] << "]},"
-              << "{\"bufferView\":" << normal_view << ",\"componentType\":5126,\"count\":"
-              << normals.size() << ",\"type\":\"VEC3\"},"
-              << "{\"bufferView\":" << index_view << ",\"componentType\":5125,\"count\":"
-              << mesh.indices.size() << ",\"type\":\"SCALAR\"}";
+              << "{\"bufferView\":" << normal_view
+              << ",\"componentType\":5126,\"count\":" << normals.size() << ",\"type\":\"VEC3\"},"
+              << "{\"bufferView\":" << index_view
+              << ",\"componentType\":5125,\"count\":" << mesh.indices.size()
+              << ",\"type\":\"SCALAR\"}";
     json_meshes << sep << "{\"name\":\"" << mesh.name << "\",\"primitives\":[{\"attributes\":"
                 << "{\"POSITION\":" << 3 * m << ",\"NORMAL\":" << 3 * m + 1
                 << "},\"indices\":" << 3 * m + 2 << ",\"material\":" << m << "}]}";

@@ -15,9 +15,9 @@ namespace sandbox::assets {
 struct GeneratedMesh {
   std::string name;
   std::array<float, 4> base_color{0.8f, 0.8f, 0.8f, 1.0f};  // linear RGBA
-  std::vector<std::array<float, 3>> positions;  // Z up, metres
-  std::vector<std::array<float, 3>> normals;    // filled by ComputeNormals if empty
-  std::vector<std::uint32_t> indices;           // counter-clockwise seen from outside
+  std::vector<std::array<float, 3>> positions;              // Z up, metres
+  std::vector<std::array<float, 3>> normals;                // filled by ComputeNormals if empty
+  std::vector<std::uint32_t> indices;                       // counter-clockwise seen from outside
 
   std::uint32_t AddVertex(float x, float y, float z);
   void AddTriangle(std::uint32_t a, std::uint32_t b, std::uint32_t c);

@@ -68,13 +68,14 @@ double Bumps(const Point& d, double seed) {
 // An icosphere of `subdivisions`, radius scaled per axis and displaced by Bumps.
 void AddRock(GeneratedMesh* mesh, Point centre, Point radius, int subdivisions, double seed) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Point> v = {{-1, float(t), 0}, {1, float(t), 0}, {-1, float(-t), 0}, {1, float(-t), 0},
-                          {0, -1, float(t)}, {0, 1, float(t)}, {0, -1, float(-t)}, {0, 1, float(-t)},
-                          {float(t), 0, -1}, {float(t), 0, 1}, {float(-t), 0, -1}, {float(-t), 0, 1}};
+  std::vector<Point> v = {{-1, float(t), 0},  {1, float(t), 0},   {-1, float(-t), 0},
+                          {1, float(-t), 0},  {0, -1, float(t)},  {0, 1, float(t)},
+                          {0, -1, float(-t)}, {0, 1, float(-t)},  {float(t), 0, -1},
+                          {float(t), 0, 1},   {float(-t), 0, -1}, {float(-t), 0, 1}};
   std::vector<std::array<std::uint32_t, 3>> faces = {
-      {0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+      {0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
       {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-      {3, 8, 9},  {4, 9, 5},  {2, 4, 11},  {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+      {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
   auto normalize = [](Point p) {
     const float l = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
     return Point{p[0] / l, p[1] / l, p[2] / l};
@@ -86,8 +87,8 @@ void AddRock(GeneratedMesh* mesh, Point centre, Point radius, int subdivisions, 
       const auto key = std::minmax(a, b);
       auto [it, inserted] = midpoints.emplace(key, std::uint32_t(v.size()));
       if (inserted) {
-        v.push_back(normalize({(v[a][0] + v[b][0]) / 2, (v[a][1] + v[b][1]) / 2,
-                               (v[a][2] + v[b][2]) / 2}));
+        v.push_back(
+            normalize({(v[a][0] + v[b][0]) / 2, (v[a][1] + v[b][1]) / 2, (v[a][2] + v[b][2]) / 2}));
       }
       return it->second;
     };
@@ -102,7 +103,8 @@ void AddRock(GeneratedMesh* mesh, Point centre, Point radius, int subdivisions, 
   const auto base = std::uint32_t(mesh->positions.size());
   for (const Point& d : v) {
     const double k = 1.0 + Bumps(d, seed);
-    mesh->AddVertex(float(centre[0] + radius[0] * k * d[0]), float(centre[1] + radius[1] * k * d[1]),
+    mesh->AddVertex(float(centre[0] + radius[0] * k * d[0]),
+                    float(centre[1] + radius[1] * k * d[1]),
                     float(centre[2] + radius[2] * k * d[2]));
   }
   for (const auto& f : faces) mesh->AddTriangle(base + f[0], base + f[1], base + f[2]);

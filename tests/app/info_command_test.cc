@@ -2,11 +2,11 @@
 // (never a crash) for bad input.
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <array>
 #include <cstdio>
 #include <string>
-#include <sys/wait.h>
 
 #include "tests/test_util.h"
 
@@ -63,8 +63,8 @@ TEST(InfoCommandTest, BadLevelsExitOneWithOneMessage) {
   const auto bad = dir.Write("bad.toml", "[[actor]]\nname = \"a\"\nfile = \"x.obj\"\nscale = -2\n");
   CommandRun run = Sandbox("info " + bad.string());
   EXPECT_EQ(run.exit_code, 1);
-  EXPECT_EQ(run.out, "sandbox info: " + bad.string() +
-                         ":4: actor 'a': 'scale' must be positive, got -2\n");
+  EXPECT_EQ(run.out,
+            "sandbox info: " + bad.string() + ":4: actor 'a': 'scale' must be positive, got -2\n");
 
   run = Sandbox("info " + (dir.path() / "none.glb").string());
   EXPECT_EQ(run.exit_code, 1);

@@ -58,7 +58,8 @@ TEST_F(SampleLevelTest, VerticalRaysHitTheGeneratorsHeightToOneMillimetre) {
       const double yi = 0.2 * sample::GridY(south) + 0.5 * sample::GridY(south) + 0.3 * y;
       const double zi = 0.2 * GridHeight(col, south) + 0.5 * GridHeight(east, south) +
                         0.3 * GridHeight(east, row);
-      for (const auto& [px, py, pz] : {std::tuple{x, y, GridHeight(col, row)}, std::tuple{xi, yi, zi}}) {
+      for (const auto& [px, py, pz] :
+           {std::tuple{x, y, GridHeight(col, row)}, std::tuple{xi, yi, zi}}) {
         const auto hit = DownOnTerrain(px, py);
         if (!hit) {
           ++blocked;  // a rock or building stands there
@@ -123,7 +124,8 @@ TEST_F(SampleLevelTest, ChannelsMovableActorsAndIgnoring) {
   world.SetActorPose(gate, X_WG);
   EXPECT_EQ(world.CastRay(above_gate, above_gate - Vector3d(0, 0, 60))->actor,
             level_->FindActor("terrain"));
-  const auto moved = world.CastRay(above_gate + Vector3d(50, 0, 30), above_gate + Vector3d(50, 0, -60));
+  const auto moved =
+      world.CastRay(above_gate + Vector3d(50, 0, 30), above_gate + Vector3d(50, 0, -60));
   ASSERT_TRUE(moved.has_value());
   EXPECT_EQ(moved->actor, gate);
   EXPECT_NEAR(moved->point_W.z(), 13.22 + 20 + 5.2, 1e-3);  // top of the beam

@@ -15,8 +15,8 @@ TEST(FramesTest, YUpAssetMapsAsBlenderDoes) {
 
 TEST(FramesTest, EveryUpAxisBecomesWorldZ) {
   const std::pair<UpAxis, Vector3d> cases[] = {
-      {UpAxis::kPosX, {1, 0, 0}}, {UpAxis::kNegX, {-1, 0, 0}}, {UpAxis::kPosY, {0, 1, 0}},
-      {UpAxis::kNegY, {0, -1, 0}}, {UpAxis::kPosZ, {0, 0, 1}}, {UpAxis::kNegZ, {0, 0, -1}}};
+      {UpAxis::kPosX, {1, 0, 0}},  {UpAxis::kNegX, {-1, 0, 0}}, {UpAxis::kPosY, {0, 1, 0}},
+      {UpAxis::kNegY, {0, -1, 0}}, {UpAxis::kPosZ, {0, 0, 1}},  {UpAxis::kNegZ, {0, 0, -1}}};
   for (const auto& [axis, up] : cases) {
     const Eigen::Matrix3d R = UpAxisToWorld(axis);
     EXPECT_TRUE((R * up).isApprox(Vector3d::UnitZ(), 1e-12)) << ToString(axis);

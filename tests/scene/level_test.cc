@@ -1,12 +1,13 @@
 // Scene files as levels: actors per node, names, frames and bad files.
 
+#include "scene/level.h"
+
+#include <assimp/scene.h>
 #include <gtest/gtest.h>
 
 #include <assimp/Exporter.hpp>
 #include <assimp/Importer.hpp>
-#include <assimp/scene.h>
 
-#include "scene/level.h"
 #include "tests/scene/obj_text.h"
 #include "tests/test_util.h"
 
@@ -38,7 +39,8 @@ void ExpectNear(const Vector3d& actual, const Vector3d& expected, const std::str
 
 TEST(LevelTest, ObjObjectsBecomeActorsInWorldZUp) {
   TempDir dir;
-  const auto file = dir.Write("two.obj", ObjBox("left", 1, 2, 3) + ObjBox("right", 1, 1, 1, 5, 0, 0, 9));
+  const auto file =
+      dir.Write("two.obj", ObjBox("left", 1, 2, 3) + ObjBox("right", 1, 1, 1, 5, 0, 0, 9));
   const Level level = LoadLevel(file);
   ASSERT_EQ(level.actors.size(), 2u);
   EXPECT_EQ(level.actors[0].name, "left");

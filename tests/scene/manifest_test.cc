@@ -37,9 +37,11 @@ class ManifestTest : public ::testing::Test {
 
 void ExpectBounds(const Actor& actor, const Vector3d& lo, const Vector3d& hi) {
   EXPECT_TRUE((actor.bounds_W.min() - lo).norm() < 1e-6)
-      << actor.name << " min " << actor.bounds_W.min().transpose() << " expected " << lo.transpose();
+      << actor.name << " min " << actor.bounds_W.min().transpose() << " expected "
+      << lo.transpose();
   EXPECT_TRUE((actor.bounds_W.max() - hi).norm() < 1e-6)
-      << actor.name << " max " << actor.bounds_W.max().transpose() << " expected " << hi.transpose();
+      << actor.name << " max " << actor.bounds_W.max().transpose() << " expected "
+      << hi.transpose();
 }
 
 TEST_F(ManifestTest, PlacesScalesAndRotatesAnAsset) {
@@ -164,8 +166,9 @@ TEST_F(ManifestTest, BadAssetFilesNameManifestLineAndAsset) {
   EXPECT_NE(missing.find("nowhere.obj: no such file"), std::string::npos) << missing;
 
   dir_.Write("notes.xyz", "not a model\n");
-  EXPECT_NE(Error("[[actor]]\nname = \"a\"\nfile = \"notes.xyz\"\n").find("unsupported format '.xyz'"),
-            std::string::npos);
+  EXPECT_NE(
+      Error("[[actor]]\nname = \"a\"\nfile = \"notes.xyz\"\n").find("unsupported format '.xyz'"),
+      std::string::npos);
 
   dir_.Write("points.obj", "v 0 0 0\nv 1 0 0\n");
   const std::string no_meshes = Error("[[actor]]\nname = \"a\"\nfile = \"points.obj\"\n");

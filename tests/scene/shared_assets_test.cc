@@ -42,8 +42,8 @@ Level ExpectSize(const fs::path& file, const Vector3d& size_m, double tolerance_
 
 TEST_F(SharedAssetsTest, Quake3MapDropsBadFacesOnceAndIsZUpInInches) {
   // STATS: 3520 x 1536 x 4096 units, Z up; 1 unit = 0.0254 m.
-  const Level level = ExpectSize(Shared("q3-de4th-run1/de4th_run1.pk3"),
-                                 Vector3d(3520, 1536, 4096) * 0.0254, 0.01);
+  const Level level =
+      ExpectSize(Shared("q3-de4th-run1/de4th_run1.pk3"), Vector3d(3520, 1536, 4096) * 0.0254, 0.01);
   EXPECT_EQ(level.actors.size(), 61u);
   ASSERT_EQ(level.warnings.size(), 1u);
   EXPECT_NE(level.warnings[0].find("dropped 3 faces with out-of-range vertex indices"),
@@ -76,14 +76,15 @@ TEST_F(SharedAssetsTest, DeepHierarchyGivesOneActorPerMeshNode) {
   const Level level =
       ExpectSize(Shared("recursive-skeletons/RecursiveSkeletons.glb"), {10, 10, 90}, 0.01);
   EXPECT_GT(level.actors.size(), 1u);
-  for (const Actor& actor : level.actors) EXPECT_EQ(level.FindActor(actor.name), &actor - &level.actors[0]);
+  for (const Actor& actor : level.actors)
+    EXPECT_EQ(level.FindActor(actor.name), &actor - &level.actors[0]);
 }
 
 TEST_F(SharedAssetsTest, ColladaUpAxisMatchesTheZUpCollisionMeshes) {
   // The URDF uses each link's visual .dae and collision .stl in the same frame:
   // with <up_axis> honoured their bounds agree (to the coarser STL's detail).
-  for (const std::string link : {"base_link", "link_1", "link_2", "link_3", "link_4", "link_5",
-                                 "link_6", "link_7"}) {
+  for (const std::string link :
+       {"base_link", "link_1", "link_2", "link_3", "link_4", "link_5", "link_6", "link_7"}) {
     const Level visual = LoadLevel(Shared("kuka-iiwa/visual/" + link + ".dae"));
     const Level collision = LoadLevel(Shared("kuka-iiwa/collision/" + link + ".stl"));
     const Eigen::AlignedBox3d a = visual.bounds_W(), b = collision.bounds_W();
@@ -97,7 +98,7 @@ TEST_F(SharedAssetsTest, KukaArmPlacedByManifestStandsAboutOnePointThreeMetresTa
   ASSERT_EQ(level.actors.size(), 8u);
   const Eigen::AlignedBox3d box = level.bounds_W();
   EXPECT_NEAR(box.min().z(), 0.0, 0.01);
-  EXPECT_NEAR(box.max().z(), 1.18 + 0.126, 0.03);  // flange at joint a7 + tool0 offset
+  EXPECT_NEAR(box.max().z(), 1.18 + 0.126, 0.03);    // flange at joint a7 + tool0 offset
   EXPECT_LT(box.sizes().head<2>().maxCoeff(), 0.3);  // a straight arm
   EXPECT_TRUE(level.actors[7].movable);
 }
@@ -106,13 +107,14 @@ TEST_F(SharedAssetsTest, Px4ModelsInTheirSdfUnits) {
   // SketchUp Collada, Z up, inches: STATS (Y-up after assimp) 7.6 x 2.6 x 11.0.
   ExpectSize(Shared("px4-plane/meshes/body.dae"), {7.63, 11.03, 2.62}, 0.02);
   ExpectSize(Shared("px4-iris/meshes/iris.stl"), {0.30, 0.48, 0.11}, 0.01);
-  for (const char* part : {"left_aileron", "right_aileron", "left_flap", "right_flap",
-                           "elevators", "rudder", "propeller_cw", "propeller_ccw"}) {
+  for (const char* part : {"left_aileron", "right_aileron", "left_flap", "right_flap", "elevators",
+                           "rudder", "propeller_cw", "propeller_ccw"}) {
     const Level level = LoadLevel(Shared(std::string("px4-plane/meshes/") + part + ".dae"));
     EXPECT_GT(level.num_triangles(), 0u) << part;
   }
   // Heightmap through a manifest, as the SDF sizes it: 80 x 80 m, at most 2 m high.
-  const Level ground = LoadLevel(fs::path(SANDBOX_SOURCE_DIR) / "tests/data/px4_uneven_ground.toml");
+  const Level ground =
+      LoadLevel(fs::path(SANDBOX_SOURCE_DIR) / "tests/data/px4_uneven_ground.toml");
   const Vector3d size = ground.bounds_W().sizes();
   EXPECT_NEAR(size.x(), 80.0, 1e-6);
   EXPECT_NEAR(size.y(), 80.0, 1e-6);
