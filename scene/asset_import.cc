@@ -10,7 +10,6 @@
 #include <cctype>
 #include <fstream>
 #include <map>
-#include <sstream>
 
 #include "scene/heightmap.h"
 

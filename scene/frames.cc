@@ -1,32 +1,32 @@
 #include "scene/frames.h"
 
+#include <cctype>
+#include <utility>
+
 namespace sandbox::scene {
+
+namespace {
+
+// Each axis with its name, for parsing and printing alike.
+constexpr std::pair<UpAxis, std::string_view> kAxisNames[] = {
+    {UpAxis::kPosX, "x"}, {UpAxis::kNegX, "-x"}, {UpAxis::kPosY, "y"},
+    {UpAxis::kNegY, "-y"}, {UpAxis::kPosZ, "z"}, {UpAxis::kNegZ, "-z"}};
+
+}  // namespace
 
 std::optional<UpAxis> ParseUpAxis(std::string_view text) {
   if (!text.empty() && text.front() == '+') text.remove_prefix(1);
-  if (text == "x" || text == "X") return UpAxis::kPosX;
-  if (text == "-x" || text == "-X") return UpAxis::kNegX;
-  if (text == "y" || text == "Y") return UpAxis::kPosY;
-  if (text == "-y" || text == "-Y") return UpAxis::kNegY;
-  if (text == "z" || text == "Z") return UpAxis::kPosZ;
-  if (text == "-z" || text == "-Z") return UpAxis::kNegZ;
+  std::string lower(text);
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  for (const auto& [axis, name] : kAxisNames) {
+    if (lower == name) return axis;
+  }
   return std::nullopt;
 }
 
 std::string ToString(UpAxis axis) {
-  switch (axis) {
-    case UpAxis::kPosX:
-      return "x";
-    case UpAxis::kNegX:
-      return "-x";
-    case UpAxis::kPosY:
-      return "y";
-    case UpAxis::kNegY:
-      return "-y";
-    case UpAxis::kPosZ:
-      return "z";
-    case UpAxis::kNegZ:
-      return "-z";
+  for (const auto& [candidate, name] : kAxisNames) {
+    if (candidate == axis) return std::string(name);
   }
   return "?";
 }

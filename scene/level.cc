@@ -1,6 +1,5 @@
 #include "scene/level.h"
 
-#include <algorithm>
 #include <numeric>
 
 #include "scene/asset_import.h"
