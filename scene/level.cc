@@ -31,9 +31,9 @@ void ComputeBounds(Actor* actor) {
   }
 }
 
-// Appends an asset's materials and textures to the level's, renumbering the
+// Appends an asset's materials, textures and warnings to the level's, renumbering the
 // references of `meshes` (of this asset) accordingly.
-void MergeMaterials(ImportedAsset* asset, Level* level) {
+void AdoptMaterialsAndWarnings(ImportedAsset* asset, Level* level) {
   const int material_base = static_cast<int>(level->materials.size());
   const int texture_base = static_cast<int>(level->textures.size());
   for (Material& material : asset->materials) {
@@ -58,7 +58,7 @@ Level LoadSceneFile(const fs::path& file, const AssetConversion& conversion) {
   Level level;
   level.file = file;
   level.name = file.stem().string();
-  MergeMaterials(&asset, &level);
+  AdoptMaterialsAndWarnings(&asset, &level);
   for (ImportedNode& node : asset.nodes) {
     Actor actor;
     actor.name = node.path;
@@ -90,7 +90,7 @@ Level LoadManifest(const fs::path& file) {
       throw LevelError(file.string() + ":" + std::to_string(spec.line) + ": actor '" + spec.name +
                        "': " + error.what());
     }
-    MergeMaterials(&asset, &level);
+    AdoptMaterialsAndWarnings(&asset, &level);
     Actor actor;
     actor.name = spec.name;
     actor.source = spec.file.string();
