@@ -94,7 +94,7 @@ Figures AssimpReadOnly(const fs::path& level_file) {
 
 // A 1000 x 500 cell terrain (1,000,000 triangles), 1 m apart, as glTF + manifest.
 fs::path WriteMillionTriangleLevel(const fs::path& dir) {
-  sandbox::assets::GeneratedMesh mesh{"terrain", {0.4f, 0.5f, 0.3f, 1.0f}, {}, {}, {}};
+  sandbox::assets::GeneratedMesh mesh{"terrain", {0.4f, 0.5f, 0.3f, 1.0f}};
   const int cols = 1000, rows = 500;
   for (int r = 0; r <= rows; ++r) {
     for (int c = 0; c <= cols; ++c) {

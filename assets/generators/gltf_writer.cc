@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iomanip>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -50,10 +51,9 @@ void GeneratedMesh::ComputeNormals() {
   }
 }
 
-namespace {
-
-// World Z-up to glTF Y-up.
 std::array<float, 3> ToGltf(const std::array<float, 3>& p) { return {p[0], p[2], -p[1]}; }
+
+namespace {
 
 template <typename T>
 void Append(std::string* bin, const std::vector<T>& values) {
@@ -61,79 +61,141 @@ void Append(std::string* bin, const std::vector<T>& values) {
   while (bin->size() % 4 != 0) bin->push_back('\0');
 }
 
+// Accumulates buffer views and accessors over one binary buffer.
+class BufferBuilder {
+ public:
+  template <typename T>
+  int Add(const std::vector<T>& values, int target, int component_type, const char* type,
+          const std::string& extra = "") {
+    const std::size_t offset = bin_.size();
+    Append(&bin_, values);
+    const int view = views_count_++;
+    views_ << (view > 0 ? "," : "") << "{\"buffer\":0,\"byteOffset\":" << offset
+           << ",\"byteLength\":" << values.size() * sizeof(T);
+    if (target != 0) views_ << ",\"target\":" << target;
+    views_ << "}";
+    const std::size_t components = sizeof(T) / ComponentSize(component_type);
+    const std::size_t count = values.size() * components / TypeSize(type);
+    accessors_ << (view > 0 ? "," : "") << "{\"bufferView\":" << view
+               << ",\"componentType\":" << component_type << ",\"count\":" << count
+               << ",\"type\":\"" << type << "\"" << extra << "}";
+    return view;  // one accessor per view, same index
+  }
+  const std::string& bin() const { return bin_; }
+  std::string views() const { return views_.str(); }
+  std::string accessors() const { return accessors_.str(); }
+
+ private:
+  static std::size_t ComponentSize(int component_type) {
+    return component_type == 5123 ? 2 : 4;  // unsigned short, else float / unsigned int
+  }
+  static std::size_t TypeSize(const std::string& type) {
+    if (type == "VEC3") return 3;
+    if (type == "VEC4") return 4;
+    if (type == "MAT4") return 16;
+    return 1;
+  }
+  std::string bin_;
+  std::ostringstream views_, accessors_;
+  int views_count_{0};
+};
+
 }  // namespace
 
-void WriteGltf(const std::filesystem::path& file, const std::vector<GeneratedMesh>& meshes) {
-  std::string bin;
-  std::ostringstream views, accessors, json_meshes, nodes, materials;
-  int view = 0;
-  auto add_view = [&](std::size_t offset, std::size_t length, int target) {
-    views << (view > 0 ? "," : "") << "{\"buffer\":0,\"byteOffset\":" << offset
-          << ",\"byteLength\":" << length << ",\"target\":" << target << "}";
-    return view++;
-  };
-  for (std::size_t m = 0; m < meshes.size(); ++m) {
-    GeneratedMesh mesh = meshes[m];
+void WriteGltfScene(const std::filesystem::path& file, const GltfScene& scene) {
+  BufferBuilder buffer;
+  std::ostringstream json_meshes, materials, nodes;
+  for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
+    GeneratedMesh mesh = scene.meshes[m];
     if (mesh.normals.size() != mesh.positions.size()) mesh.ComputeNormals();
-    std::vector<std::array<float, 3>> positions, normals;
     std::array<float, 3> lo{}, hi{};
     lo.fill(std::numeric_limits<float>::max());
     hi.fill(-std::numeric_limits<float>::max());
     for (const auto& p : mesh.positions) {
-      positions.push_back(ToGltf(p));
-      for (int j = 0; j < 3; ++j) {
-        lo[j] = std::min(lo[j], positions.back()[j]);
-        hi[j] = std::max(hi[j], positions.back()[j]);
-      }
+      for (int j = 0; j < 3; ++j) lo[j] = std::min(lo[j], p[j]), hi[j] = std::max(hi[j], p[j]);
     }
-    for (const auto& n : mesh.normals) normals.push_back(ToGltf(n));
-
-    std::size_t offset = bin.size();
-    Append(&bin, positions);
-    const int position_view = add_view(offset, positions.size() * 12, 34962);
-    offset = bin.size();
-    Append(&bin, normals);
-    const int normal_view = add_view(offset, normals.size() * 12, 34962);
-    offset = bin.size();
-    Append(&bin, mesh.indices);
-    const int index_view = add_view(offset, mesh.indices.size() * 4, 34963);
-
-    const char* sep = m > 0 ? "," : "";
-    accessors << sep << "{\"bufferView\":" << position_view
-              << ",\"componentType\":5126,\"count\":" << positions.size()
-              << ",\"type\":\"VEC3\",\"min\":[" << lo[0] << "," << lo[1] << "," << lo[2]
-              << "],\"max\":[" << hi[0] << "," << hi[1] << "," << hi[2] << "]},"
-              << "{\"bufferView\":" << normal_view
-              << ",\"componentType\":5126,\"count\":" << normals.size() << ",\"type\":\"VEC3\"},"
-              << "{\"bufferView\":" << index_view
-              << ",\"componentType\":5125,\"count\":" << mesh.indices.size()
-              << ",\"type\":\"SCALAR\"}";
-    json_meshes << sep << "{\"name\":\"" << mesh.name << "\",\"primitives\":[{\"attributes\":"
-                << "{\"POSITION\":" << 3 * m << ",\"NORMAL\":" << 3 * m + 1
-                << "},\"indices\":" << 3 * m + 2 << ",\"material\":" << m << "}]}";
-    nodes << sep << "{\"name\":\"" << mesh.name << "\",\"mesh\":" << m << "}";
+    std::ostringstream bounds;
+    bounds << ",\"min\":[" << lo[0] << "," << lo[1] << "," << lo[2] << "],\"max\":[" << hi[0]
+           << "," << hi[1] << "," << hi[2] << "]";
+    const int position = buffer.Add(mesh.positions, 34962, 5126, "VEC3", bounds.str());
+    const int normal = buffer.Add(mesh.normals, 34962, 5126, "VEC3");
+    const int indices = buffer.Add(mesh.indices, 34963, 5125, "SCALAR");
+    json_meshes << (m > 0 ? "," : "") << "{\"name\":\"" << mesh.name
+                << "\",\"primitives\":[{\"attributes\":{\"POSITION\":" << position
+                << ",\"NORMAL\":" << normal;
+    if (!mesh.joints.empty()) {
+      json_meshes << ",\"JOINTS_0\":" << buffer.Add(mesh.joints, 34962, 5123, "VEC4")
+                  << ",\"WEIGHTS_0\":" << buffer.Add(mesh.weights, 34962, 5126, "VEC4");
+    }
+    json_meshes << "},\"indices\":" << indices << ",\"material\":" << m << "}]}";
     const auto& c = mesh.base_color;
-    materials << sep << "{\"name\":\"" << mesh.name << "\",\"pbrMetallicRoughness\":"
-              << "{\"baseColorFactor\":[" << c[0] << "," << c[1] << "," << c[2] << "," << c[3]
-              << "],\"metallicFactor\":0,\"roughnessFactor\":0.9}"
+    materials << (m > 0 ? "," : "") << "{\"name\":\"" << mesh.name
+              << "\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[" << c[0] << "," << c[1]
+              << "," << c[2] << "," << c[3] << "],\"metallicFactor\":0,\"roughnessFactor\":0.9}"
               << (c[3] < 1.0f ? ",\"alphaMode\":\"BLEND\"" : "") << "}";
   }
-  std::ostringstream scene_nodes;
-  for (std::size_t m = 0; m < meshes.size(); ++m) scene_nodes << (m > 0 ? "," : "") << m;
+  for (std::size_t n = 0; n < scene.nodes.size(); ++n) {
+    const GltfNode& node = scene.nodes[n];
+    const auto& t = node.translation;
+    const auto& r = node.rotation_xyzw;
+    nodes << (n > 0 ? "," : "") << "{\"name\":\"" << node.name << "\",\"translation\":[" << t[0]
+          << "," << t[1] << "," << t[2] << "],\"rotation\":[" << r[0] << "," << r[1] << ","
+          << r[2] << "," << r[3] << "]";
+    if (node.mesh >= 0) nodes << ",\"mesh\":" << node.mesh;
+    if (node.skinned) nodes << ",\"skin\":0";
+    if (!node.children.empty()) {
+      nodes << ",\"children\":[";
+      for (std::size_t c = 0; c < node.children.size(); ++c) {
+        nodes << (c > 0 ? "," : "") << node.children[c];
+      }
+      nodes << "]";
+    }
+    nodes << "}";
+  }
+  std::ostringstream skins;
+  if (!scene.skin.joints.empty()) {
+    const int inverse_bind = buffer.Add(scene.skin.inverse_bind, 0, 5126, "MAT4");
+    skins << ",\"skins\":[{\"inverseBindMatrices\":" << inverse_bind << ",\"joints\":[";
+    for (std::size_t j = 0; j < scene.skin.joints.size(); ++j) {
+      skins << (j > 0 ? "," : "") << scene.skin.joints[j];
+    }
+    skins << "]}]";
+  }
+  std::ostringstream roots;
+  for (std::size_t r = 0; r < scene.roots.size(); ++r) roots << (r > 0 ? "," : "") << scene.roots[r];
 
   std::filesystem::path bin_file = file;
   bin_file.replace_extension(".bin");
   std::ofstream bin_out(bin_file, std::ios::binary);
-  bin_out.write(bin.data(), static_cast<std::streamsize>(bin.size()));
+  bin_out.write(buffer.bin().data(), static_cast<std::streamsize>(buffer.bin().size()));
   std::ofstream json(file);
-  json << "{\"asset\":{\"version\":\"2.0\",\"generator\":\"sandbox assets/generators\"},"
-       << "\"scene\":0,\"scenes\":[{\"nodes\":[" << scene_nodes.str() << "]}],"
+  json << std::setprecision(9)
+       << "{\"asset\":{\"version\":\"2.0\",\"generator\":\"sandbox assets/generators\"},"
+       << "\"scene\":0,\"scenes\":[{\"nodes\":[" << roots.str() << "]}],"
        << "\"nodes\":[" << nodes.str() << "],\"meshes\":[" << json_meshes.str() << "],"
-       << "\"materials\":[" << materials.str() << "],"
+       << "\"materials\":[" << materials.str() << "]" << skins.str() << ","
        << "\"buffers\":[{\"uri\":\"" << bin_file.filename().string()
-       << "\",\"byteLength\":" << bin.size() << "}],"
-       << "\"bufferViews\":[" << views.str() << "],\"accessors\":[" << accessors.str() << "]}\n";
+       << "\",\"byteLength\":" << buffer.bin().size() << "}],"
+       << "\"bufferViews\":[" << buffer.views() << "],\"accessors\":[" << buffer.accessors()
+       << "]}\n";
   if (!bin_out || !json) throw std::runtime_error("WriteGltf(): cannot write " + file.string());
+}
+
+void WriteGltf(const std::filesystem::path& file, const std::vector<GeneratedMesh>& meshes) {
+  GltfScene scene;
+  for (const GeneratedMesh& world_mesh : meshes) {
+    GeneratedMesh mesh = world_mesh;
+    if (mesh.normals.size() != mesh.positions.size()) mesh.ComputeNormals();
+    for (auto& p : mesh.positions) p = ToGltf(p);
+    for (auto& n : mesh.normals) n = ToGltf(n);
+    GltfNode node;
+    node.name = mesh.name;
+    node.mesh = static_cast<int>(scene.meshes.size());
+    scene.roots.push_back(static_cast<int>(scene.nodes.size()));
+    scene.nodes.push_back(node);
+    scene.meshes.push_back(std::move(mesh));
+  }
+  WriteGltfScene(file, scene);
 }
 
 }  // namespace sandbox::assets

@@ -22,7 +22,7 @@ using Point = std::array<float, 3>;
 constexpr double kPi = 3.14159265358979323846;
 
 GeneratedMesh Terrain() {
-  GeneratedMesh mesh{"terrain", {0.36f, 0.45f, 0.24f, 1.0f}, {}, {}, {}};
+  GeneratedMesh mesh{"terrain", {0.36f, 0.45f, 0.24f, 1.0f}};
   const int n = sample::kTerrainPoints;
   for (int row = 0; row < n; ++row) {
     for (int col = 0; col < n; ++col) {
@@ -42,7 +42,7 @@ GeneratedMesh Terrain() {
 }
 
 GeneratedMesh Water() {
-  GeneratedMesh mesh{"water", {0.15f, 0.32f, 0.55f, 0.6f}, {}, {}, {}};
+  GeneratedMesh mesh{"water", {0.15f, 0.32f, 0.55f, 0.6f}};
   const auto h = float(sample::kTerrainHalfSize_m);
   mesh.AddQuad({-h, -h, 0.f}, {h, -h, 0.f}, {h, h, 0.f}, {-h, h, 0.f});
   return mesh;
@@ -112,7 +112,7 @@ void AddRock(GeneratedMesh* mesh, Point centre, Point radius, int subdivisions, 
 
 // Rocks scattered over the terrain, baked at their world positions.
 GeneratedMesh Rocks() {
-  GeneratedMesh mesh{"rocks", {0.5f, 0.49f, 0.47f, 1.0f}, {}, {}, {}};
+  GeneratedMesh mesh{"rocks", {0.5f, 0.49f, 0.47f, 1.0f}};
   for (int i = 0; i < 16; ++i) {
     const double x = 150.0 * std::sin(1.9 * i + 0.3), y = 150.0 * std::cos(2.7 * i + 1.1);
     const double r = 1.0 + 1.5 * (0.5 + 0.5 * std::sin(4.1 * i));
@@ -123,14 +123,14 @@ GeneratedMesh Rocks() {
 }
 
 GeneratedMesh Boulder() {
-  GeneratedMesh mesh{"boulder", {0.42f, 0.4f, 0.38f, 1.0f}, {}, {}, {}};
+  GeneratedMesh mesh{"boulder", {0.42f, 0.4f, 0.38f, 1.0f}};
   AddRock(&mesh, {0.f, 0.f, 4.f}, {11.f, 9.f, 8.f}, 3, 42.0);
   return mesh;
 }
 
 // 40 m long, 0.6 m thick, 14 m above its origin, with a 5 m foundation.
 GeneratedMesh Wall() {
-  GeneratedMesh mesh{"wall", {0.62f, 0.6f, 0.56f, 1.0f}, {}, {}, {}};
+  GeneratedMesh mesh{"wall", {0.62f, 0.6f, 0.56f, 1.0f}};
   AddBox(&mesh, {-20.f, -0.3f, -5.f}, {20.f, 0.3f, 14.f});
   return mesh;
 }
@@ -152,7 +152,7 @@ void AddRingBlock(GeneratedMesh* mesh, double r_in, double r_out, double a0, dou
 // A hollow round tower (outer radius 6 m, wall 1 m, up to 24 m) with a door,
 // windows, a breach and a broken top; its foundation goes 4 m below ground.
 GeneratedMesh Tower() {
-  GeneratedMesh mesh{"tower", {0.55f, 0.5f, 0.44f, 1.0f}, {}, {}, {}};
+  GeneratedMesh mesh{"tower", {0.55f, 0.5f, 0.44f, 1.0f}};
   const int segments = 36, levels = 12;
   for (int s = 0; s < segments; ++s) {
     const double a0 = 2.0 * kPi * s / segments, a1 = 2.0 * kPi * (s + 1) / segments;
@@ -170,7 +170,7 @@ GeneratedMesh Tower() {
 
 // Two posts, a beam and a slatted leaf; the actor that may be moved from outside.
 GeneratedMesh Gate() {
-  GeneratedMesh mesh{"gate", {0.45f, 0.3f, 0.16f, 1.0f}, {}, {}, {}};
+  GeneratedMesh mesh{"gate", {0.45f, 0.3f, 0.16f, 1.0f}};
   AddBox(&mesh, {-2.9f, -0.2f, -2.f}, {-2.5f, 0.2f, 5.f});
   AddBox(&mesh, {2.5f, -0.2f, -2.f}, {2.9f, 0.2f, 5.f});
   AddBox(&mesh, {-2.9f, -0.25f, 4.6f}, {2.9f, 0.25f, 5.2f});
