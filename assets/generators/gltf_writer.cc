@@ -27,6 +27,16 @@ void GeneratedMesh::AddQuad(const std::array<float, 3>& a, const std::array<floa
   AddTriangle(ia, ic, id);
 }
 
+void GeneratedMesh::AddBox(const std::array<float, 3>& lo, const std::array<float, 3>& hi) {
+  const float x0 = lo[0], y0 = lo[1], z0 = lo[2], x1 = hi[0], y1 = hi[1], z1 = hi[2];
+  AddQuad({x1, y0, z0}, {x1, y1, z0}, {x1, y1, z1}, {x1, y0, z1});  // +x
+  AddQuad({x0, y1, z0}, {x0, y0, z0}, {x0, y0, z1}, {x0, y1, z1});  // -x
+  AddQuad({x1, y1, z0}, {x0, y1, z0}, {x0, y1, z1}, {x1, y1, z1});  // +y
+  AddQuad({x0, y0, z0}, {x1, y0, z0}, {x1, y0, z1}, {x0, y0, z1});  // -y
+  AddQuad({x0, y0, z1}, {x1, y0, z1}, {x1, y1, z1}, {x0, y1, z1});  // +z
+  AddQuad({x0, y1, z0}, {x1, y1, z0}, {x1, y0, z0}, {x0, y0, z0});  // -z
+}
+
 void GeneratedMesh::ComputeNormals() {
   std::vector<std::array<double, 3>> sum(positions.size(), {0.0, 0.0, 0.0});
   for (std::size_t i = 0; i + 2 < indices.size(); i += 3) {

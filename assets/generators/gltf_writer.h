@@ -30,6 +30,8 @@ struct GeneratedMesh {
   // A planar quad a-b-c-d, counter-clockwise seen from outside.
   void AddQuad(const std::array<float, 3>& a, const std::array<float, 3>& b,
                const std::array<float, 3>& c, const std::array<float, 3>& d);
+  // An axis-aligned box between corners lo and hi, 6 outward quads.
+  void AddBox(const std::array<float, 3>& lo, const std::array<float, 3>& hi);
   // Area-weighted vertex normals (shared vertices are smooth).
   void ComputeNormals();
 };

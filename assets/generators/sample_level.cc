@@ -48,15 +48,6 @@ GeneratedMesh Water() {
   return mesh;
 }
 
-void AddBox(GeneratedMesh* mesh, Point lo, Point hi) {
-  const float x0 = lo[0], y0 = lo[1], z0 = lo[2], x1 = hi[0], y1 = hi[1], z1 = hi[2];
-  mesh->AddQuad({x1, y0, z0}, {x1, y1, z0}, {x1, y1, z1}, {x1, y0, z1});  // +x
-  mesh->AddQuad({x0, y1, z0}, {x0, y0, z0}, {x0, y0, z1}, {x0, y1, z1});  // -x
-  mesh->AddQuad({x1, y1, z0}, {x0, y1, z0}, {x0, y1, z1}, {x1, y1, z1});  // +y
-  mesh->AddQuad({x0, y0, z0}, {x1, y0, z0}, {x1, y0, z1}, {x0, y0, z1});  // -y
-  mesh->AddQuad({x0, y0, z1}, {x1, y0, z1}, {x1, y1, z1}, {x0, y1, z1});  // +z
-  mesh->AddQuad({x0, y1, z0}, {x1, y1, z0}, {x1, y0, z0}, {x0, y0, z0});  // -z
-}
 
 // A deterministic bumpy displacement of a unit direction.
 double Bumps(const Point& d, double seed) {
@@ -131,7 +122,7 @@ GeneratedMesh Boulder() {
 // 40 m long, 0.6 m thick, 14 m above its origin, with a 5 m foundation.
 GeneratedMesh Wall() {
   GeneratedMesh mesh{"wall", {0.62f, 0.6f, 0.56f, 1.0f}};
-  AddBox(&mesh, {-20.f, -0.3f, -5.f}, {20.f, 0.3f, 14.f});
+  mesh.AddBox({-20.f, -0.3f, -5.f}, {20.f, 0.3f, 14.f});
   return mesh;
 }
 
@@ -171,15 +162,15 @@ GeneratedMesh Tower() {
 // Two posts, a beam and a slatted leaf; the actor that may be moved from outside.
 GeneratedMesh Gate() {
   GeneratedMesh mesh{"gate", {0.45f, 0.3f, 0.16f, 1.0f}};
-  AddBox(&mesh, {-2.9f, -0.2f, -2.f}, {-2.5f, 0.2f, 5.f});
-  AddBox(&mesh, {2.5f, -0.2f, -2.f}, {2.9f, 0.2f, 5.f});
-  AddBox(&mesh, {-2.9f, -0.25f, 4.6f}, {2.9f, 0.25f, 5.2f});
+  mesh.AddBox({-2.9f, -0.2f, -2.f}, {-2.5f, 0.2f, 5.f});
+  mesh.AddBox({2.5f, -0.2f, -2.f}, {2.9f, 0.2f, 5.f});
+  mesh.AddBox({-2.9f, -0.25f, 4.6f}, {2.9f, 0.25f, 5.2f});
   for (int slat = 0; slat < 6; ++slat) {
     const float x = -2.2f + 0.8f * float(slat);
-    AddBox(&mesh, {x, -0.08f, 0.2f}, {x + 0.6f, 0.08f, 3.8f});
+    mesh.AddBox({x, -0.08f, 0.2f}, {x + 0.6f, 0.08f, 3.8f});
   }
-  AddBox(&mesh, {-2.4f, -0.1f, 1.0f}, {2.4f, 0.1f, 1.3f});
-  AddBox(&mesh, {-2.4f, -0.1f, 3.0f}, {2.4f, 0.1f, 3.3f});
+  mesh.AddBox({-2.4f, -0.1f, 1.0f}, {2.4f, 0.1f, 1.3f});
+  mesh.AddBox({-2.4f, -0.1f, 3.0f}, {2.4f, 0.1f, 3.3f});
   return mesh;
 }
 
