@@ -70,6 +70,16 @@ void PrintJson(const Level& level, const LoadFigures& figures, std::ostream& out
         << ", \"bounds_min\": " << JsonVector(Lo(a.bounds_W))
         << ", \"bounds_max\": " << JsonVector(Hi(a.bounds_W)) << "}";
   }
+  out << "\n  ],\n  \"robots\": [";
+  for (std::size_t i = 0; i < level.robots.size(); ++i) {
+    const scene::RobotModel& r = level.robots[i];
+    out << (i > 0 ? ",\n" : "\n") << "    {\"name\": " << JsonString(r.name)
+        << ", \"file\": " << JsonString(r.file.string()) << ", \"nodes\": " << r.nodes.size()
+        << ", \"bones\": " << r.bones.size() << ", \"bone_values\": " << r.num_values
+        << ", \"vertices\": " << r.num_vertices() << ", \"triangles\": " << r.num_triangles()
+        << ", \"collision\": " << (r.collision ? "true" : "false")
+        << ", \"spawn_position\": " << JsonVector(r.X_WB_spawn.translation()) << "}";
+  }
   out << "\n  ],\n  \"totals\": {\"actors\": " << level.actors.size()
       << ", \"collision_actors\": " << collision_actors
       << ", \"movable_actors\": " << movable_actors << ", \"triangles\": " << level.num_triangles()
@@ -104,6 +114,14 @@ void PrintText(const Level& level, const LoadFigures& figures, std::ostream& out
         << (a.collision ? "yes" : "no") << "  " << std::setw(7) << (a.movable ? "yes" : "no")
         << std::right << "  (" << lo.x() << ", " << lo.y() << ", " << lo.z() << ") .. (" << hi.x()
         << ", " << hi.y() << ", " << hi.z() << ")\n";
+  }
+  for (const scene::RobotModel& r : level.robots) {
+    const Eigen::Vector3d p = r.X_WB_spawn.translation();
+    out << "robot " << r.name << ": " << r.file.filename().string() << ", " << r.nodes.size()
+        << " nodes, " << r.bones.size() << " bones (" << r.num_values << " values), "
+        << r.num_vertices() << " vertices, " << r.num_triangles() << " triangles, collision "
+        << (r.collision ? "on" : "off") << ", spawn (" << p.x() << ", " << p.y() << ", " << p.z()
+        << ")\n";
   }
   const Eigen::AlignedBox3d bounds = level.bounds_W();
   const Eigen::Vector3d size = Hi(bounds) - Lo(bounds);

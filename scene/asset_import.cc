@@ -11,6 +11,7 @@
 #include <fstream>
 #include <map>
 
+#include "scene/assimp_read.h"
 #include "scene/heightmap.h"
 
 namespace sandbox::scene {
@@ -84,12 +85,16 @@ void ReadFbxConvention(const aiScene& scene, UpAxis* up, double* unit_m) {
   }
 }
 
+}  // namespace
+
 Eigen::Matrix4d ToEigen(const aiMatrix4x4& m) {
   Eigen::Matrix4d out;
   out << m.a1, m.a2, m.a3, m.a4, m.b1, m.b2, m.b3, m.b4, m.c1, m.c2, m.c3, m.c4, m.d1, m.d2, m.d3,
       m.d4;
   return out;
 }
+
+namespace {
 
 // Drops faces whose vertex indices are out of range (the Quake 3 importer of
 // assimp 5.2.5 leaves uninitialised indices). Runs before any post-processing
@@ -171,7 +176,8 @@ EmbeddedTexture ConvertTexture(const aiTexture& in) {
   return out;
 }
 
-// Copies the triangles of an aiMesh (points and lines are counted and skipped).
+}  // namespace
+
 Mesh ConvertMesh(const aiMesh& in, std::size_t* non_triangles) {
   Mesh out;
   out.material = static_cast<int>(in.mMaterialIndex);
@@ -204,6 +210,8 @@ Mesh ConvertMesh(const aiMesh& in, std::size_t* non_triangles) {
   }
   return out;
 }
+
+namespace {
 
 // Walks the node tree and collects every node with meshes, named by its path.
 class NodeCollector {
@@ -251,6 +259,8 @@ class NodeCollector {
   std::size_t non_triangles_{0};
 };
 
+}  // namespace
+
 void CheckReadable(const fs::path& file) {
   std::error_code error;
   if (!fs::exists(file, error)) throw LevelError(file.string() + ": no such file");
@@ -261,7 +271,6 @@ void CheckReadable(const fs::path& file) {
   }
 }
 
-}  // namespace
 
 std::string LowerExtension(const fs::path& file) {
   std::string ext = file.extension().string();
@@ -287,17 +296,8 @@ void TransformMesh(const Eigen::Affine3d& T, Mesh* mesh) {
   }
 }
 
-ImportedAsset ImportAsset(const fs::path& file, const AssetConversion& conversion) {
-  CheckReadable(file);
-  const Format format = FormatOf(file);
-  if (format == Format::kTerragen) return ImportTerragen(file, conversion);
-  if (LowerExtension(file) == ".png" || LowerExtension(file) == ".pgm") {
-    throw LevelError(file.string() +
-                     ": a heightmap image needs a size; place it in a level manifest with "
-                     "heightmap = \"...\" and size = [x, y, z]");
-  }
-
-  Assimp::Importer importer;
+AssimpScene ReadAssimpScene(Assimp::Importer& importer, const fs::path& file,
+                            const AssetConversion& conversion) {
   if (!importer.IsExtensionSupported(LowerExtension(file))) {
     throw LevelError(file.string() + ": unsupported format '" + LowerExtension(file) +
                      "' (not a format assimp reads)");
@@ -310,21 +310,22 @@ ImportedAsset ImportAsset(const fs::path& file, const AssetConversion& conversio
   if (scene == nullptr) {
     throw LevelError(file.string() + ": assimp could not read it: " + importer.GetErrorString());
   }
-  ImportedAsset asset;
+  AssimpScene out;
   if (const std::size_t dropped = DropFacesWithBadIndices(*scene); dropped > 0) {
-    asset.warnings.push_back(file.string() + ": dropped " + std::to_string(dropped) +
-                             " faces with out-of-range vertex indices");
+    out.warnings.push_back(file.string() + ": dropped " + std::to_string(dropped) +
+                           " faces with out-of-range vertex indices");
   }
   scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_GenSmoothNormals);
   if (scene == nullptr || scene->mRootNode == nullptr) {
     throw LevelError(file.string() + ": assimp could not process it: " + importer.GetErrorString());
   }
+  out.scene = scene;
 
   // The file's (or format's) axes and unit, unless the caller overrides them.
   UpAxis up = UpAxis::kPosZ;
   double unit_m = 1.0;
   double applied_unit_m = 1.0;  // what assimp already applied (Collada <unit>)
-  switch (format) {
+  switch (FormatOf(file)) {
     case Format::kGltf:
       up = UpAxis::kPosY;
       break;
@@ -338,26 +339,44 @@ ImportedAsset ImportAsset(const fs::path& file, const AssetConversion& conversio
       ReadFbxConvention(*scene, &up, &unit_m);
       break;
     case Format::kQuake3:
-      unit_m = 0.0254;
-      break;  // Quake units are about an inch
+      unit_m = 0.0254;  // Quake units are about an inch
+      break;
     case Format::kTerragen:
     case Format::kOther:
       break;
   }
-  asset.up = conversion.up.value_or(up);
-  asset.unit_scale_m = conversion.unit_scale_m.value_or(unit_m);
-  Eigen::Affine3d X_RF = Eigen::Affine3d::Identity();
-  X_RF.linear() = (asset.unit_scale_m / applied_unit_m) * UpAxisToWorld(asset.up);
+  out.up = conversion.up.value_or(up);
+  out.unit_scale_m = conversion.unit_scale_m.value_or(unit_m);
+  out.X_RF.linear() = (out.unit_scale_m / applied_unit_m) * UpAxisToWorld(out.up);
 
   const fs::path folder = file.parent_path();
   for (unsigned m = 0; m < scene->mNumMaterials; ++m) {
-    asset.materials.push_back(ConvertMaterial(*scene, *scene->mMaterials[m], folder));
+    out.materials.push_back(ConvertMaterial(*scene, *scene->mMaterials[m], folder));
   }
   for (unsigned t = 0; t < scene->mNumTextures; ++t) {
-    asset.textures.push_back(ConvertTexture(*scene->mTextures[t]));
+    out.textures.push_back(ConvertTexture(*scene->mTextures[t]));
   }
-  NodeCollector collector(*scene, X_RF, &asset);
-  collector.Visit(*scene->mRootNode, "", ToEigen(scene->mRootNode->mTransformation));
+  return out;
+}
+
+ImportedAsset ImportAsset(const fs::path& file, const AssetConversion& conversion) {
+  CheckReadable(file);
+  if (FormatOf(file) == Format::kTerragen) return ImportTerragen(file, conversion);
+  if (LowerExtension(file) == ".png" || LowerExtension(file) == ".pgm") {
+    throw LevelError(file.string() +
+                     ": a heightmap image needs a size; place it in a level manifest with "
+                     "heightmap = \"...\" and size = [x, y, z]");
+  }
+  Assimp::Importer importer;
+  AssimpScene read = ReadAssimpScene(importer, file, conversion);
+  ImportedAsset asset;
+  asset.up = read.up;
+  asset.unit_scale_m = read.unit_scale_m;
+  asset.materials = std::move(read.materials);
+  asset.textures = std::move(read.textures);
+  asset.warnings = std::move(read.warnings);
+  NodeCollector collector(*read.scene, read.X_RF, &asset);
+  collector.Visit(*read.scene->mRootNode, "", ToEigen(read.scene->mRootNode->mTransformation));
   if (collector.non_triangles() > 0) {
     asset.warnings.push_back(file.string() + ": skipped " +
                              std::to_string(collector.non_triangles()) +

@@ -34,6 +34,11 @@ struct ImportedAsset {
 // unsupported format or has no triangles.
 ImportedAsset ImportAsset(const std::filesystem::path& file, const AssetConversion& conversion);
 
+// Appends materials and textures to the level, renumbering the materials'
+// texture references; returns the index the first material got.
+int AppendMaterials(std::vector<Material> materials, std::vector<EmbeddedTexture> textures,
+                    Level* level);
+
 // The file's extension in lower case, with its dot: ".glb".
 std::string LowerExtension(const std::filesystem::path& file);
 

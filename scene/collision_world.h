@@ -11,12 +11,17 @@
 // Threads: one thread (the loop thread) owns the world; CastRay uses
 // btCollisionWorld::rayTest, which is not safe to call from several threads.
 
-#include <Eigen/Geometry>
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Geometry>
 
 #include "scene/level.h"
+#include "scene/robot_state.h"
 
 namespace sandbox::scene {
 
@@ -32,29 +37,40 @@ struct RayHit {
   Eigen::Vector3d point_W;
   Eigen::Vector3d normal_W;  // unit, facing the ray
   double distance_m{0.0};    // from the ray's start
-  int actor{-1};             // index into Level::actors
+  int actor{-1};             // index into Level::actors, or -1 when a robot was hit
+  int robot{-1};             // index into Level::robots, or -1 when an actor was hit
 };
 
 class CollisionWorld {
  public:
   // Builds triangle-mesh shapes (quantized BVH) for every actor with collision
-  // on: movable actors in kWorldMovable, the rest in kWorldStatic. The meshes
-  // are referenced, not copied: `level` must outlive the world. Meshes are split
-  // to respect Bullet's limits (2^21 triangles a part, 1024 parts a shape).
+  // on: movable actors in kWorldMovable, the rest in kWorldStatic; and for every
+  // robot with collision on, in kRobot, posed at its spawn pose with bones at
+  // rest. Actor meshes are referenced, not copied: `level` must outlive the
+  // world. Meshes are split to respect Bullet's limits (2^21 triangles a part,
+  // 1024 parts a shape).
   explicit CollisionWorld(const Level& level);
   ~CollisionWorld();
   CollisionWorld(const CollisionWorld&) = delete;
   CollisionWorld& operator=(const CollisionWorld&) = delete;
 
   // The first hit on the segment from `from_W` to `to_W` among objects whose
-  // group is in `group_mask`, skipping actor `ignore_actor` (-1: none).
+  // group is in `group_mask`, skipping actor `ignore_actor` and robot
+  // `ignore_robot` (-1: none; a robot's own sensors ignore the robot).
   std::optional<RayHit> CastRay(const Eigen::Vector3d& from_W, const Eigen::Vector3d& to_W,
-                                std::uint32_t group_mask = kAllGroups, int ignore_actor = -1) const;
+                                std::uint32_t group_mask = kAllGroups, int ignore_actor = -1,
+                                int ignore_robot = -1) const;
 
   // Places a movable actor. Throws std::invalid_argument for an unknown index,
   // a static actor or a non-finite pose (the previous pose stays).
   void SetActorPose(int actor, const Eigen::Isometry3d& X_WA);
+  // The same by actor name; std::invalid_argument names an unknown actor.
+  void SetActorPose(std::string_view actor, const Eigen::Isometry3d& X_WA);
   const Eigen::Isometry3d& actor_pose(int actor) const;
+
+  // Moves robot `robot`'s collision shape to the state's pose and posed mesh
+  // (the BVH is refitted, not rebuilt). `state` must belong to that robot.
+  void UpdateRobot(int robot, const RobotState& state);
 
   // Moves the floating origin to `p_WO` (world coordinates kept in double).
   void SetOrigin(const Eigen::Vector3d& p_WO);
@@ -66,6 +82,7 @@ class CollisionWorld {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  std::vector<std::string> actor_names_;
   Eigen::Vector3d p_WO_{Eigen::Vector3d::Zero()};
 };
 

@@ -31,6 +31,13 @@ std::string ToString(UpAxis axis) {
   return "?";
 }
 
+Eigen::Vector3d AxisDirection(UpAxis axis) {
+  const int index = static_cast<int>(axis);  // kPosX, kNegX, kPosY, ... in pairs
+  Eigen::Vector3d direction = Eigen::Vector3d::Zero();
+  direction[index / 2] = index % 2 == 0 ? 1.0 : -1.0;
+  return direction;
+}
+
 Eigen::Matrix3d UpAxisToWorld(UpAxis up) {
   using Eigen::AngleAxisd;
   using Eigen::Vector3d;

@@ -16,6 +16,9 @@ enum class UpAxis { kPosX, kNegX, kPosY, kNegY, kPosZ, kNegZ };
 std::optional<UpAxis> ParseUpAxis(std::string_view text);
 std::string ToString(UpAxis axis);
 
+// The unit vector of an axis: kNegY is (0, -1, 0).
+Eigen::Vector3d AxisDirection(UpAxis axis);
+
 // The rotation R_WF that takes coordinates of a file whose up is `up` to the
 // world frame. kPosY maps asset (x, y, z) to world (x, -z, y) (+90 degrees
 // about X, as Blender does); kPosZ is the identity.

@@ -31,18 +31,11 @@ void ComputeBounds(Actor* actor) {
   }
 }
 
-// Appends an asset's materials, textures and warnings to the level's, renumbering the
-// references of `meshes` (of this asset) accordingly.
+// Appends an asset's materials, textures and warnings to the level's,
+// renumbering the material references of its meshes.
 void AdoptMaterialsAndWarnings(ImportedAsset* asset, Level* level) {
-  const int material_base = static_cast<int>(level->materials.size());
-  const int texture_base = static_cast<int>(level->textures.size());
-  for (Material& material : asset->materials) {
-    if (material.base_color_texture_embedded >= 0) {
-      material.base_color_texture_embedded += texture_base;
-    }
-    level->materials.push_back(std::move(material));
-  }
-  for (EmbeddedTexture& texture : asset->textures) level->textures.push_back(std::move(texture));
+  const int material_base =
+      AppendMaterials(std::move(asset->materials), std::move(asset->textures), level);
   for (ImportedNode& node : asset->nodes) {
     for (Mesh& mesh : node.meshes) {
       if (mesh.material >= 0) mesh.material += material_base;
@@ -85,7 +78,7 @@ Level LoadManifest(const fs::path& file) {
     ImportedAsset asset;
     try {
       asset = spec.is_heightmap ? ImportHeightmapImage(spec.file, spec.heightmap_size_m)
-                                : ImportAsset(spec.file, spec.conversion);
+                                : ImportAsset(spec.file, spec.placement.conversion);
     } catch (const LevelError& error) {
       throw LevelError(file.string() + ":" + std::to_string(spec.line) + ": actor '" + spec.name +
                        "': " + error.what());
@@ -96,9 +89,9 @@ Level LoadManifest(const fs::path& file) {
     actor.source = spec.file.string();
     actor.collision = spec.collision;
     actor.movable = spec.movable;
-    actor.X_WA = Eigen::Translation3d(spec.position_m) * spec.rotation;
+    actor.X_WA = spec.placement.pose();
     for (ImportedNode& node : asset.nodes) {
-      const Eigen::Affine3d X_AN = Eigen::Scaling(spec.scale) * node.X_RN;
+      const Eigen::Affine3d X_AN = Eigen::Scaling(spec.placement.scale) * node.X_RN;
       for (Mesh& mesh : node.meshes) {
         TransformMesh(X_AN, &mesh);
         actor.meshes.push_back(std::move(mesh));
@@ -106,10 +99,27 @@ Level LoadManifest(const fs::path& file) {
     }
     level.actors.push_back(std::move(actor));
   }
+  for (const RobotSpec& spec : manifest.robots) {
+    level.robots.push_back(LoadRobotModel(spec, file, &level));
+  }
   return level;
 }
 
 }  // namespace
+
+int AppendMaterials(std::vector<Material> materials, std::vector<EmbeddedTexture> textures,
+                    Level* level) {
+  const int material_base = static_cast<int>(level->materials.size());
+  const int texture_base = static_cast<int>(level->textures.size());
+  for (Material& material : materials) {
+    if (material.base_color_texture_embedded >= 0) {
+      material.base_color_texture_embedded += texture_base;
+    }
+    level->materials.push_back(std::move(material));
+  }
+  for (EmbeddedTexture& texture : textures) level->textures.push_back(std::move(texture));
+  return material_base;
+}
 
 std::size_t Actor::num_triangles() const {
   return std::accumulate(meshes.begin(), meshes.end(), std::size_t{0},
@@ -124,6 +134,13 @@ std::size_t Actor::num_vertices() const {
 int Level::FindActor(std::string_view actor_name) const {
   for (std::size_t i = 0; i < actors.size(); ++i) {
     if (actors[i].name == actor_name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+int Level::FindRobot(std::string_view robot_name) const {
+  for (std::size_t i = 0; i < robots.size(); ++i) {
+    if (robots[i].name == robot_name) return static_cast<int>(i);
   }
   return -1;
 }

@@ -13,18 +13,11 @@
 #include <string_view>
 #include <vector>
 
-#include "scene/frames.h"
 #include "scene/mesh.h"
+#include "scene/placement.h"
+#include "scene/robot_model.h"
 
 namespace sandbox::scene {
-
-// Thrown for every problem with a level or asset file. what() names the file,
-// the line or node where known, and what is wrong: "level.toml:12: actor 'gate':
-// scale must be positive, got -1".
-class LevelError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 struct Actor {
   std::string name;                                       // unique in the level
@@ -45,20 +38,14 @@ struct Level {
   std::vector<Actor> actors;
   std::vector<Material> materials;
   std::vector<EmbeddedTexture> textures;
+  std::vector<RobotModel> robots;  // declared by [[robot]] tables of a manifest
   std::vector<std::string> warnings;  // problems that were handled, e.g. dropped faces
 
-  // Index of the actor called `name`, or -1.
+  // Index of the actor (robot) called `name`, or -1.
   int FindActor(std::string_view name) const;
+  int FindRobot(std::string_view name) const;
   std::size_t num_triangles() const;
   Eigen::AlignedBox3d bounds_W() const;
-};
-
-// How to read a plain scene file given as a level (a manifest says it per actor).
-// Unset fields take the file's own statement or the format's convention
-// (docs/levels.md lists them).
-struct AssetConversion {
-  std::optional<UpAxis> up;
-  std::optional<double> unit_scale_m;  // metres per file unit
 };
 
 // Loads a level: a `.toml` file is a level manifest, anything else a scene file

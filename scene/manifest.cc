@@ -3,6 +3,7 @@
 #include <toml++/toml.h>
 
 #include <cmath>
+#include <algorithm>
 #include <set>
 #include <sstream>
 
@@ -93,39 +94,29 @@ class TableReader {
   std::set<std::string> known_;
 };
 
-ActorSpec ParseActor(const fs::path& file, const toml::table& table, int index) {
-  ActorSpec actor;
-  actor.line = static_cast<int>(table.source().begin.line);
-  TableReader named(file, table, "actor " + std::to_string(index) + ": ");
+// The required, non-empty `name` of the `index`-th table of `kind`.
+std::string ParseName(const fs::path& file, const toml::table& table, const std::string& kind,
+                      int index) {
+  TableReader named(file, table, kind + " " + std::to_string(index) + ": ");
   const std::optional<std::string> name = named.String("name");
   if (!name || name->empty()) named.Fail(nullptr, "'name' is required");
-  actor.name = *name;
-  TableReader read(file, table, "actor '" + actor.name + "': ");
-  read.Find("name");
+  return *name;
+}
 
-  // What to place: an asset file or a heightmap image.
-  const std::optional<std::string> asset = read.String("file");
-  const std::optional<std::string> heightmap = read.String("heightmap");
-  if (asset.has_value() == heightmap.has_value()) {
-    read.Fail(nullptr, "give exactly one of 'file' and 'heightmap'");
-  }
-  actor.is_heightmap = heightmap.has_value();
-  actor.file = (file.parent_path() / (asset ? *asset : *heightmap)).lexically_normal();
-  if (const auto size = read.Numbers("size", 3)) {
-    if (!actor.is_heightmap) read.Fail(read.Find("size"), "'size' belongs to a heightmap");
-    if ((size->array() <= 0.0).any()) read.Fail(read.Find("size"), "'size' must be positive");
-    actor.heightmap_size_m = *size;
-  } else if (actor.is_heightmap) {
-    read.Fail(nullptr, "a heightmap needs 'size' = [x, y, height] in metres");
-  }
+// An asset path relative to the manifest.
+fs::path AssetPath(const fs::path& manifest, const std::string& relative) {
+  return (manifest.parent_path() / relative).lexically_normal();
+}
 
-  // Placement.
-  if (const auto position = read.Numbers("position", 3)) actor.position_m = *position;
+// position, rpy_deg | quaternion_wxyz, scale, up, unit_scale.
+Placement ParsePlacement(TableReader& read) {
+  Placement placement;
+  if (const auto position = read.Numbers("position", 3)) placement.position_m = *position;
   const auto rpy = read.Numbers("rpy_deg", 3);
   const auto quaternion = read.Numbers("quaternion_wxyz", 4);
   if (rpy && quaternion) read.Fail(nullptr, "give either 'rpy_deg' or 'quaternion_wxyz', not both");
   if (rpy) {
-    actor.rotation = Eigen::Quaterniond(RotationFromRollPitchYaw(
+    placement.rotation = Eigen::Quaterniond(RotationFromRollPitchYaw(
         (*rpy)[0] * kDegToRad, (*rpy)[1] * kDegToRad, (*rpy)[2] * kDegToRad));
   }
   if (quaternion) {
@@ -136,35 +127,157 @@ ActorSpec ParseActor(const fs::path& file, const toml::table& table, int index) 
                 "'quaternion_wxyz' must be a unit quaternion, its norm is " +
                     TableReader::Format(q.norm()));
     }
-    actor.rotation = q.normalized();
+    placement.rotation = q.normalized();
   }
   if (const toml::node* scale = read.Find("scale")) {
     if (scale->is_array()) {
-      actor.scale = *read.Numbers("scale", 3);
+      placement.scale = *read.Numbers("scale", 3);
     } else {
-      actor.scale.setConstant(read.Number(scale, "scale"));
+      placement.scale.setConstant(read.Number(scale, "scale"));
     }
-    if ((actor.scale.array() <= 0.0).any()) {
+    if ((placement.scale.array() <= 0.0).any()) {
       read.Fail(scale,
-                "'scale' must be positive, got " + TableReader::Format(actor.scale.minCoeff()));
+                "'scale' must be positive, got " + TableReader::Format(placement.scale.minCoeff()));
     }
   }
-
   // How to read the asset when its file does not say.
   if (const auto up = read.String("up")) {
-    actor.conversion.up = ParseUpAxis(*up);
-    if (!actor.conversion.up) {
+    placement.conversion.up = ParseUpAxis(*up);
+    if (!placement.conversion.up) {
       read.Fail(read.Find("up"), "'up' must be one of x, -x, y, -y, z, -z, got '" + *up + "'");
     }
   }
   if (const auto unit = read.Number("unit_scale")) {
     if (*unit <= 0.0) read.Fail(read.Find("unit_scale"), "'unit_scale' must be positive");
-    actor.conversion.unit_scale_m = *unit;
+    placement.conversion.unit_scale_m = *unit;
   }
+  return placement;
+}
+
+ActorSpec ParseActor(const fs::path& file, const toml::table& table, int index) {
+  ActorSpec actor;
+  actor.line = static_cast<int>(table.source().begin.line);
+  actor.name = ParseName(file, table, "actor", index);
+  TableReader read(file, table, "actor '" + actor.name + "': ");
+  read.Find("name");
+
+  // What to place: an asset file or a heightmap image.
+  const std::optional<std::string> asset = read.String("file");
+  const std::optional<std::string> heightmap = read.String("heightmap");
+  if (asset.has_value() == heightmap.has_value()) {
+    read.Fail(nullptr, "give exactly one of 'file' and 'heightmap'");
+  }
+  actor.is_heightmap = heightmap.has_value();
+  actor.file = AssetPath(file, asset ? *asset : *heightmap);
+  if (const auto size = read.Numbers("size", 3)) {
+    if (!actor.is_heightmap) read.Fail(read.Find("size"), "'size' belongs to a heightmap");
+    if ((size->array() <= 0.0).any()) read.Fail(read.Find("size"), "'size' must be positive");
+    actor.heightmap_size_m = *size;
+  } else if (actor.is_heightmap) {
+    read.Fail(nullptr, "a heightmap needs 'size' = [x, y, height] in metres");
+  }
+  actor.placement = ParsePlacement(read);
   actor.collision = read.Bool("collision").value_or(true);
   actor.movable = read.Bool("movable").value_or(false);
   read.RejectUnknownKeys();
   return actor;
+}
+
+// An array of axis names ("x", "-y", ...) as unit vectors.
+std::vector<Eigen::Vector3d> ParseAxes(TableReader& read, const toml::node* node,
+                                       const std::string& key) {
+  const toml::array* array = node->as_array();
+  if (array == nullptr || array->empty() || array->size() > 3) {
+    read.Fail(node, "'" + key + "' must be an array of 1 to 3 axis names, e.g. [\"x\", \"y\"]");
+  }
+  std::vector<Eigen::Vector3d> axes;
+  for (const toml::node& item : *array) {
+    const std::optional<std::string> name = item.value<std::string>();
+    const std::optional<UpAxis> axis = name ? ParseUpAxis(*name) : std::nullopt;
+    if (!axis) read.Fail(&item, "'" + key + "' takes axis names x, -x, y, -y, z, -z");
+    axes.push_back(AxisDirection(*axis));
+  }
+  return axes;
+}
+
+RobotSpec ParseRobot(const fs::path& file, const toml::table& table, int index) {
+  RobotSpec robot;
+  robot.line = static_cast<int>(table.source().begin.line);
+  robot.name = ParseName(file, table, "robot", index);
+  TableReader read(file, table, "robot '" + robot.name + "': ");
+  read.Find("name");
+  const std::optional<std::string> model = read.String("file");
+  if (!model) read.Fail(nullptr, "'file' is required");
+  robot.file = AssetPath(file, *model);
+  robot.placement = ParsePlacement(read);
+  robot.collision = read.Bool("collision").value_or(true);
+
+  // The bone map and how each bone's rotation is given.
+  if (const toml::node* bones = read.Find("bones")) {
+    const toml::array* array = bones->as_array();
+    if (array == nullptr) read.Fail(bones, "'bones' must be an array of bone names");
+    std::set<std::string> seen;
+    for (const toml::node& item : *array) {
+      const std::optional<std::string> name = item.value<std::string>();
+      if (!name || name->empty()) read.Fail(&item, "'bones' must be an array of bone names");
+      if (!seen.insert(*name).second) read.Fail(&item, "bone '" + *name + "' is listed twice");
+      robot.bones.push_back(*name);
+    }
+  }
+  const std::string rotation = read.String("rotation").value_or("quaternion");
+  if (rotation == "angles") {
+    robot.rotation = BoneRotation::kAngles;
+  } else if (rotation != "quaternion") {
+    read.Fail(read.Find("rotation"),
+              "'rotation' must be \"quaternion\" or \"angles\", got '" + rotation + "'");
+  }
+  if (const toml::node* axes = read.Find("angle_axes")) {
+    if (robot.rotation != BoneRotation::kAngles) {
+      read.Fail(axes, "'angle_axes' needs rotation = \"angles\"");
+    }
+    robot.angle_axes = ParseAxes(read, axes, "angle_axes");
+  } else if (robot.rotation == BoneRotation::kAngles) {
+    read.Fail(nullptr, "rotation = \"angles\" needs 'angle_axes', e.g. [\"x\", \"y\"]");
+  }
+  if (const toml::node* overrides = read.Find("bone_axes")) {
+    if (!overrides->is_table()) read.Fail(overrides, "'bone_axes' must be a table: bone = [axes]");
+    if (robot.rotation != BoneRotation::kAngles) {
+      read.Fail(overrides, "'bone_axes' needs rotation = \"angles\"");
+    }
+    for (const auto& [key, value] : *overrides->as_table()) {
+      const std::string bone(key.str());
+      if (std::find(robot.bones.begin(), robot.bones.end(), bone) == robot.bones.end()) {
+        read.Fail(&value, "'bone_axes' names '" + bone + "', which is not in 'bones'");
+      }
+      robot.bone_axes[bone] = ParseAxes(read, &value, "bone_axes." + bone);
+    }
+  }
+  read.RejectUnknownKeys();
+  return robot;
+}
+
+// Every table of the array `key` ([[key]]), parsed by `parse`, with unique names.
+template <typename Spec, typename Parse>
+std::vector<Spec> ParseTables(const fs::path& file, TableReader& top, const std::string& key,
+                              Parse parse) {
+  std::vector<Spec> specs;
+  const toml::node* node = top.Find(key);
+  if (node == nullptr) return specs;
+  const toml::array* array = node->as_array();
+  if (array == nullptr || !array->is_array_of_tables()) {
+    top.Fail(node, "'" + key + "' must be an array of tables: [[" + key + "]]");
+  }
+  std::set<std::string> names;
+  int index = 0;
+  for (const toml::node& item : *array) {
+    const toml::table& table = *item.as_table();  // is_array_of_tables() holds
+    Spec spec = parse(file, table, ++index);
+    if (!names.insert(spec.name).second) {
+      TableReader(file, table, "").Fail(nullptr, "duplicate " + key + " name '" + spec.name + "'");
+    }
+    specs.push_back(std::move(spec));
+  }
+  return specs;
 }
 
 }  // namespace
@@ -191,25 +304,12 @@ LevelManifest ParseManifest(const fs::path& file) {
     read.RejectUnknownKeys();
   }
 
-  if (const toml::node* actors = top.Find("actor")) {
-    const toml::array* array = actors->as_array();
-    if (array == nullptr || !array->is_array_of_tables()) {
-      top.Fail(actors, "'actor' must be an array of tables: [[actor]]");
-    }
-    std::set<std::string> names;
-    int index = 0;
-    for (const toml::node& node : *array) {
-      const toml::table& table = *node.as_table();  // is_array_of_tables() holds
-      ActorSpec actor = ParseActor(file, table, ++index);
-      if (!names.insert(actor.name).second) {
-        TableReader(file, table, "").Fail(nullptr, "duplicate actor name '" + actor.name + "'");
-      }
-      manifest.actors.push_back(std::move(actor));
-    }
-  }
+  manifest.actors = ParseTables<ActorSpec>(file, top, "actor", ParseActor);
+  manifest.robots = ParseTables<RobotSpec>(file, top, "robot", ParseRobot);
   top.RejectUnknownKeys();
-  if (manifest.actors.empty()) {
-    throw LevelError(file.string() + ": the manifest places no actors (add [[actor]] tables)");
+  if (manifest.actors.empty() && manifest.robots.empty()) {
+    throw LevelError(file.string() +
+                     ": the manifest places nothing (add [[actor]] or [[robot]] tables)");
   }
   return manifest;
 }

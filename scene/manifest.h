@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "scene/level.h"
+#include "scene/robot_model.h"
 
 namespace sandbox::scene {
 
@@ -18,10 +19,7 @@ struct ActorSpec {
   std::filesystem::path file;  // resolved against the manifest's folder
   bool is_heightmap{false};    // `heightmap = ...` instead of `file = ...`
   Eigen::Vector3d heightmap_size_m{Eigen::Vector3d::Zero()};
-  Eigen::Vector3d position_m{Eigen::Vector3d::Zero()};
-  Eigen::Quaterniond rotation{Eigen::Quaterniond::Identity()};
-  Eigen::Vector3d scale{Eigen::Vector3d::Ones()};
-  AssetConversion conversion;
+  Placement placement;
   bool collision{true};
   bool movable{false};
   int line{0};  // where the table starts, for messages
@@ -31,11 +29,12 @@ struct LevelManifest {
   std::filesystem::path file;
   std::string name;
   std::vector<ActorSpec> actors;
+  std::vector<RobotSpec> robots;
 };
 
 // Throws LevelError "file:line: what" for a TOML syntax error, an unknown key,
 // a wrong type, a missing or duplicate name, a negative scale, a non-finite
-// number or a non-unit quaternion.
+// number, a non-unit quaternion or an inconsistent bone declaration.
 LevelManifest ParseManifest(const std::filesystem::path& file);
 
 }  // namespace sandbox::scene

@@ -47,7 +47,10 @@ TEST(InfoCommandTest, JsonListsActorsTotalsAndLoadFigures) {
   const CommandRun run = Sandbox("info " + sandbox::testing::SampleLevel().string() + " --json");
   ASSERT_EQ(run.exit_code, 0) << run.out;
   EXPECT_EQ(run.out.front(), '{');
-  EXPECT_EQ(Count(run.out, "\"triangles\": "), 7u + 1u);  // 7 actors and the totals
+  EXPECT_EQ(Count(run.out, "\"triangles\": "), 7u + 1u + 1u);  // 7 actors, 1 robot, the totals
+  // The flying wing: 24 bones in its bone map, 21 of them with two angles, 3 with one.
+  EXPECT_NE(run.out.find("{\"name\": \"ELAHA\", "), std::string::npos);
+  EXPECT_NE(run.out.find("\"bones\": 24, \"bone_values\": 45"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("{\"name\": \"gate\", "), std::string::npos);
   EXPECT_NE(run.out.find("\"movable\": true"), std::string::npos);
   EXPECT_NE(run.out.find("\"actors\": 7, \"collision_actors\": 6, \"movable_actors\": 1"),

@@ -157,7 +157,7 @@ TEST_F(ManifestTest, MissingAndConflictingKeys) {
                   "quaternion_wxyz = [1, 0, 0, 0]\n")
                 .find("not both"),
             std::string::npos);
-  EXPECT_NE(Error("[level]\nname = \"empty\"\n").find("places no actors"), std::string::npos);
+  EXPECT_NE(Error("[level]\nname = \"empty\"\n").find("places nothing"), std::string::npos);
 }
 
 TEST_F(ManifestTest, BadAssetFilesNameManifestLineAndAsset) {

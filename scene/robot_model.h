@@ -1,0 +1,101 @@
+#pragma once
+// A robot's constant model: its node tree (the skeleton), the bone map that
+// external publishers address by index, and its meshes with bone weights.
+// Skinned meshes (glTF/FBX skins) and articulated link meshes (rigid meshes on
+// nodes) are the same thing here: every vertex follows a weighted set of nodes.
+// The changing part (pose, bone rotations, posed mesh) is RobotState.
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "scene/mesh.h"
+#include "scene/placement.h"
+
+namespace sandbox::scene {
+
+struct Level;
+
+// How one bone's rotation is given from outside.
+enum class BoneRotation {
+  kQuaternion,  // 4 values (w, x, y, z), a unit quaternion
+  kAngles,      // one angle (radians) per axis, applied in order about the bone's rest axes
+};
+
+// A [[robot]] table of the level manifest.
+struct RobotSpec {
+  std::string name;
+  std::filesystem::path file;
+  Placement placement;  // the spawn pose and the asset conversion
+  bool collision{true};
+  std::vector<std::string> bones;  // the bone map: index 0 = root
+  BoneRotation rotation{BoneRotation::kQuaternion};
+  std::vector<Eigen::Vector3d> angle_axes;                         // kAngles: the default axes
+  std::map<std::string, std::vector<Eigen::Vector3d>> bone_axes;  // per-bone overrides
+  int line{0};
+};
+
+// A node of the robot's tree. Parents come before their children.
+struct RobotNode {
+  std::string name;
+  int parent{-1};
+  Eigen::Affine3d X_PN{Eigen::Affine3d::Identity()};  // rest transform in the parent
+};
+
+// One entry of the bone map.
+struct Bone {
+  std::string name;
+  int node{-1};
+  BoneRotation rotation{BoneRotation::kQuaternion};
+  std::vector<Eigen::Vector3d> axes;  // kAngles: unit axes in the bone's rest frame
+  int first_value{0};  // where this bone's values start in the flat value vector
+  int num_values{4};   // 4 for a quaternion, axes.size() for angles
+};
+
+// A node that moves vertices: vertex v follows X_BN(node) * offset * v.
+struct SkinJoint {
+  int node{-1};
+  Eigen::Affine3d offset{Eigen::Affine3d::Identity()};  // bind space to node space
+};
+
+// A mesh in bind space with its vertex weights (compressed rows: vertex v
+// uses influences [influence_begin[v], influence_begin[v + 1])).
+struct SkinnedMesh {
+  Mesh bind;  // positions and normals in bind (file) space
+  std::vector<std::uint32_t> influence_begin;
+  std::vector<std::uint16_t> influence_joint;  // index into RobotModel::joints
+  std::vector<float> influence_weight;         // sum to 1 per vertex
+};
+
+struct RobotModel {
+  std::string name;
+  std::filesystem::path file;
+  std::vector<RobotNode> nodes;  // node 0 is the file's root
+  std::vector<Bone> bones;       // the bone map
+  int num_values{0};             // length of the flat bone value vector
+  std::vector<SkinJoint> joints;
+  std::vector<SkinnedMesh> meshes;  // Mesh::material indexes Level::materials
+  // The robot body frame B from the file frame F: up axis, unit and scale.
+  Eigen::Affine3d X_BF{Eigen::Affine3d::Identity()};
+  Eigen::Isometry3d X_WB_spawn{Eigen::Isometry3d::Identity()};
+  bool collision{true};
+
+  int FindNode(const std::string& node_name) const;  // -1 when absent
+  int FindBone(const std::string& bone_name) const;  // -1 when absent
+  std::size_t num_vertices() const;
+  std::size_t num_triangles() const;
+};
+
+// Loads the robot `spec` declares. Materials and textures are appended to
+// `level` (the meshes index them there). Throws LevelError "manifest:line:
+// robot 'name': what" for an unknown bone, a bone map longer than the
+// skeleton, a bone 0 that is not the root of the others, or bones declared
+// for a file without a skeleton.
+RobotModel LoadRobotModel(const RobotSpec& spec, const std::filesystem::path& manifest,
+                          Level* level);
+
+}  // namespace sandbox::scene

@@ -1,0 +1,57 @@
+#pragma once
+// The changing part of a robot: its world pose, its bone rotations, and the
+// posed (skinned) mesh from forward kinematics. Owned by the loop thread.
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "scene/robot_model.h"
+
+namespace sandbox::scene {
+
+class RobotState {
+ public:
+  // At the model's spawn pose with every bone at rest, already updated.
+  // Keeps a reference to `model`, which must outlive the state.
+  explicit RobotState(const RobotModel& model);
+
+  // Updates from outside. A rejected update changes nothing, returns false and
+  // is counted under its reason in rejected(); the last good value stays.
+  bool SetPose(const Eigen::Isometry3d& X_WB);
+  // One bone of the bone map: Bone::num_values values (radians for angles,
+  // (w, x, y, z) for a quaternion, relative to the bone's rest rotation).
+  bool SetBone(int bone, const double* values, int num_values);
+  // Every bone at once, flat in bone-map order (RobotModel::num_values values).
+  bool SetBones(const std::vector<double>& values);
+
+  // Forward kinematics, root to tip, then linear-blend skinning of every mesh.
+  void Update();
+
+  const RobotModel& model() const { return *model_; }
+  const Eigen::Isometry3d& pose() const { return X_WB_; }
+  // Node poses in the robot body frame B (after Update()).
+  const std::vector<Eigen::Affine3d>& node_poses_B() const { return X_BN_; }
+  Eigen::Affine3d node_pose_W(int node) const;
+  // The posed mesh in frame B, one array per RobotModel::meshes entry.
+  const std::vector<Eigen::Vector3f>& positions_B(int mesh) const;
+  const std::vector<Eigen::Vector3f>& normals_B(int mesh) const;
+  // Rejected updates by reason.
+  const std::map<std::string, int>& rejected() const { return rejected_; }
+
+ private:
+  bool Reject(const std::string& reason);
+
+  const RobotModel* model_;
+  Eigen::Isometry3d X_WB_;
+  std::vector<Eigen::Quaterniond> rotation_;  // per node, relative to its rest transform
+  std::vector<Eigen::Affine3d> X_BN_;
+  std::vector<Eigen::Matrix<float, 3, 4>> skin_;  // per joint: X_BN * offset
+  std::vector<std::vector<Eigen::Vector3f>> positions_B_;
+  std::vector<std::vector<Eigen::Vector3f>> normals_B_;
+  std::map<std::string, int> rejected_;
+};
+
+}  // namespace sandbox::scene
