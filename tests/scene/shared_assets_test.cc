@@ -8,6 +8,8 @@
 
 #include "scene/collision_world.h"
 #include "scene/level.h"
+#include "scene/robot_state.h"
+#include "tests/test_util.h"
 
 namespace sandbox::scene {
 namespace {
@@ -137,6 +139,67 @@ TEST_F(SharedAssetsTest, Terrains) {
   EXPECT_GE(box.min().z(), -105.0);
   EXPECT_LE(box.max().z(), 885.0);
   EXPECT_GT(box.sizes().z(), 100.0);
+}
+
+// Declares `file` as a robot whose bone map is the one bone `bone` (quaternions).
+Level LoadAsRobot(const testing::TempDir& dir, const fs::path& file, const std::string& bone) {
+  return LoadLevel(dir.Write("robot.toml", "[[robot]]\nname = \"r\"\nfile = \"" + file.string() +
+                                               "\"\nbones = [\"" + bone + "\"]\n"));
+}
+
+TEST_F(SharedAssetsTest, RotatingANamedBoneMovesItsVerticesByTheRotatedOffset) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"cesium-man/CesiumMan.glb", "Skeleton_neck_joint_2"},
+      {"rigged-figure/RiggedFigure.glb", "arm_joint_L_3"},
+      {"fox/Fox.glb", "b_Tail03_014"}};
+  for (const auto& [asset, bone_name] : cases) {
+    SCOPED_TRACE(asset);
+    testing::TempDir dir;
+    const Level level = LoadAsRobot(dir, Shared(asset), bone_name);
+    const RobotModel& model = level.robots.at(0);
+    const RobotState rest(model);
+    // At rest the skin is exactly the static import of the file (the bind pose).
+    const Level still = LoadLevel(Shared(asset));
+    Eigen::AlignedBox3d box;
+    for (const Eigen::Vector3f& p : rest.positions_B(0)) box.extend(p.cast<double>());
+    EXPECT_LT((box.min() - still.bounds_W().min()).norm(), 1e-4);
+    EXPECT_LT((box.max() - still.bounds_W().max()).norm(), 1e-4);
+
+    // Turn the bone 30 degrees about an oblique axis of its rest frame.
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(0.5235987755982988, Vector3d(1, 2, 3).normalized()));
+    const double values[4] = {q.w(), q.x(), q.y(), q.z()};
+    RobotState posed(model);
+    ASSERT_TRUE(posed.SetBone(0, values, 4));
+    posed.Update();
+    // A vertex weighted fully to the bone moves by X_B,bone R X_B,bone^-1.
+    const int node = model.bones[0].node;
+    const Eigen::Affine3d X = rest.node_poses_B()[static_cast<std::size_t>(node)];
+    const Eigen::Affine3d moved = X * q * X.inverse();
+    const SkinnedMesh& mesh = model.meshes.at(0);
+    int checked = 0, still_vertices = 0;
+    for (std::size_t v = 0; v + 1 < mesh.influence_begin.size(); ++v) {
+      if (mesh.influence_begin[v + 1] - mesh.influence_begin[v] != 1) continue;
+      const int joint_node = model.joints[mesh.influence_joint[mesh.influence_begin[v]]].node;
+      const Vector3d before = rest.positions_B(0)[v].cast<double>();
+      const Vector3d after = posed.positions_B(0)[v].cast<double>();
+      if (joint_node == node) {
+        EXPECT_LT((after - moved * before).norm(), 1e-4 * std::max(1.0, box.sizes().norm()));
+        ++checked;
+      } else {
+        // Vertices on bones that are not below the turned one stay put.
+        bool below = false;
+        for (int n = joint_node; n >= 0; n = model.nodes[static_cast<std::size_t>(n)].parent) {
+          below |= n == node;
+        }
+        if (!below) {
+          EXPECT_LT((after - before).norm(), 1e-5 * std::max(1.0, box.sizes().norm()));
+          ++still_vertices;
+        }
+      }
+    }
+    EXPECT_GT(checked, 10);
+    EXPECT_GT(still_vertices, 0);
+  }
 }
 
 }  // namespace
