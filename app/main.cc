@@ -5,13 +5,15 @@
 #include <vector>
 
 #include "app/info_command.h"
+#include "app/pose_command.h"
 
 namespace {
 
 const char* kUsage =
     "usage: sandbox COMMAND [ARGS]\n"
     "commands:\n"
-    "  info [LEVEL] [--json]   actors, triangles, bounds, load time and memory of a level\n"
+    "  info [LEVEL] [--json]   actors, robots, triangles, bounds, load time and memory of a level\n"
+    "  pose [LEVEL] --out M.ply  a robot posed from the command line, as a mesh and bone frames\n"
     "run 'sandbox COMMAND --help' for a command's options\n";
 
 }  // namespace
@@ -25,6 +27,7 @@ int main(int argc, char** argv) {
   const std::vector<std::string> rest(args.begin() + 1, args.end());
   try {
     if (args[0] == "info") return sandbox::app::RunInfo(rest, std::cout, std::cerr);
+    if (args[0] == "pose") return sandbox::app::RunPose(rest, std::cout, std::cerr);
   } catch (const std::exception& error) {
     std::cerr << "sandbox " << args[0] << ": " << error.what() << "\n";
     return 1;

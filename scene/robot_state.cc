@@ -21,6 +21,7 @@ RobotState::RobotState(const RobotModel& model)
 
 bool RobotState::Reject(const std::string& reason) {
   ++rejected_[reason];
+  last_rejection_ = reason;
   return false;
 }
 

@@ -38,8 +38,9 @@ class RobotState {
   // The posed mesh in frame B, one array per RobotModel::meshes entry.
   const std::vector<Eigen::Vector3f>& positions_B(int mesh) const;
   const std::vector<Eigen::Vector3f>& normals_B(int mesh) const;
-  // Rejected updates by reason.
+  // Rejected updates by reason, and the reason of the latest one.
   const std::map<std::string, int>& rejected() const { return rejected_; }
+  const std::string& last_rejection() const { return last_rejection_; }
 
  private:
   bool Reject(const std::string& reason);
@@ -52,6 +53,7 @@ class RobotState {
   std::vector<std::vector<Eigen::Vector3f>> positions_B_;
   std::vector<std::vector<Eigen::Vector3f>> normals_B_;
   std::map<std::string, int> rejected_;
+  std::string last_rejection_;
 };
 
 }  // namespace sandbox::scene

@@ -8,25 +8,14 @@
 #include <cstdio>
 #include <string>
 
+#include "tests/app/run_sandbox.h"
 #include "tests/test_util.h"
 
 namespace {
 
-struct CommandRun {
-  int exit_code{-1};
-  std::string out;  // stdout and stderr together
-};
+using sandbox::testing::CommandRun;
 
-CommandRun Sandbox(const std::string& args) {
-  CommandRun run;
-  const std::string command = std::string(SANDBOX_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  std::array<char, 4096> buffer;
-  while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) run.out += buffer.data();
-  const int status = pclose(pipe);
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  return run;
-}
+CommandRun Sandbox(const std::string& args) { return sandbox::testing::RunSandbox(args); }
 
 std::size_t Count(const std::string& text, const std::string& what) {
   std::size_t n = 0;

@@ -204,6 +204,7 @@ TEST_F(RobotTest, QuaternionBonesRejectNonUnitQuaternions) {
   EXPECT_TRUE(state.SetBone(1, half_turn, 4));
   EXPECT_FALSE(state.SetBone(1, long_q, 4));
   EXPECT_EQ(state.rejected().at("non-unit bone quaternion"), 1);
+  EXPECT_EQ(state.last_rejection(), "non-unit bone quaternion");
   state.Update();
   // link1 turned 180 degrees about z (in its rest frame = the robot's axes).
   EXPECT_TRUE(state.node_poses_B()[static_cast<std::size_t>(level.robots[0].FindNode("link1"))]

@@ -1,0 +1,228 @@
+#include "app/pose_command.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include "app/defaults.h"
+#include "scene/level.h"
+#include "scene/robot_state.h"
+
+namespace sandbox::app {
+namespace {
+
+namespace fs = std::filesystem;
+using scene::RobotModel;
+using scene::RobotState;
+
+const char* kUsage =
+    "usage: sandbox pose [LEVEL] [--robot NAME] [--robot-pose X,Y,Z[,ROLL,PITCH,YAW]]\n"
+    "                    [--bones FILE|LIST] --out MESH.ply\n"
+    "  LEVEL         a level manifest with [[robot]] tables (default: the sample level)\n"
+    "  --robot       which robot (default: the first)\n"
+    "  --robot-pose  world position in metres, roll/pitch/yaw in degees (default: spawn pose)\n"
+    "  --bones       bone values, entries 'BONE V1 [V2 ...]' separated by ';' or new lines,\n"
+    "                BONE a name or bone-map index; angles in degrees, quaternions w x y z;\n"
+    "                or a file with one entry a line ('#' starts a comment)\n"
+    "  --out         the posed mesh (ASCII PLY, world frame); bone frames go to\n"
+    "                MESH.bones.csv beside it\n";
+
+// Thrown for a bad pose argument; the message is shown to the user.
+struct PoseError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+std::vector<double> ParseNumbers(const std::string& text, const std::string& what) {
+  std::vector<double> values;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    char* end = nullptr;
+    const double value = std::strtod(item.c_str(), &end);
+    if (item.empty() || *end != '\0' || !std::isfinite(value)) {
+      throw PoseError(what + ": '" + item + "' is not a finite number");
+    }
+    values.push_back(value);
+  }
+  return values;
+}
+
+Eigen::Isometry3d ParseRobotPose(const std::string& text) {
+  const std::vector<double> v = ParseNumbers(text, "--robot-pose");
+  if (v.size() != 3 && v.size() != 6) {
+    throw PoseError("--robot-pose takes X,Y,Z or X,Y,Z,ROLL,PITCH,YAW, got " +
+                    std::to_string(v.size()) + " numbers");
+  }
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
+  if (v.size() == 6) {
+    X.linear() = scene::RotationFromRollPitchYaw(v[3] * scene::kDegToRad, v[4] * scene::kDegToRad,
+                                                 v[5] * scene::kDegToRad);
+  }
+  return X;
+}
+
+// Applies "BONE V1 V2 ...; BONE ..." (or the lines of a file) to `state`.
+void ApplyBones(const std::string& spec, const RobotModel& model, RobotState* state) {
+  std::string text = spec;
+  if (fs::is_regular_file(spec)) {
+    std::ifstream in(spec);
+    std::ostringstream contents;
+    contents << in.rdbuf();
+    text = contents.str();
+  }
+  for (char& c : text) {
+    if (c == ';') c = '\n';
+  }
+  std::istringstream lines(text);
+  std::string line;
+  while (std::getline(lines, line)) {
+    line = line.substr(0, line.find('#'));
+    std::istringstream words(line);
+    std::string bone_word;
+    if (!(words >> bone_word)) continue;
+    int bone = model.FindBone(bone_word);
+    if (bone < 0 && !bone_word.empty() &&
+        bone_word.find_first_not_of("0123456789") == std::string::npos) {
+      bone = std::atoi(bone_word.c_str());
+    }
+    if (bone < 0 || bone >= static_cast<int>(model.bones.size())) {
+      throw PoseError("--bones: robot '" + model.name + "' has no bone '" + bone_word + "' (" +
+                      std::to_string(model.bones.size()) + " bones)");
+    }
+    const scene::Bone& b = model.bones[static_cast<std::size_t>(bone)];
+    std::vector<double> values;
+    std::string word;
+    while (words >> word) values.push_back(ParseNumbers(word, "--bones " + bone_word).at(0));
+    if (static_cast<int>(values.size()) != b.num_values) {
+      throw PoseError("--bones: bone '" + b.name + "' takes " + std::to_string(b.num_values) +
+                      (b.rotation == scene::BoneRotation::kQuaternion
+                           ? " values (quaternion w x y z)"
+                           : " values (angles in degrees)") +
+                      ", got " + std::to_string(values.size()));
+    }
+    if (b.rotation == scene::BoneRotation::kAngles) {
+      for (double& v : values) v *= scene::kDegToRad;
+    }
+    if (!state->SetBone(bone, values.data(), b.num_values)) {
+      throw PoseError("--bones: bone '" + b.name + "' rejected: " +
+                      state->last_rejection());
+    }
+  }
+}
+
+void WritePly(const fs::path& file, const RobotState& state) {
+  const RobotModel& model = state.model();
+  std::ofstream out(file);
+  out << "ply\nformat ascii 1.0\ncomment sandbox pose: robot " << model.name
+      << ", world frame, metres\nelement vertex " << model.num_vertices()
+      << "\nproperty float x\nproperty float y\nproperty float z\n"
+      << "property float nx\nproperty float ny\nproperty float nz\nelement face "
+      << model.num_triangles() << "\nproperty list uchar int vertex_indices\nend_header\n";
+  const Eigen::Matrix3d R = state.pose().linear();
+  out << std::setprecision(7);
+  for (std::size_t m = 0; m < model.meshes.size(); ++m) {
+    const auto& positions = state.positions_B(static_cast<int>(m));
+    const auto& normals = state.normals_B(static_cast<int>(m));
+    for (std::size_t v = 0; v < positions.size(); ++v) {
+      const Eigen::Vector3d p = state.pose() * positions[v].cast<double>();
+      const Eigen::Vector3d n = R * normals[v].cast<double>();
+      out << p.x() << " " << p.y() << " " << p.z() << " " << n.x() << " " << n.y() << " "
+          << n.z() << "\n";
+    }
+  }
+  std::size_t base = 0;
+  for (const auto& mesh : model.meshes) {
+    const auto& indices = mesh.bind.indices;
+    for (std::size_t i = 0; i + 2 < indices.size(); i += 3) {
+      out << "3 " << base + indices[i] << " " << base + indices[i + 1] << " "
+          << base + indices[i + 2] << "\n";
+    }
+    base += mesh.bind.positions_A.size();
+  }
+  if (!out) throw PoseError("cannot write " + file.string());
+}
+
+void WriteBoneFrames(const fs::path& file, const RobotState& state) {
+  const RobotModel& model = state.model();
+  std::ofstream out(file);
+  out << "bone,name,x,y,z,qw,qx,qy,qz\n" << std::setprecision(9);
+  for (std::size_t b = 0; b < model.bones.size(); ++b) {
+    const Eigen::Affine3d X = state.node_pose_W(model.bones[b].node);
+    Eigen::Matrix3d rotation, scaling;
+    X.computeRotationScaling(&rotation, &scaling);
+    const Eigen::Quaterniond q(rotation);
+    out << b << "," << model.bones[b].name << "," << X.translation().x() << ","
+        << X.translation().y() << "," << X.translation().z() << "," << q.w() << "," << q.x()
+        << "," << q.y() << "," << q.z() << "\n";
+  }
+  if (!out) throw PoseError("cannot write " + file.string());
+}
+
+}  // namespace
+
+int RunPose(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  std::string level_file = kDefaultLevel, robot_name, pose_text, bones_text, out_file;
+  bool have_level = false;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    const bool has_value = i + 1 < args.size();
+    if (arg == "--help" || arg == "-h") {
+      out << kUsage;
+      return 0;
+    } else if (arg == "--robot" && has_value) {
+      robot_name = args[++i];
+    } else if (arg == "--robot-pose" && has_value) {
+      pose_text = args[++i];
+    } else if (arg == "--bones" && has_value) {
+      bones_text = args[++i];
+    } else if (arg == "--out" && has_value) {
+      out_file = args[++i];
+    } else if (!arg.empty() && arg[0] == '-') {
+      err << "sandbox pose: unknown or incomplete option '" << arg << "'\n" << kUsage;
+      return 2;
+    } else if (!have_level) {
+      level_file = arg;
+      have_level = true;
+    } else {
+      err << "sandbox pose: more than one level given\n";
+      return 2;
+    }
+  }
+  if (out_file.empty()) {
+    err << "sandbox pose: --out MESH.ply is required\n" << kUsage;
+    return 2;
+  }
+  try {
+    const scene::Level level = scene::LoadLevel(level_file);
+    if (level.robots.empty()) throw PoseError(level_file + ": the level declares no [[robot]]");
+    const int robot = robot_name.empty() ? 0 : level.FindRobot(robot_name);
+    if (robot < 0) throw PoseError("the level has no robot '" + robot_name + "'");
+    const RobotModel& model = level.robots[static_cast<std::size_t>(robot)];
+    RobotState state(model);
+    if (!pose_text.empty() && !state.SetPose(ParseRobotPose(pose_text))) {
+      throw PoseError("--robot-pose rejected: " + state.last_rejection());
+    }
+    if (!bones_text.empty()) ApplyBones(bones_text, model, &state);
+    state.Update();
+    fs::path bones_file = out_file;
+    bones_file.replace_extension(".bones.csv");
+    WritePly(out_file, state);
+    WriteBoneFrames(bones_file, state);
+    out << "robot " << model.name << ": " << model.num_vertices() << " vertices, "
+        << model.num_triangles() << " triangles -> " << out_file << "\n"
+        << model.bones.size() << " bone frames -> " << bones_file.string() << "\n";
+    return 0;
+  } catch (const scene::LevelError& error) {
+    err << "sandbox pose: " << error.what() << "\n";
+    return 1;
+  } catch (const PoseError& error) {
+    err << "sandbox pose: " << error.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace sandbox::app
