@@ -136,6 +136,56 @@ void MapBones(const RobotSpec& spec, bool has_skeleton, RobotModel* model,
 
 }  // namespace
 
+void PrepareSkinning(SkinnedMesh* mesh) {
+  const std::size_t n = mesh->bind.positions_A.size();
+  mesh->runs.clear();
+  mesh->scattered.clear();
+  for (std::vector<float>& weights : mesh->run_weight) weights.assign(n, 0.0f);
+  // A vertex's joints in order; empty when it has more than four.
+  auto joints_of = [&](std::size_t v) {
+    std::vector<std::uint16_t> joints(mesh->influence_joint.begin() + mesh->influence_begin[v],
+                                      mesh->influence_joint.begin() + mesh->influence_begin[v + 1]);
+    std::sort(joints.begin(), joints.end());
+    if (joints.size() > 4 || std::adjacent_find(joints.begin(), joints.end()) != joints.end()) {
+      joints.clear();
+    }
+    return joints;
+  };
+  for (std::size_t v = 0; v < n;) {
+    const std::vector<std::uint16_t> joints = joints_of(v);
+    std::size_t end = v + 1;
+    while (!joints.empty() && end < n && joints_of(end) == joints) ++end;
+    if (joints.empty() || end - v < 4) {
+      for (std::size_t u = v; u < end; ++u) mesh->scattered.push_back(static_cast<std::uint32_t>(u));
+      v = end;
+      continue;
+    }
+    SkinRun run;
+    run.first = static_cast<std::uint32_t>(v);
+    run.count = static_cast<std::uint32_t>(end - v);
+    run.num_joints = static_cast<int>(joints.size());
+    std::copy(joints.begin(), joints.end(), run.joints);
+    for (std::size_t u = v; u < end; ++u) {
+      for (std::uint32_t i = mesh->influence_begin[u]; i < mesh->influence_begin[u + 1]; ++i) {
+        const auto k = std::find(joints.begin(), joints.end(), mesh->influence_joint[i]) - joints.begin();
+        mesh->run_weight[k][u] = mesh->influence_weight[i];
+      }
+    }
+    mesh->runs.push_back(run);
+    v = end;
+  }
+  std::vector<float>* soa[6] = {&mesh->bind_x,  &mesh->bind_y,  &mesh->bind_z,
+                                &mesh->bind_nx, &mesh->bind_ny, &mesh->bind_nz};
+  for (int k = 0; k < 3; ++k) {
+    soa[k]->resize(n);
+    soa[k + 3]->resize(n);
+    for (std::size_t v = 0; v < n; ++v) {
+      (*soa[k])[v] = mesh->bind.positions_A[v][k];
+      (*soa[k + 3])[v] = mesh->bind.normals_A[v][k];
+    }
+  }
+}
+
 int RobotModel::FindNode(const std::string& node_name) const {
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     if (nodes[i].name == node_name) return static_cast<int>(i);
@@ -200,7 +250,9 @@ RobotModel LoadRobotModel(const RobotSpec& spec, const fs::path& manifest, Level
     for (unsigned i = 0; i < sources[n]->mNumMeshes; ++i) {
       SkinnedMesh mesh = ConvertSkinnedMesh(*scene.mMeshes[sources[n]->mMeshes[i]], int(n),
                                             material_base, &model, &non_triangles);
-      if (!mesh.bind.indices.empty()) model.meshes.push_back(std::move(mesh));
+      if (mesh.bind.indices.empty()) continue;
+      PrepareSkinning(&mesh);
+      model.meshes.push_back(std::move(mesh));
     }
   }
   if (non_triangles > 0) {

@@ -62,6 +62,15 @@ struct SkinJoint {
   Eigen::Affine3d offset{Eigen::Affine3d::Identity()};  // bind space to node space
 };
 
+// Consecutive vertices that follow the same joints (up to four), each with
+// its own weights (SkinnedMesh::run_weight).
+struct SkinRun {
+  std::uint32_t first{0};
+  std::uint32_t count{0};
+  int num_joints{1};
+  std::uint16_t joints[4]{0, 0, 0, 0};
+};
+
 // A mesh in bind space with its vertex weights (compressed rows: vertex v
 // uses influences [influence_begin[v], influence_begin[v + 1])).
 struct SkinnedMesh {
@@ -69,7 +78,16 @@ struct SkinnedMesh {
   std::vector<std::uint32_t> influence_begin;
   std::vector<std::uint16_t> influence_joint;  // index into RobotModel::joints
   std::vector<float> influence_weight;         // sum to 1 per vertex
+  // For fast skinning: runs of at least 4 vertices on the same joints, the
+  // vertices in no run, and the bind data and run weights as separate arrays.
+  std::vector<SkinRun> runs;
+  std::vector<std::uint32_t> scattered;
+  std::vector<float> bind_x, bind_y, bind_z, bind_nx, bind_ny, bind_nz;
+  std::vector<float> run_weight[4];  // weight of the run's k-th joint, per vertex
 };
+
+// Fills the fast-skinning fields of `mesh` from its weights and bind data.
+void PrepareSkinning(SkinnedMesh* mesh);
 
 struct RobotModel {
   std::string name;

@@ -2,6 +2,10 @@
 
 #include <cmath>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "scene/check.h"
 
 namespace sandbox::scene {
@@ -11,7 +15,8 @@ RobotState::RobotState(const RobotModel& model)
       X_WB_(model.X_WB_spawn),
       rotation_(model.nodes.size(), Eigen::Quaterniond::Identity()),
       X_BN_(model.nodes.size(), Eigen::Affine3d::Identity()),
-      skin_(model.joints.size()) {
+      skin_(model.joints.size()),
+      rigid_(model.joints.size()) {
   for (const SkinnedMesh& mesh : model.meshes) {
     positions_B_.emplace_back(mesh.bind.positions_A.size());
     normals_B_.emplace_back(mesh.bind.normals_A.size());
@@ -93,27 +98,126 @@ void RobotState::Update() {
                    .topRows<3>()
                    .cast<float>();
   }
-  // Linear-blend skinning; a vertex with one influence takes its matrix as is.
+  // A joint's matrix is rigid when its 3x3 part is a rotation: normals then
+  // keep their length and need no normalising.
+  for (std::size_t j = 0; j < skin_.size(); ++j) {
+    const Eigen::Matrix3f L = skin_[j].leftCols<3>();
+    rigid_[j] = (L.transpose() * L - Eigen::Matrix3f::Identity()).cwiseAbs().maxCoeff() < 1e-5f;
+  }
   for (std::size_t m = 0; m < model_->meshes.size(); ++m) {
     const SkinnedMesh& mesh = model_->meshes[m];
-    const std::size_t n = mesh.bind.positions_A.size();
-    Eigen::Vector3f* positions = positions_B_[m].data();
-    Eigen::Vector3f* normals = normals_B_[m].data();
-    const Eigen::Vector3f* bind_positions = mesh.bind.positions_A.data();
-    const Eigen::Vector3f* bind_normals = mesh.bind.normals_A.data();
-    for (std::size_t v = 0; v < n; ++v) {
-      const std::uint32_t begin = mesh.influence_begin[v], end = mesh.influence_begin[v + 1];
-      Eigen::Matrix<float, 3, 4> M = skin_[mesh.influence_joint[begin]];
-      if (end - begin > 1) {
-        M *= mesh.influence_weight[begin];
-        for (std::uint32_t i = begin + 1; i < end; ++i) {
-          M += mesh.influence_weight[i] * skin_[mesh.influence_joint[i]];
-        }
+    for (const SkinRun& run : mesh.runs) SkinRunOfVertices(mesh, run, m);
+    for (const std::uint32_t v : mesh.scattered) SkinVertex(mesh, v, m);
+  }
+}
+
+// One vertex, any number of influences: blend the matrices, then apply.
+void RobotState::SkinVertex(const SkinnedMesh& mesh, std::uint32_t v, std::size_t m) {
+  const std::uint32_t begin = mesh.influence_begin[v], end = mesh.influence_begin[v + 1];
+  Eigen::Matrix<float, 3, 4> M = mesh.influence_weight[begin] * skin_[mesh.influence_joint[begin]];
+  for (std::uint32_t i = begin + 1; i < end; ++i) {
+    M += mesh.influence_weight[i] * skin_[mesh.influence_joint[i]];
+  }
+  positions_B_[m][v] = M.leftCols<3>() * mesh.bind.positions_A[v] + M.col(3);
+  normals_B_[m][v] = (M.leftCols<3>() * mesh.bind.normals_A[v]).normalized();
+}
+
+#if defined(__SSE2__)
+namespace {
+
+// A 3x4 matrix with every entry broadcast (or blended) over four vertices.
+struct Wide3x4 {
+  __m128 m00, m01, m02, m03, m10, m11, m12, m13, m20, m21, m22, m23;
+};
+
+inline Wide3x4 Broadcast(const Eigen::Matrix<float, 3, 4>& M) {
+  return {_mm_set1_ps(M(0, 0)), _mm_set1_ps(M(0, 1)), _mm_set1_ps(M(0, 2)), _mm_set1_ps(M(0, 3)),
+          _mm_set1_ps(M(1, 0)), _mm_set1_ps(M(1, 1)), _mm_set1_ps(M(1, 2)), _mm_set1_ps(M(1, 3)),
+          _mm_set1_ps(M(2, 0)), _mm_set1_ps(M(2, 1)), _mm_set1_ps(M(2, 2)), _mm_set1_ps(M(2, 3))};
+}
+
+// A += w * M, entry by entry.
+inline void AddWeighted(__m128 w, const Eigen::Matrix<float, 3, 4>& M, Wide3x4* A) {
+  const float* e = M.data();  // column-major: (0,0) (1,0) (2,0) (0,1) ...
+  A->m00 = _mm_add_ps(A->m00, _mm_mul_ps(w, _mm_set1_ps(e[0])));
+  A->m10 = _mm_add_ps(A->m10, _mm_mul_ps(w, _mm_set1_ps(e[1])));
+  A->m20 = _mm_add_ps(A->m20, _mm_mul_ps(w, _mm_set1_ps(e[2])));
+  A->m01 = _mm_add_ps(A->m01, _mm_mul_ps(w, _mm_set1_ps(e[3])));
+  A->m11 = _mm_add_ps(A->m11, _mm_mul_ps(w, _mm_set1_ps(e[4])));
+  A->m21 = _mm_add_ps(A->m21, _mm_mul_ps(w, _mm_set1_ps(e[5])));
+  A->m02 = _mm_add_ps(A->m02, _mm_mul_ps(w, _mm_set1_ps(e[6])));
+  A->m12 = _mm_add_ps(A->m12, _mm_mul_ps(w, _mm_set1_ps(e[7])));
+  A->m22 = _mm_add_ps(A->m22, _mm_mul_ps(w, _mm_set1_ps(e[8])));
+  A->m03 = _mm_add_ps(A->m03, _mm_mul_ps(w, _mm_set1_ps(e[9])));
+  A->m13 = _mm_add_ps(A->m13, _mm_mul_ps(w, _mm_set1_ps(e[10])));
+  A->m23 = _mm_add_ps(A->m23, _mm_mul_ps(w, _mm_set1_ps(e[11])));
+}
+
+// Four x, four y and four z values stored as four consecutive (x, y, z).
+inline void StoreFourXyz(__m128 x, __m128 y, __m128 z, float* out) {
+  const __m128 xy_low = _mm_unpacklo_ps(x, y);   // x0 y0 x1 y1
+  const __m128 xy_high = _mm_unpackhi_ps(x, y);  // x2 y2 x3 y3
+  const __m128 z0_x1 = _mm_unpacklo_ps(z, _mm_shuffle_ps(x, x, _MM_SHUFFLE(1, 1, 1, 1)));
+  const __m128 yz = _mm_unpacklo_ps(y, z);  // y0 z0 y1 z1
+  const __m128 z2z3x3y3 = _mm_shuffle_ps(z, xy_high, _MM_SHUFFLE(3, 2, 3, 2));
+  _mm_storeu_ps(out, _mm_movelh_ps(xy_low, z0_x1));                             // x0 y0 z0 x1
+  _mm_storeu_ps(out + 4, _mm_shuffle_ps(yz, xy_high, _MM_SHUFFLE(1, 0, 3, 2)));  // y1 z1 x2 y2
+  _mm_storeu_ps(out + 8, _mm_shuffle_ps(z2z3x3y3, z2z3x3y3, _MM_SHUFFLE(1, 3, 2, 0)));  // z2 x3 y3 z3
+}
+
+// Positions and normals of vertices v .. v+3 under the wide matrix M.
+inline void SkinFour(const Wide3x4& M, const SkinnedMesh& mesh, std::uint32_t v, bool normalize,
+                     float* positions, float* normals) {
+  const __m128 x = _mm_loadu_ps(&mesh.bind_x[v]), y = _mm_loadu_ps(&mesh.bind_y[v]);
+  const __m128 z = _mm_loadu_ps(&mesh.bind_z[v]);
+  StoreFourXyz(
+      _mm_add_ps(_mm_add_ps(_mm_mul_ps(M.m00, x), _mm_mul_ps(M.m01, y)),
+                 _mm_add_ps(_mm_mul_ps(M.m02, z), M.m03)),
+      _mm_add_ps(_mm_add_ps(_mm_mul_ps(M.m10, x), _mm_mul_ps(M.m11, y)),
+                 _mm_add_ps(_mm_mul_ps(M.m12, z), M.m13)),
+      _mm_add_ps(_mm_add_ps(_mm_mul_ps(M.m20, x), _mm_mul_ps(M.m21, y)),
+                 _mm_add_ps(_mm_mul_ps(M.m22, z), M.m23)),
+      positions + 3 * std::size_t{v});
+  const __m128 nx = _mm_loadu_ps(&mesh.bind_nx[v]), ny = _mm_loadu_ps(&mesh.bind_ny[v]);
+  const __m128 nz = _mm_loadu_ps(&mesh.bind_nz[v]);
+  __m128 ox = _mm_add_ps(_mm_add_ps(_mm_mul_ps(M.m00, nx), _mm_mul_ps(M.m01, ny)), _mm_mul_ps(M.m02, nz));
+  __m128 oy = _mm_add_ps(_mm_add_ps(_mm_mul_ps(M.m10, nx), _mm_mul_ps(M.m11, ny)), _mm_mul_ps(M.m12, nz));
+  __m128 oz = _mm_add_ps(_mm_add_ps(_mm_mul_ps(M.m20, nx), _mm_mul_ps(M.m21, ny)), _mm_mul_ps(M.m22, nz));
+  if (normalize) {
+    const __m128 length = _mm_sqrt_ps(
+        _mm_add_ps(_mm_add_ps(_mm_mul_ps(ox, ox), _mm_mul_ps(oy, oy)), _mm_mul_ps(oz, oz)));
+    ox = _mm_div_ps(ox, length), oy = _mm_div_ps(oy, length), oz = _mm_div_ps(oz, length);
+  }
+  StoreFourXyz(ox, oy, oz, normals + 3 * std::size_t{v});
+}
+
+}  // namespace
+#endif
+
+// A run of vertices on the same joints, four at a time: per vertex the
+// weighted sum of the joints' matrices, applied to position and normal.
+void RobotState::SkinRunOfVertices(const SkinnedMesh& mesh, const SkinRun& run, std::size_t m) {
+  float* positions = positions_B_[m][0].data();
+  float* normals = normals_B_[m][0].data();
+  std::uint32_t v = run.first;
+  const std::uint32_t end = run.first + run.count;
+#if defined(__SSE2__)
+  if (run.num_joints == 1) {
+    const Wide3x4 M = Broadcast(skin_[run.joints[0]]);
+    const bool normalize = !rigid_[run.joints[0]];
+    for (; v + 4 <= end; v += 4) SkinFour(M, mesh, v, normalize, positions, normals);
+  } else {
+    for (; v + 4 <= end; v += 4) {
+      const __m128 zero = _mm_setzero_ps();
+      Wide3x4 M{zero, zero, zero, zero, zero, zero, zero, zero, zero, zero, zero, zero};
+      for (int j = 0; j < run.num_joints; ++j) {
+        AddWeighted(_mm_loadu_ps(&mesh.run_weight[j][v]), skin_[run.joints[j]], &M);
       }
-      positions[v] = M.leftCols<3>() * bind_positions[v] + M.col(3);
-      normals[v] = (M.leftCols<3>() * bind_normals[v]).normalized();
+      SkinFour(M, mesh, v, true, positions, normals);
     }
   }
+#endif
+  for (; v < end; ++v) SkinVertex(mesh, v, m);
 }
 
 Eigen::Affine3d RobotState::node_pose_W(int node) const {

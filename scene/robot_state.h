@@ -44,12 +44,15 @@ class RobotState {
 
  private:
   bool Reject(const std::string& reason);
+  void SkinVertex(const SkinnedMesh& mesh, std::uint32_t v, std::size_t m);
+  void SkinRunOfVertices(const SkinnedMesh& mesh, const SkinRun& run, std::size_t m);
 
   const RobotModel* model_;
   Eigen::Isometry3d X_WB_;
   std::vector<Eigen::Quaterniond> rotation_;  // per node, relative to its rest transform
   std::vector<Eigen::Affine3d> X_BN_;
   std::vector<Eigen::Matrix<float, 3, 4>> skin_;  // per joint: X_BN * offset
+  std::vector<bool> rigid_;                       // per joint: skin_ keeps lengths
   std::vector<std::vector<Eigen::Vector3f>> positions_B_;
   std::vector<std::vector<Eigen::Vector3f>> normals_B_;
   std::map<std::string, int> rejected_;
