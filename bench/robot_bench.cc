@@ -1,7 +1,8 @@
 // Robot figures per tick: forward kinematics + linear-blend skinning of the
 // flying wing (24 bones, ~20k vertices), FK of RecursiveSkeletons (925 nodes,
-// depth 30) from ../shared/assets when present, and the refit of the wing's
-// collision body. The reference, run in the same process, is a plain
+// depth 30) from ../shared/assets when present, and the update of the wing's
+// collision body (its rigid pieces moved with their bones, and how far they
+// stray from the skin). The reference, run in the same process, is a plain
 // double-precision skinning loop (every vertex: sum of weighted Affine3d).
 //
 //   bench_robots [--iterations N]
@@ -124,7 +125,29 @@ int main(int argc, char** argv) {
     state.Update();
     world.UpdateRobot(robot, state);
   });
-  std::printf("%-44s %12.1f %14s %8s\n", "  + collision body refit (UpdateRobot)", refit, "-", "-");
+  std::printf("%-44s %12.1f %14s %8s\n", "  + collision body (UpdateRobot)", refit, "-", "-");
+
+  // How far the rigid collision pieces stray from the skin, bent 4.5 degrees a joint.
+  RobotState rest(wing), bent(wing);
+  for (int b = 1; b <= 20; ++b) {
+    const double values[2] = {(b <= 10 ? 1 : -1) * 4.5 * 3.14159265358979 / 180.0, 0.0};
+    bent.SetBone(b, values, 2);
+  }
+  bent.Update();
+  const std::vector<int> node_of = DominantNodePerTriangle(wing, 0);
+  const auto& indices = wing.meshes[0].bind.indices;
+  double worst_m = 0.0;
+  for (std::size_t t = 0; t < node_of.size(); ++t) {
+    const auto n = static_cast<std::size_t>(node_of[t]);
+    const Eigen::Isometry3d move =
+        RigidPart(bent.node_poses_B()[n]) * RigidPart(rest.node_poses_B()[n]).inverse();
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t v = indices[3 * t + std::size_t(k)];
+      worst_m = std::max(worst_m, (move * rest.positions_B(0)[v].cast<double>() -
+                                   bent.positions_B(0)[v].cast<double>()).norm());
+    }
+  }
+  std::printf("%-44s %9.1f mm\n", "  collision pieces off the skin at 4.5 deg/joint", 1e3 * worst_m);
 
   const fs::path skeletons =
       fs::path(SANDBOX_SOURCE_DIR) / "../shared/assets/recursive-skeletons/RecursiveSkeletons.glb";
@@ -136,10 +159,10 @@ int main(int argc, char** argv) {
     const RobotModel& model = deep.robots.at(0);
     RobotState skeleton(model);
     ReferenceSkinning skeleton_reference(model);
-    std::vector<Eigen::Quaterniond> rest(model.nodes.size(), Eigen::Quaterniond::Identity());
+    std::vector<Eigen::Quaterniond> identity(model.nodes.size(), Eigen::Quaterniond::Identity());
     const double fk = MicrosecondsPerCall(iterations, [&](int) { skeleton.Update(); });
     const double fk_ref =
-        MicrosecondsPerCall(iterations / 4, [&](int) { skeleton_reference.Update(rest); });
+        MicrosecondsPerCall(iterations / 4, [&](int) { skeleton_reference.Update(identity); });
     std::printf("%-44s %12.1f %14.1f %7.1fx\n",
                 ("RecursiveSkeletons FK + skin (" + std::to_string(model.nodes.size()) + " nodes)").c_str(),
                 fk, fk_ref, fk_ref / fk);

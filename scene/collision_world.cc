@@ -1,6 +1,7 @@
 #include "scene/collision_world.h"
 
 #include <algorithm>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -34,6 +35,15 @@ struct MeshObject {
   std::unique_ptr<btTriangleIndexVertexArray> mesh_interface;
   std::unique_ptr<btBvhTriangleMeshShape> shape;
   std::unique_ptr<btCollisionObject> object;
+  Eigen::Isometry3d X_BO{Eigen::Isometry3d::Identity()};  // in its body's frame
+};
+
+// A rigid piece of a robot's collision body: the triangles that mostly follow
+// one node, in that node's frame at rest.
+struct RobotPiece {
+  int node{-1};
+  std::vector<Eigen::Vector3f> positions;
+  std::vector<std::uint32_t> indices;
 };
 
 // Ray callback that skips the bodies (actors or robots) of the world it is told.
@@ -77,16 +87,19 @@ struct CollisionWorld::Impl {
   std::vector<bool> movable;                      // actors only
   int num_actors{0};
   int num_parts{0};
-  // Robots: their posed vertices (Bullet reads these) and their model.
-  std::vector<std::vector<std::vector<Eigen::Vector3f>>> robot_positions;
+  // Robots: their models and rigid pieces (Bullet reads the pieces' arrays).
   std::vector<const RobotModel*> robot_models;
+  std::vector<std::vector<std::unique_ptr<RobotPiece>>> robot_pieces;
 
   ~Impl() {
     for (MeshObject& object : objects) world.removeCollisionObject(object.object.get());
   }
 
-  // Creates the objects of one body over `meshes` (split to Bullet's limits).
-  void AddBody(int body, const std::vector<MeshArrays>& meshes, int group) {
+  // Creates the objects of one body over `meshes` (split to Bullet's limits),
+  // placed at X_BO in the body's frame; returns their indices in `objects`.
+  std::vector<int> AddBody(int body, const std::vector<MeshArrays>& meshes, int group,
+                           const Eigen::Isometry3d& X_BO = Eigen::Isometry3d::Identity()) {
+    std::vector<int> added;
     std::vector<btIndexedMesh> parts;
     for (const MeshArrays& mesh : meshes) {
       const std::size_t triangles = mesh.indices->size() / 3;
@@ -113,19 +126,22 @@ struct CollisionWorld::Impl {
       object.object = std::make_unique<btCollisionObject>();
       object.object->setCollisionShape(object.shape.get());
       object.object->setUserIndex(body);
+      object.X_BO = X_BO;
       world.addCollisionObject(object.object.get(), group, static_cast<int>(kAllGroups));
       num_parts += static_cast<int>(end - first);
       objects_of_body[static_cast<std::size_t>(body)].push_back(static_cast<int>(objects.size()));
+      added.push_back(static_cast<int>(objects.size()));
       objects.push_back(std::move(object));
     }
+    return added;
   }
 
   void Place(int body, const Eigen::Vector3d& p_WO) {
-    const btTransform transform = ToBulletTransform(X_W[static_cast<std::size_t>(body)], p_WO);
+    const Eigen::Isometry3d& X_WB = X_W[static_cast<std::size_t>(body)];
     for (int index : objects_of_body[static_cast<std::size_t>(body)]) {
-      btCollisionObject* object = objects[static_cast<std::size_t>(index)].object.get();
-      object->setWorldTransform(transform);
-      world.updateSingleAabb(object);
+      MeshObject& object = objects[static_cast<std::size_t>(index)];
+      object.object->setWorldTransform(ToBulletTransform(X_WB * object.X_BO, p_WO));
+      world.updateSingleAabb(object.object.get());
     }
   }
 };
@@ -146,23 +162,38 @@ CollisionWorld::CollisionWorld(const Level& level) : impl_(std::make_unique<Impl
               static_cast<int>(actor.movable ? kWorldMovable : kWorldStatic));
     w.Place(static_cast<int>(a), p_WO_);
   }
-  // Robots: a copy of the posed mesh that UpdateRobot overwrites in place.
+  // Robots: the skin cut into rigid pieces, one per dominant node, each
+  // moved with its node (a transform per tick, no BVH work).
   for (std::size_t r = 0; r < level.robots.size(); ++r) {
     const RobotModel& model = level.robots[r];
     const RobotState rest(model);
     w.robot_models.push_back(&model);
     w.X_W.push_back(rest.pose());
-    w.robot_positions.emplace_back();
+    w.robot_pieces.emplace_back();
     if (!model.collision) continue;
-    std::vector<MeshArrays> meshes;
+    std::map<int, std::unique_ptr<RobotPiece>> pieces;  // by node
     for (std::size_t m = 0; m < model.meshes.size(); ++m) {
-      w.robot_positions[r].push_back(rest.positions_B(static_cast<int>(m)));
-    }
-    for (std::size_t m = 0; m < model.meshes.size(); ++m) {
-      meshes.push_back({&w.robot_positions[r][m], &model.meshes[m].bind.indices});
+      const std::vector<int> node_of = DominantNodePerTriangle(model, static_cast<int>(m));
+      const std::vector<std::uint32_t>& indices = model.meshes[m].bind.indices;
+      const auto& rest_B = rest.positions_B(static_cast<int>(m));
+      for (std::size_t t = 0; t < node_of.size(); ++t) {
+        auto& piece = pieces[node_of[t]];
+        if (!piece) piece = std::make_unique<RobotPiece>(), piece->node = node_of[t];
+        const Eigen::Isometry3d X_PB =
+            RigidPart(rest.node_poses_B()[static_cast<std::size_t>(node_of[t])]).inverse();
+        for (int k = 0; k < 3; ++k) {
+          const Eigen::Vector3d p_B = rest_B[indices[3 * t + std::size_t(k)]].cast<double>();
+          piece->indices.push_back(static_cast<std::uint32_t>(piece->positions.size()));
+          piece->positions.push_back((X_PB * p_B).cast<float>());
+        }
+      }
     }
     const int body = w.num_actors + static_cast<int>(r);
-    w.AddBody(body, meshes, static_cast<int>(kRobot));
+    for (auto& [node, piece] : pieces) {
+      w.AddBody(body, {{&piece->positions, &piece->indices}}, static_cast<int>(kRobot),
+                RigidPart(rest.node_poses_B()[static_cast<std::size_t>(node)]));
+      w.robot_pieces[r].push_back(std::move(piece));
+    }
     w.Place(body, p_WO_);
   }
 }
@@ -229,20 +260,12 @@ void CollisionWorld::UpdateRobot(int robot, const RobotState& state) {
   SANDBOX_CHECK(&state.model() == w.robot_models[static_cast<std::size_t>(robot)]);
   const int body = w.num_actors + robot;
   w.X_W[static_cast<std::size_t>(body)] = state.pose();
-  auto& positions = w.robot_positions[static_cast<std::size_t>(robot)];
-  if (!positions.empty()) {
-    // New vertices in place, then the BVH refitted over their bounds.
-    Eigen::AlignedBox3f bounds;
-    for (std::size_t m = 0; m < positions.size(); ++m) {
-      positions[m] = state.positions_B(static_cast<int>(m));
-      for (const Eigen::Vector3f& p : positions[m]) bounds.extend(p);
-    }
-    const btVector3 margin(0.01f, 0.01f, 0.01f);
-    const btVector3 lo(bounds.min().x(), bounds.min().y(), bounds.min().z());
-    const btVector3 hi(bounds.max().x(), bounds.max().y(), bounds.max().z());
-    for (int index : w.objects_of_body[static_cast<std::size_t>(body)]) {
-      w.objects[static_cast<std::size_t>(index)].shape->refitTree(lo - margin, hi + margin);
-    }
+  const auto& pieces = w.robot_pieces[static_cast<std::size_t>(robot)];
+  const std::vector<int>& objects = w.objects_of_body[static_cast<std::size_t>(body)];
+  // Objects were added piece by piece, one object per piece.
+  for (std::size_t p = 0; p < pieces.size(); ++p) {
+    w.objects[static_cast<std::size_t>(objects[p])].X_BO =
+        RigidPart(state.node_poses_B()[static_cast<std::size_t>(pieces[p]->node)]);
   }
   w.Place(body, p_WO_);
 }

@@ -68,8 +68,12 @@ class CollisionWorld {
   void SetActorPose(std::string_view actor, const Eigen::Isometry3d& X_WA);
   const Eigen::Isometry3d& actor_pose(int actor) const;
 
-  // Moves robot `robot`'s collision shape to the state's pose and posed mesh
-  // (the BVH is refitted, not rebuilt). `state` must belong to that robot.
+  // Moves robot `robot`'s collision body to the state's pose and bones. The
+  // body is the skin cut into rigid pieces, one per node that carries most of
+  // a triangle's weight, each moved with its node: exact for link-mesh robots,
+  // within blend zones of a skin off the rendered surface by about the blend
+  // width times the joint angle (bench_robots prints the figure for the wing).
+  // `state` must belong to that robot.
   void UpdateRobot(int robot, const RobotState& state);
 
   // Moves the floating origin to `p_WO` (world coordinates kept in double).

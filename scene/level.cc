@@ -11,17 +11,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The rigid part of an affine map: its translation and the nearest rotation
-// of its linear part. Actors have rigid poses; scale and shear stay in the mesh.
-Eigen::Isometry3d RigidPart(const Eigen::Affine3d& X) {
-  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
-  out.translation() = X.translation();
-  Eigen::Matrix3d rotation, scaling;
-  X.computeRotationScaling(&rotation, &scaling);
-  out.linear() = rotation;
-  return out;
-}
-
 void ComputeBounds(Actor* actor) {
   actor->bounds_W.setEmpty();
   for (const Mesh& mesh : actor->meshes) {
@@ -56,7 +45,7 @@ Level LoadSceneFile(const fs::path& file, const AssetConversion& conversion) {
     Actor actor;
     actor.name = node.path;
     actor.source = file.string() + ":" + node.path;
-    actor.X_WA = RigidPart(node.X_RN);
+    actor.X_WA = RigidPart(node.X_RN);  // scale and shear stay in the mesh
     const Eigen::Affine3d X_AN = actor.X_WA.inverse() * node.X_RN;
     for (Mesh& mesh : node.meshes) {
       TransformMesh(X_AN, &mesh);

@@ -1,6 +1,8 @@
 #include "scene/robot_model.h"
 
 #include <algorithm>
+#include <cmath>
+#include <map>
 #include <numeric>
 #include <sstream>
 
@@ -184,6 +186,40 @@ void PrepareSkinning(SkinnedMesh* mesh) {
       (*soa[k + 3])[v] = mesh->bind.normals_A[v][k];
     }
   }
+}
+
+std::vector<int> DominantNodePerTriangle(const RobotModel& model, int mesh_index) {
+  const SkinnedMesh& mesh = model.meshes.at(static_cast<std::size_t>(mesh_index));
+  const std::vector<std::uint32_t>& indices = mesh.bind.indices;
+  std::vector<int> nodes(indices.size() / 3);
+  std::map<int, float> weight_of_node;
+  for (std::size_t t = 0; t < nodes.size(); ++t) {
+    weight_of_node.clear();
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t v = indices[3 * t + std::size_t(k)];
+      for (std::uint32_t i = mesh.influence_begin[v]; i < mesh.influence_begin[v + 1]; ++i) {
+        weight_of_node[model.joints[mesh.influence_joint[i]].node] += mesh.influence_weight[i];
+      }
+    }
+    nodes[t] = std::max_element(weight_of_node.begin(), weight_of_node.end(),
+                                [](const auto& a, const auto& b) { return a.second < b.second; })
+                   ->first;
+  }
+  return nodes;
+}
+
+Eigen::Isometry3d RigidPart(const Eigen::Affine3d& X) {
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  out.translation() = X.translation();
+  const Eigen::Matrix3d L = X.linear();
+  const double scale = std::cbrt(L.determinant());
+  Eigen::Matrix3d R = L / scale;
+  if (!(R.transpose() * R).isApprox(Eigen::Matrix3d::Identity(), 1e-6)) {
+    Eigen::Matrix3d scaling;
+    X.computeRotationScaling(&R, &scaling);  // shear or non-uniform scale: the nearest rotation
+  }
+  out.linear() = R;
+  return out;
 }
 
 int RobotModel::FindNode(const std::string& node_name) const {

@@ -108,6 +108,14 @@ struct RobotModel {
   std::size_t num_triangles() const;
 };
 
+// For each triangle of mesh `mesh`, the node that carries most of its
+// vertices' weight: the robot's collision body is split into rigid pieces by it.
+std::vector<int> DominantNodePerTriangle(const RobotModel& model, int mesh);
+
+// The rigid part (rotation and translation) of a node pose whose 3x3 part is
+// a rotation times a uniform scale (as robot node poses are).
+Eigen::Isometry3d RigidPart(const Eigen::Affine3d& X);
+
 // Loads the robot `spec` declares. Materials and textures are appended to
 // `level` (the meshes index them there). Throws LevelError "manifest:line:
 // robot 'name': what" for an unknown bone, a bone map longer than the

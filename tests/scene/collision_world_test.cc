@@ -137,6 +137,13 @@ TEST_F(SampleLevelTest, ChannelsMovableActorsAndIgnoring) {
   EXPECT_THROW(world.SetActorPose(gate, bad), std::invalid_argument);
   EXPECT_TRUE(world.actor_pose(gate).isApprox(X_WG));
   EXPECT_THROW(world.SetActorPose(99, X_WG), std::invalid_argument);
+
+  // Placed by name, as external publishers address actors.
+  X_WG.translation() = Vector3d(-100, 100, 60);
+  world.SetActorPose("gate", X_WG);
+  EXPECT_TRUE(world.actor_pose(gate).isApprox(X_WG));
+  EXPECT_EQ(world.CastRay({-100, 100, 80}, {-100, 100, 0})->actor, gate);
+  EXPECT_THROW(world.SetActorPose("no such gate", X_WG), std::invalid_argument);
 }
 
 TEST(CollisionWorldTest, FloatingOriginKeepsMillimetresFarAway) {
