@@ -108,8 +108,7 @@ void ApplyBones(const std::string& spec, const RobotModel& model, RobotState* st
       for (double& v : values) v *= scene::kDegToRad;
     }
     if (!state->SetBone(bone, values.data(), b.num_values)) {
-      throw PoseError("--bones: bone '" + b.name + "' rejected: " +
-                      state->last_rejection());
+      throw PoseError("--bones: bone '" + b.name + "' rejected: " + state->last_rejection());
     }
   }
 }
@@ -130,8 +129,8 @@ void WritePly(const fs::path& file, const RobotState& state) {
     for (std::size_t v = 0; v < positions.size(); ++v) {
       const Eigen::Vector3d p = state.pose() * positions[v].cast<double>();
       const Eigen::Vector3d n = R * normals[v].cast<double>();
-      out << p.x() << " " << p.y() << " " << p.z() << " " << n.x() << " " << n.y() << " "
-          << n.z() << "\n";
+      out << p.x() << " " << p.y() << " " << p.z() << " " << n.x() << " " << n.y() << " " << n.z()
+          << "\n";
     }
   }
   std::size_t base = 0;
@@ -156,8 +155,8 @@ void WriteBoneFrames(const fs::path& file, const RobotState& state) {
     X.computeRotationScaling(&rotation, &scaling);
     const Eigen::Quaterniond q(rotation);
     out << b << "," << model.bones[b].name << "," << X.translation().x() << ","
-        << X.translation().y() << "," << X.translation().z() << "," << q.w() << "," << q.x()
-        << "," << q.y() << "," << q.z() << "\n";
+        << X.translation().y() << "," << X.translation().z() << "," << q.w() << "," << q.x() << ","
+        << q.y() << "," << q.z() << "\n";
   }
   if (!out) throw PoseError("cannot write " + file.string());
 }

@@ -54,8 +54,8 @@ struct ReferenceSkinning {
   void Update(const std::vector<Eigen::Quaterniond>& rotation) {
     for (std::size_t n = 0; n < model.nodes.size(); ++n) {
       const RobotNode& node = model.nodes[n];
-      X_BN[n] = (node.parent < 0 ? model.X_BF : X_BN[std::size_t(node.parent)]) * node.X_PN *
-                rotation[n];
+      X_BN[n] =
+          (node.parent < 0 ? model.X_BF : X_BN[std::size_t(node.parent)]) * node.X_PN * rotation[n];
     }
     for (std::size_t m = 0; m < model.meshes.size(); ++m) {
       const SkinnedMesh& mesh = model.meshes[m];
@@ -63,8 +63,7 @@ struct ReferenceSkinning {
         Eigen::Matrix4d M = Eigen::Matrix4d::Zero();
         for (std::uint32_t i = mesh.influence_begin[v]; i < mesh.influence_begin[v + 1]; ++i) {
           const SkinJoint& joint = model.joints[mesh.influence_joint[i]];
-          M += mesh.influence_weight[i] *
-               (X_BN[std::size_t(joint.node)] * joint.offset).matrix();
+          M += mesh.influence_weight[i] * (X_BN[std::size_t(joint.node)] * joint.offset).matrix();
         }
         const Eigen::Affine3d X(M);
         positions[m][v] = X * mesh.bind.positions_A[v].cast<double>();
@@ -115,8 +114,8 @@ int main(int argc, char** argv) {
     }
     reference.Update(rotation);
   });
-  std::printf("%-44s %12.1f %14.1f %7.1fx\n", "flying wing FK + skinning (24 bones, 20k vtx)",
-              ours, ref, ref / ours);
+  std::printf("%-44s %12.1f %14.1f %7.1fx\n", "flying wing FK + skinning (24 bones, 20k vtx)", ours,
+              ref, ref / ours);
 
   CollisionWorld world(level);
   const int robot = level.FindRobot("ELAHA");
@@ -144,10 +143,12 @@ int main(int argc, char** argv) {
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t v = indices[3 * t + std::size_t(k)];
       worst_m = std::max(worst_m, (move * rest.positions_B(0)[v].cast<double>() -
-                                   bent.positions_B(0)[v].cast<double>()).norm());
+                                   bent.positions_B(0)[v].cast<double>())
+                                      .norm());
     }
   }
-  std::printf("%-44s %9.1f mm\n", "  collision pieces off the skin at 4.5 deg/joint", 1e3 * worst_m);
+  std::printf("%-44s %9.1f mm\n", "  collision pieces off the skin at 4.5 deg/joint",
+              1e3 * worst_m);
 
   const fs::path skeletons =
       fs::path(SANDBOX_SOURCE_DIR) / "../shared/assets/recursive-skeletons/RecursiveSkeletons.glb";
@@ -163,12 +164,14 @@ int main(int argc, char** argv) {
     const double fk = MicrosecondsPerCall(iterations, [&](int) { skeleton.Update(); });
     const double fk_ref =
         MicrosecondsPerCall(iterations / 4, [&](int) { skeleton_reference.Update(identity); });
-    std::printf("%-44s %12.1f %14.1f %7.1fx\n",
-                ("RecursiveSkeletons FK + skin (" + std::to_string(model.nodes.size()) + " nodes)").c_str(),
-                fk, fk_ref, fk_ref / fk);
+    std::printf(
+        "%-44s %12.1f %14.1f %7.1fx\n",
+        ("RecursiveSkeletons FK + skin (" + std::to_string(model.nodes.size()) + " nodes)").c_str(),
+        fk, fk_ref, fk_ref / fk);
   } else {
     std::printf("RecursiveSkeletons: skipped, no %s\n", skeletons.c_str());
   }
-  std::printf("\nmedian of 15 batches, one core; targets: wing under 50 us, skeletons under 200 us\n");
+  std::printf(
+      "\nmedian of 15 batches, one core; targets: wing under 50 us, skeletons under 200 us\n");
   return 0;
 }

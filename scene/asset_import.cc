@@ -271,7 +271,6 @@ void CheckReadable(const fs::path& file) {
   }
 }
 
-
 std::string LowerExtension(const fs::path& file) {
   std::string ext = file.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),

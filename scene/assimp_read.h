@@ -2,13 +2,13 @@
 // Scene-internal: reading files with assimp, shared by the level and robot
 // loaders. Includes assimp; no header outside scene/*.cc includes this one.
 
+#include <assimp/scene.h>
+
+#include <Eigen/Geometry>
+#include <assimp/Importer.hpp>
 #include <filesystem>
 #include <string>
 #include <vector>
-
-#include <assimp/Importer.hpp>
-#include <assimp/scene.h>
-#include <Eigen/Geometry>
 
 #include "scene/level.h"
 
@@ -16,7 +16,7 @@ namespace sandbox::scene {
 
 // A scene read by ReadAssimpScene and how to convert it to the world's axes.
 struct AssimpScene {
-  const aiScene* scene{nullptr};  // owned by the importer
+  const aiScene* scene{nullptr};                      // owned by the importer
   Eigen::Affine3d X_RF{Eigen::Affine3d::Identity()};  // root R (Z up, metres) from file F
   UpAxis up{UpAxis::kPosZ};
   double unit_scale_m{1.0};

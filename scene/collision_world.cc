@@ -1,12 +1,12 @@
 #include "scene/collision_world.h"
 
+#include <btBulletCollisionCommon.h>
+
 #include <algorithm>
 #include <map>
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <btBulletCollisionCommon.h>
 
 #include "scene/check.h"
 
@@ -63,10 +63,11 @@ btTransform ToBulletTransform(const Eigen::Isometry3d& X, const Eigen::Vector3d&
   btTransform transform;
   transform.setOrigin(ToBullet(X.translation() - p_WO));
   const Eigen::Matrix3d& R = X.linear();
-  transform.setBasis(btMatrix3x3(
-      static_cast<btScalar>(R(0, 0)), static_cast<btScalar>(R(0, 1)), static_cast<btScalar>(R(0, 2)),
-      static_cast<btScalar>(R(1, 0)), static_cast<btScalar>(R(1, 1)), static_cast<btScalar>(R(1, 2)),
-      static_cast<btScalar>(R(2, 0)), static_cast<btScalar>(R(2, 1)), static_cast<btScalar>(R(2, 2))));
+  transform.setBasis(btMatrix3x3(static_cast<btScalar>(R(0, 0)), static_cast<btScalar>(R(0, 1)),
+                                 static_cast<btScalar>(R(0, 2)), static_cast<btScalar>(R(1, 0)),
+                                 static_cast<btScalar>(R(1, 1)), static_cast<btScalar>(R(1, 2)),
+                                 static_cast<btScalar>(R(2, 0)), static_cast<btScalar>(R(2, 1)),
+                                 static_cast<btScalar>(R(2, 2))));
   return transform;
 }
 
@@ -228,7 +229,8 @@ std::optional<RayHit> CollisionWorld::CastRay(const Eigen::Vector3d& from_W,
 
 void CollisionWorld::SetActorPose(int actor, const Eigen::Isometry3d& X_WA) {
   if (actor < 0 || actor >= impl_->num_actors) {
-    throw std::invalid_argument("CollisionWorld::SetActorPose(): no actor " + std::to_string(actor));
+    throw std::invalid_argument("CollisionWorld::SetActorPose(): no actor " +
+                                std::to_string(actor));
   }
   if (!impl_->movable[static_cast<std::size_t>(actor)]) {
     throw std::invalid_argument("CollisionWorld::SetActorPose(): actor " + std::to_string(actor) +
@@ -275,7 +277,9 @@ void CollisionWorld::SetOrigin(const Eigen::Vector3d& p_WO) {
   for (std::size_t b = 0; b < impl_->X_W.size(); ++b) impl_->Place(static_cast<int>(b), p_WO_);
 }
 
-int CollisionWorld::num_collision_objects() const { return static_cast<int>(impl_->objects.size()); }
+int CollisionWorld::num_collision_objects() const {
+  return static_cast<int>(impl_->objects.size());
+}
 
 int CollisionWorld::num_parts() const { return impl_->num_parts; }
 

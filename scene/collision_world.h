@@ -11,14 +11,13 @@
 // Threads: one thread (the loop thread) owns the world; CastRay uses
 // btCollisionWorld::rayTest, which is not safe to call from several threads.
 
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "scene/level.h"
 #include "scene/robot_state.h"

@@ -9,8 +9,8 @@ namespace {
 
 // Each axis with its name, for parsing and printing alike.
 constexpr std::pair<UpAxis, std::string_view> kAxisNames[] = {
-    {UpAxis::kPosX, "x"}, {UpAxis::kNegX, "-x"}, {UpAxis::kPosY, "y"},
-    {UpAxis::kNegY, "-y"}, {UpAxis::kPosZ, "z"}, {UpAxis::kNegZ, "-z"}};
+    {UpAxis::kPosX, "x"},  {UpAxis::kNegX, "-x"}, {UpAxis::kPosY, "y"},
+    {UpAxis::kNegY, "-y"}, {UpAxis::kPosZ, "z"},  {UpAxis::kNegZ, "-z"}};
 
 }  // namespace
 

@@ -38,7 +38,7 @@ struct Level {
   std::vector<Actor> actors;
   std::vector<Material> materials;
   std::vector<EmbeddedTexture> textures;
-  std::vector<RobotModel> robots;  // declared by [[robot]] tables of a manifest
+  std::vector<RobotModel> robots;     // declared by [[robot]] tables of a manifest
   std::vector<std::string> warnings;  // problems that were handled, e.g. dropped faces
 
   // Index of the actor (robot) called `name`, or -1.

@@ -2,8 +2,8 @@
 
 #include <toml++/toml.h>
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <set>
 #include <sstream>
 

@@ -1,10 +1,9 @@
 #pragma once
 // How assets are read and placed: errors, axis and unit conversion, placement.
 
+#include <Eigen/Geometry>
 #include <optional>
 #include <stdexcept>
-
-#include <Eigen/Geometry>
 
 #include "scene/frames.h"
 

@@ -7,8 +7,8 @@
 #include <sstream>
 
 #include "scene/asset_import.h"
-#include "scene/level.h"
 #include "scene/assimp_read.h"
+#include "scene/level.h"
 
 namespace sandbox::scene {
 namespace {
@@ -104,13 +104,14 @@ void MapBones(const RobotSpec& spec, bool has_skeleton, RobotModel* model,
   auto fail = [&](const std::string& what) { throw LevelError(where + what); };
   if (spec.bones.empty()) return;
   if (!has_skeleton) {
-    fail(spec.file.string() + " has no skeleton (no bones and a single node), but 'bones' "
-         "declares " + std::to_string(spec.bones.size()));
+    fail(spec.file.string() +
+         " has no skeleton (no bones and a single node), but 'bones' "
+         "declares " +
+         std::to_string(spec.bones.size()));
   }
   if (spec.bones.size() > model->nodes.size()) {
     fail("the bone map lists " + std::to_string(spec.bones.size()) + " bones, the skeleton of " +
-         spec.file.filename().string() + " has " + std::to_string(model->nodes.size()) +
-         " nodes");
+         spec.file.filename().string() + " has " + std::to_string(model->nodes.size()) + " nodes");
   }
   for (const std::string& name : spec.bones) {
     Bone bone;
@@ -158,7 +159,8 @@ void PrepareSkinning(SkinnedMesh* mesh) {
     std::size_t end = v + 1;
     while (!joints.empty() && end < n && joints_of(end) == joints) ++end;
     if (joints.empty() || end - v < 4) {
-      for (std::size_t u = v; u < end; ++u) mesh->scattered.push_back(static_cast<std::uint32_t>(u));
+      for (std::size_t u = v; u < end; ++u)
+        mesh->scattered.push_back(static_cast<std::uint32_t>(u));
       v = end;
       continue;
     }
@@ -169,7 +171,8 @@ void PrepareSkinning(SkinnedMesh* mesh) {
     std::copy(joints.begin(), joints.end(), run.joints);
     for (std::size_t u = v; u < end; ++u) {
       for (std::uint32_t i = mesh->influence_begin[u]; i < mesh->influence_begin[u + 1]; ++i) {
-        const auto k = std::find(joints.begin(), joints.end(), mesh->influence_joint[i]) - joints.begin();
+        const auto k =
+            std::find(joints.begin(), joints.end(), mesh->influence_joint[i]) - joints.begin();
         mesh->run_weight[k][u] = mesh->influence_weight[i];
       }
     }
@@ -237,17 +240,15 @@ int RobotModel::FindBone(const std::string& bone_name) const {
 }
 
 std::size_t RobotModel::num_vertices() const {
-  return std::accumulate(meshes.begin(), meshes.end(), std::size_t{0},
-                         [](std::size_t sum, const SkinnedMesh& m) {
-                           return sum + m.bind.positions_A.size();
-                         });
+  return std::accumulate(
+      meshes.begin(), meshes.end(), std::size_t{0},
+      [](std::size_t sum, const SkinnedMesh& m) { return sum + m.bind.positions_A.size(); });
 }
 
 std::size_t RobotModel::num_triangles() const {
-  return std::accumulate(meshes.begin(), meshes.end(), std::size_t{0},
-                         [](std::size_t sum, const SkinnedMesh& m) {
-                           return sum + m.bind.num_triangles();
-                         });
+  return std::accumulate(
+      meshes.begin(), meshes.end(), std::size_t{0},
+      [](std::size_t sum, const SkinnedMesh& m) { return sum + m.bind.num_triangles(); });
 }
 
 RobotModel LoadRobotModel(const RobotSpec& spec, const fs::path& manifest, Level* level) {
@@ -295,7 +296,8 @@ RobotModel LoadRobotModel(const RobotSpec& spec, const fs::path& manifest, Level
     level->warnings.push_back(spec.file.string() + ": skipped " + std::to_string(non_triangles) +
                               " point and line primitives");
   }
-  if (model.meshes.empty()) throw LevelError(where + spec.file.string() + ": has no triangle meshes");
+  if (model.meshes.empty())
+    throw LevelError(where + spec.file.string() + ": has no triangle meshes");
   return model;
 }
 

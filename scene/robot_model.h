@@ -5,13 +5,12 @@
 // nodes) are the same thing here: every vertex follows a weighted set of nodes.
 // The changing part (pose, bone rotations, posed mesh) is RobotState.
 
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <filesystem>
 #include <map>
 #include <string>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "scene/mesh.h"
 #include "scene/placement.h"
@@ -34,7 +33,7 @@ struct RobotSpec {
   bool collision{true};
   std::vector<std::string> bones;  // the bone map: index 0 = root
   BoneRotation rotation{BoneRotation::kQuaternion};
-  std::vector<Eigen::Vector3d> angle_axes;                         // kAngles: the default axes
+  std::vector<Eigen::Vector3d> angle_axes;                        // kAngles: the default axes
   std::map<std::string, std::vector<Eigen::Vector3d>> bone_axes;  // per-bone overrides
   int line{0};
 };
@@ -52,8 +51,8 @@ struct Bone {
   int node{-1};
   BoneRotation rotation{BoneRotation::kQuaternion};
   std::vector<Eigen::Vector3d> axes;  // kAngles: unit axes in the bone's rest frame
-  int first_value{0};  // where this bone's values start in the flat value vector
-  int num_values{4};   // 4 for a quaternion, axes.size() for angles
+  int first_value{0};                 // where this bone's values start in the flat value vector
+  int num_values{4};                  // 4 for a quaternion, axes.size() for angles
 };
 
 // A node that moves vertices: vertex v follows X_BN(node) * offset * v.

@@ -160,9 +160,10 @@ inline void StoreFourXyz(__m128 x, __m128 y, __m128 z, float* out) {
   const __m128 z0_x1 = _mm_unpacklo_ps(z, _mm_shuffle_ps(x, x, _MM_SHUFFLE(1, 1, 1, 1)));
   const __m128 yz = _mm_unpacklo_ps(y, z);  // y0 z0 y1 z1
   const __m128 z2z3x3y3 = _mm_shuffle_ps(z, xy_high, _MM_SHUFFLE(3, 2, 3, 2));
-  _mm_storeu_ps(out, _mm_movelh_ps(xy_low, z0_x1));                             // x0 y0 z0 x1
+  _mm_storeu_ps(out, _mm_movelh_ps(xy_low, z0_x1));                              // x0 y0 z0 x1
   _mm_storeu_ps(out + 4, _mm_shuffle_ps(yz, xy_high, _MM_SHUFFLE(1, 0, 3, 2)));  // y1 z1 x2 y2
-  _mm_storeu_ps(out + 8, _mm_shuffle_ps(z2z3x3y3, z2z3x3y3, _MM_SHUFFLE(1, 3, 2, 0)));  // z2 x3 y3 z3
+  _mm_storeu_ps(out + 8,
+                _mm_shuffle_ps(z2z3x3y3, z2z3x3y3, _MM_SHUFFLE(1, 3, 2, 0)));  // z2 x3 y3 z3
 }
 
 // Positions and normals of vertices v .. v+3 under the wide matrix M.
@@ -170,19 +171,21 @@ inline void SkinFour(const Wide3x4& M, const SkinnedMesh& mesh, std::uint32_t v,
                      float* positions, float* normals) {
   const __m128 x = _mm_loadu_ps(&mesh.bind_x[v]), y = _mm_loadu_ps(&mesh.bind_y[v]);
   const __m128 z = _mm_loadu_ps(&mesh.bind_z[v]);
-  StoreFourXyz(
-      _mm_add_ps(_mm_add_ps(_mm_mul_ps(M.m00, x), _mm_mul_ps(M.m01, y)),
-                 _mm_add_ps(_mm_mul_ps(M.m02, z), M.m03)),
-      _mm_add_ps(_mm_add_ps(_mm_mul_ps(M.m10, x), _mm_mul_ps(M.m11, y)),
-                 _mm_add_ps(_mm_mul_ps(M.m12, z), M.m13)),
-      _mm_add_ps(_mm_add_ps(_mm_mul_ps(M.m20, x), _mm_mul_ps(M.m21, y)),
-                 _mm_add_ps(_mm_mul_ps(M.m22, z), M.m23)),
-      positions + 3 * std::size_t{v});
+  StoreFourXyz(_mm_add_ps(_mm_add_ps(_mm_mul_ps(M.m00, x), _mm_mul_ps(M.m01, y)),
+                          _mm_add_ps(_mm_mul_ps(M.m02, z), M.m03)),
+               _mm_add_ps(_mm_add_ps(_mm_mul_ps(M.m10, x), _mm_mul_ps(M.m11, y)),
+                          _mm_add_ps(_mm_mul_ps(M.m12, z), M.m13)),
+               _mm_add_ps(_mm_add_ps(_mm_mul_ps(M.m20, x), _mm_mul_ps(M.m21, y)),
+                          _mm_add_ps(_mm_mul_ps(M.m22, z), M.m23)),
+               positions + 3 * std::size_t{v});
   const __m128 nx = _mm_loadu_ps(&mesh.bind_nx[v]), ny = _mm_loadu_ps(&mesh.bind_ny[v]);
   const __m128 nz = _mm_loadu_ps(&mesh.bind_nz[v]);
-  __m128 ox = _mm_add_ps(_mm_add_ps(_mm_mul_ps(M.m00, nx), _mm_mul_ps(M.m01, ny)), _mm_mul_ps(M.m02, nz));
-  __m128 oy = _mm_add_ps(_mm_add_ps(_mm_mul_ps(M.m10, nx), _mm_mul_ps(M.m11, ny)), _mm_mul_ps(M.m12, nz));
-  __m128 oz = _mm_add_ps(_mm_add_ps(_mm_mul_ps(M.m20, nx), _mm_mul_ps(M.m21, ny)), _mm_mul_ps(M.m22, nz));
+  __m128 ox =
+      _mm_add_ps(_mm_add_ps(_mm_mul_ps(M.m00, nx), _mm_mul_ps(M.m01, ny)), _mm_mul_ps(M.m02, nz));
+  __m128 oy =
+      _mm_add_ps(_mm_add_ps(_mm_mul_ps(M.m10, nx), _mm_mul_ps(M.m11, ny)), _mm_mul_ps(M.m12, nz));
+  __m128 oz =
+      _mm_add_ps(_mm_add_ps(_mm_mul_ps(M.m20, nx), _mm_mul_ps(M.m21, ny)), _mm_mul_ps(M.m22, nz));
   if (normalize) {
     const __m128 length = _mm_sqrt_ps(
         _mm_add_ps(_mm_add_ps(_mm_mul_ps(ox, ox), _mm_mul_ps(oy, oy)), _mm_mul_ps(oz, oz)));

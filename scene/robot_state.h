@@ -2,11 +2,10 @@
 // The changing part of a robot: its world pose, its bone rotations, and the
 // posed (skinned) mesh from forward kinematics. Owned by the loop thread.
 
+#include <Eigen/Geometry>
 #include <map>
 #include <string>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "scene/robot_model.h"
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <iomanip>
 #include <limits>
@@ -125,8 +126,8 @@ void WriteGltfScene(const std::filesystem::path& file, const GltfScene& scene) {
       for (int j = 0; j < 3; ++j) lo[j] = std::min(lo[j], p[j]), hi[j] = std::max(hi[j], p[j]);
     }
     std::ostringstream bounds;
-    bounds << ",\"min\":[" << lo[0] << "," << lo[1] << "," << lo[2] << "],\"max\":[" << hi[0]
-           << "," << hi[1] << "," << hi[2] << "]";
+    bounds << ",\"min\":[" << lo[0] << "," << lo[1] << "," << lo[2] << "],\"max\":[" << hi[0] << ","
+           << hi[1] << "," << hi[2] << "]";
     const int position = buffer.Add(mesh.positions, 34962, 5126, "VEC3", bounds.str());
     const int normal = buffer.Add(mesh.normals, 34962, 5126, "VEC3");
     const int indices = buffer.Add(mesh.indices, 34963, 5125, "SCALAR");
@@ -140,8 +141,8 @@ void WriteGltfScene(const std::filesystem::path& file, const GltfScene& scene) {
     json_meshes << "},\"indices\":" << indices << ",\"material\":" << m << "}]}";
     const auto& c = mesh.base_color;
     materials << (m > 0 ? "," : "") << "{\"name\":\"" << mesh.name
-              << "\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[" << c[0] << "," << c[1]
-              << "," << c[2] << "," << c[3] << "],\"metallicFactor\":0,\"roughnessFactor\":0.9}"
+              << "\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[" << c[0] << "," << c[1] << ","
+              << c[2] << "," << c[3] << "],\"metallicFactor\":0,\"roughnessFactor\":0.9}"
               << (c[3] < 1.0f ? ",\"alphaMode\":\"BLEND\"" : "") << "}";
   }
   for (std::size_t n = 0; n < scene.nodes.size(); ++n) {
@@ -149,8 +150,8 @@ void WriteGltfScene(const std::filesystem::path& file, const GltfScene& scene) {
     const auto& t = node.translation;
     const auto& r = node.rotation_xyzw;
     nodes << (n > 0 ? "," : "") << "{\"name\":\"" << node.name << "\",\"translation\":[" << t[0]
-          << "," << t[1] << "," << t[2] << "],\"rotation\":[" << r[0] << "," << r[1] << ","
-          << r[2] << "," << r[3] << "]";
+          << "," << t[1] << "," << t[2] << "],\"rotation\":[" << r[0] << "," << r[1] << "," << r[2]
+          << "," << r[3] << "]";
     if (node.mesh >= 0) nodes << ",\"mesh\":" << node.mesh;
     if (node.skinned) nodes << ",\"skin\":0";
     if (!node.children.empty()) {
@@ -172,7 +173,8 @@ void WriteGltfScene(const std::filesystem::path& file, const GltfScene& scene) {
     skins << "]}]";
   }
   std::ostringstream roots;
-  for (std::size_t r = 0; r < scene.roots.size(); ++r) roots << (r > 0 ? "," : "") << scene.roots[r];
+  for (std::size_t r = 0; r < scene.roots.size(); ++r)
+    roots << (r > 0 ? "," : "") << scene.roots[r];
 
   std::filesystem::path bin_file = file;
   bin_file.replace_extension(".bin");
@@ -206,6 +208,22 @@ void WriteGltf(const std::filesystem::path& file, const std::vector<GeneratedMes
     scene.meshes.push_back(std::move(mesh));
   }
   WriteGltfScene(file, scene);
+}
+
+int GeneratorMain(int argc, char** argv,
+                  const std::function<void(const std::filesystem::path&)>& write) {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: %s OUT_DIR\n", argv[0]);
+    return 2;
+  }
+  try {
+    std::filesystem::create_directories(argv[1]);
+    write(argv[1]);
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "%s: %s\n", argv[0], error.what());
+    return 1;
+  }
+  return 0;
 }
 
 }  // namespace sandbox::assets

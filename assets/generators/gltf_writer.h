@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -38,8 +39,8 @@ struct GeneratedMesh {
 
 struct GltfNode {
   std::string name;
-  int mesh{-1};          // index into GltfScene::meshes, -1: none
-  bool skinned{false};   // the mesh is deformed by GltfScene::skin
+  int mesh{-1};         // index into GltfScene::meshes, -1: none
+  bool skinned{false};  // the mesh is deformed by GltfScene::skin
   std::array<float, 3> translation{0.f, 0.f, 0.f};
   std::array<float, 4> rotation_xyzw{0.f, 0.f, 0.f, 1.f};
   std::vector<int> children;
@@ -67,5 +68,10 @@ void WriteGltfScene(const std::filesystem::path& file, const GltfScene& scene);
 // Meshes given in the world frame (Z up, metres), one root node each, written
 // Y-up as glTF requires.
 void WriteGltf(const std::filesystem::path& file, const std::vector<GeneratedMesh>& meshes);
+
+// The main() of a generator program: `program OUT_DIR` creates OUT_DIR and
+// calls `write` with it; prints usage or the error and returns the exit code.
+int GeneratorMain(int argc, char** argv,
+                  const std::function<void(const std::filesystem::path&)>& write);
 
 }  // namespace sandbox::assets

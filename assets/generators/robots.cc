@@ -7,7 +7,6 @@
 
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <string>
 
@@ -119,7 +118,8 @@ void WriteFlyingWing(const std::filesystem::path& file) {
   }
   for (int s = 0; s + 1 < stations; ++s) {
     for (int a = 0; a < around; ++a) {
-      const auto v0 = std::uint32_t(s * around + a), v1 = std::uint32_t(s * around + (a + 1) % around);
+      const auto v0 = std::uint32_t(s * around + a),
+                 v1 = std::uint32_t(s * around + (a + 1) % around);
       const auto w0 = v0 + around, w1 = v1 + around;
       wing.AddTriangle(v0, v1, w1);
       wing.AddTriangle(v0, w1, w0);
@@ -127,9 +127,11 @@ void WriteFlyingWing(const std::filesystem::path& file) {
   }
   for (const int end : {0, stations - 1}) {
     const double y = end == 0 ? -kHalfSpan : kHalfSpan;
-    const std::uint32_t centre = add_vertex({float(0.5 * (kLeadingEdgeX + kTrailingEdgeX)), float(y), 0.f}, y);
+    const std::uint32_t centre =
+        add_vertex({float(0.5 * (kLeadingEdgeX + kTrailingEdgeX)), float(y), 0.f}, y);
     for (int a = 0; a < around; ++a) {
-      const auto v0 = std::uint32_t(end * around + a), v1 = std::uint32_t(end * around + (a + 1) % around);
+      const auto v0 = std::uint32_t(end * around + a),
+                 v1 = std::uint32_t(end * around + (a + 1) % around);
       if (end == 0) {
         wing.AddTriangle(centre, v1, v0);
       } else {
@@ -204,8 +206,8 @@ void WriteQuadrotor(const std::filesystem::path& file) {
   const float sx[4] = {1, 0, -1, 0}, sy[4] = {0, 1, 0, -1};
   for (int k = 0; k < 4; ++k) {
     scene.nodes[0].children.push_back(int(scene.nodes.size()));
-    scene.nodes.push_back(Node("rotor" + std::to_string(k + 1),
-                               {sx[k] * r, sy[k] * r, float(kRotorZ)}, 1));
+    scene.nodes.push_back(
+        Node("rotor" + std::to_string(k + 1), {sx[k] * r, sy[k] * r, float(kRotorZ)}, 1));
   }
   scene.roots = {0};
   WriteGltfScene(file, scene);
@@ -227,20 +229,10 @@ void WriteBox(const std::filesystem::path& file) {
 
 int main(int argc, char** argv) {
   using namespace sandbox::assets;
-  if (argc != 2) {
-    std::fprintf(stderr, "usage: %s OUT_DIR\n", argv[0]);
-    return 2;
-  }
-  const std::filesystem::path out = argv[1];
-  try {
-    std::filesystem::create_directories(out);
+  return GeneratorMain(argc, argv, [](const std::filesystem::path& out) {
     WriteFlyingWing(out / "flying_wing.gltf");
     WriteArm(out / "arm.gltf");
     WriteQuadrotor(out / "quadrotor.gltf");
     WriteBox(out / "box.gltf");
-  } catch (const std::exception& error) {
-    std::fprintf(stderr, "make_robots: %s\n", error.what());
-    return 1;
-  }
-  return 0;
+  });
 }

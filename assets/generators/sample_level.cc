@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <utility>
@@ -47,7 +46,6 @@ GeneratedMesh Water() {
   mesh.AddQuad({-h, -h, 0.f}, {h, -h, 0.f}, {h, h, 0.f}, {-h, h, 0.f});
   return mesh;
 }
-
 
 // A deterministic bumpy displacement of a unit direction.
 double Bumps(const Point& d, double seed) {
@@ -179,13 +177,7 @@ GeneratedMesh Gate() {
 
 int main(int argc, char** argv) {
   using namespace sandbox::assets;
-  if (argc != 2) {
-    std::fprintf(stderr, "usage: %s OUT_DIR\n", argv[0]);
-    return 2;
-  }
-  const std::filesystem::path out = argv[1];
-  try {
-    std::filesystem::create_directories(out);
+  return GeneratorMain(argc, argv, [](const std::filesystem::path& out) {
     WriteGltf(out / "terrain.gltf", {Terrain()});
     WriteGltf(out / "water.gltf", {Water()});
     WriteGltf(out / "rocks.gltf", {Rocks()});
@@ -193,9 +185,5 @@ int main(int argc, char** argv) {
     WriteGltf(out / "wall.gltf", {Wall()});
     WriteGltf(out / "tower.gltf", {Tower()});
     WriteGltf(out / "gate.gltf", {Gate()});
-  } catch (const std::exception& error) {
-    std::fprintf(stderr, "make_sample_level: %s\n", error.what());
-    return 1;
-  }
-  return 0;
+  });
 }

@@ -2,11 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <fstream>
 #include <sstream>
-
-#include <Eigen/Geometry>
 
 #include "tests/app/run_sandbox.h"
 #include "tests/test_util.h"
@@ -43,14 +42,11 @@ TEST(PoseCommandTest, ArmJointsGiveTheHandComputedFrames) {
   // Base at (1, 2, 3) turned 90 degrees about z; joints 0.25, 0.2, 0.6 up;
   // link1 about z by 30, link2 about y by -45, link3 about y by 60 (degrees).
   const double d = 3.14159265358979323846 / 180.0;
-  const Eigen::Isometry3d X = Eigen::Translation3d(1, 2, 3) *
-                              Eigen::AngleAxisd(90 * d, Eigen::Vector3d::UnitZ()) *
-                              Eigen::Translation3d(0, 0, 0.25) *
-                              Eigen::AngleAxisd(30 * d, Eigen::Vector3d::UnitZ()) *
-                              Eigen::Translation3d(0, 0, 0.2) *
-                              Eigen::AngleAxisd(-45 * d, Eigen::Vector3d::UnitY()) *
-                              Eigen::Translation3d(0, 0, 0.6) *
-                              Eigen::AngleAxisd(60 * d, Eigen::Vector3d::UnitY());
+  const Eigen::Isometry3d X =
+      Eigen::Translation3d(1, 2, 3) * Eigen::AngleAxisd(90 * d, Eigen::Vector3d::UnitZ()) *
+      Eigen::Translation3d(0, 0, 0.25) * Eigen::AngleAxisd(30 * d, Eigen::Vector3d::UnitZ()) *
+      Eigen::Translation3d(0, 0, 0.2) * Eigen::AngleAxisd(-45 * d, Eigen::Vector3d::UnitY()) *
+      Eigen::Translation3d(0, 0, 0.6) * Eigen::AngleAxisd(60 * d, Eigen::Vector3d::UnitY());
   const std::vector<double> row = BoneRow(dir.path() / "arm.bones.csv", "link3");
   ASSERT_EQ(row.size(), 7u);
   EXPECT_LT((Eigen::Vector3d(row[0], row[1], row[2]) - X.translation()).norm(), 1e-5);
@@ -77,7 +73,8 @@ TEST(PoseCommandTest, BadBonesAreOneClearMessage) {
   EXPECT_EQ(run.out, "sandbox pose: --bones: robot 'ARM' has no bone 'elbow' (7 bones)\n");
   run = RunSandbox("pose " + Robots() + " --robot ARM --bones 'link2 10 20'" + out);
   EXPECT_EQ(run.exit_code, 1);
-  EXPECT_EQ(run.out, "sandbox pose: --bones: bone 'link2' takes 1 values (angles in degrees), got 2\n");
+  EXPECT_EQ(run.out,
+            "sandbox pose: --bones: bone 'link2' takes 1 values (angles in degrees), got 2\n");
   run = RunSandbox("pose " + Robots() + " --robot NOBODY" + out);
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_EQ(run.out, "sandbox pose: the level has no robot 'NOBODY'\n");

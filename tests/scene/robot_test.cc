@@ -37,7 +37,8 @@ class RobotTest : public ::testing::Test {
     const auto& positions = rest.positions_B(0);
     std::size_t best = 0;
     for (std::size_t v = 0; v < positions.size(); ++v) {
-      if ((positions[v].cast<double>() - p_B).norm() < (positions[best].cast<double>() - p_B).norm()) {
+      if ((positions[v].cast<double>() - p_B).norm() <
+          (positions[best].cast<double>() - p_B).norm()) {
         best = v;
       }
     }
@@ -87,8 +88,10 @@ TEST_F(RobotTest, WingBendsNinetyDegreesTipToTipAsTheAnalyticChain) {
         X_B10.matrix(), 1e-6));
   }
   // 45 degrees down on each side: the tip frames differ by 90 degrees.
-  const Eigen::Matrix3d R_right = state.node_poses_B()[static_cast<std::size_t>(wing.bones[10].node)].linear();
-  const Eigen::Matrix3d R_left = state.node_poses_B()[static_cast<std::size_t>(wing.bones[20].node)].linear();
+  const Eigen::Matrix3d R_right =
+      state.node_poses_B()[static_cast<std::size_t>(wing.bones[10].node)].linear();
+  const Eigen::Matrix3d R_left =
+      state.node_poses_B()[static_cast<std::size_t>(wing.bones[20].node)].linear();
   EXPECT_NEAR(AngleAxisd(R_right.transpose() * R_left).angle(), 90.0 * kDeg, 1e-5);
 }
 
@@ -107,7 +110,8 @@ TEST_F(RobotTest, BentWingSkinHasNoCracks) {
   double worst = 0.0;
   for (std::size_t t = 0; t < indices.size(); t += 3) {
     for (int e = 0; e < 3; ++e) {
-      const std::uint32_t a = indices[t + std::size_t(e)], b = indices[t + std::size_t((e + 1) % 3)];
+      const std::uint32_t a = indices[t + std::size_t(e)],
+                          b = indices[t + std::size_t((e + 1) % 3)];
       const double before = (rest.positions_B(0)[a] - rest.positions_B(0)[b]).norm();
       const double after = (state.positions_B(0)[a] - state.positions_B(0)[b]).norm();
       if (before > 1e-4) worst = std::max(worst, std::abs(after / before - 1.0));
@@ -195,9 +199,10 @@ TEST_F(RobotTest, BadRunTimeUpdatesAreRejectedCountedAndChangeNothing) {
 
 TEST_F(RobotTest, QuaternionBonesRejectNonUnitQuaternions) {
   testing::TempDir dir;
-  const Level level = LoadLevel(dir.Write("q.toml", "[[robot]]\nname = \"q\"\nfile = \"" +
-                                                       (RobotsLevel().parent_path() / "generated/arm.gltf").string() +
-                                                       "\"\nbones = [\"base\", \"link1\"]\n"));
+  const Level level = LoadLevel(
+      dir.Write("q.toml", "[[robot]]\nname = \"q\"\nfile = \"" +
+                              (RobotsLevel().parent_path() / "generated/arm.gltf").string() +
+                              "\"\nbones = [\"base\", \"link1\"]\n"));
   RobotState state(level.robots[0]);
   const double half_turn[4] = {0.0, 0.0, 0.0, 1.0};
   const double long_q[4] = {1.0, 1.0, 0.0, 0.0};
@@ -207,10 +212,11 @@ TEST_F(RobotTest, QuaternionBonesRejectNonUnitQuaternions) {
   EXPECT_EQ(state.last_rejection(), "non-unit bone quaternion");
   state.Update();
   // link1 turned 180 degrees about z (in its rest frame = the robot's axes).
-  EXPECT_TRUE(state.node_poses_B()[static_cast<std::size_t>(level.robots[0].FindNode("link1"))]
-                  .linear()
-                  .isApprox(AngleAxisd(3.14159265358979323846, Vector3d::UnitZ()).toRotationMatrix(),
-                            1e-6));
+  EXPECT_TRUE(
+      state.node_poses_B()[static_cast<std::size_t>(level.robots[0].FindNode("link1"))]
+          .linear()
+          .isApprox(AngleAxisd(3.14159265358979323846, Vector3d::UnitZ()).toRotationMatrix(),
+                    1e-6));
 }
 
 TEST_F(RobotTest, RobotCollisionFollowsTheBentWingAndIgnoresItself) {
@@ -226,8 +232,8 @@ TEST_F(RobotTest, RobotCollisionFollowsTheBentWingAndIgnoresItself) {
   EXPECT_EQ(hit->actor, -1);
   EXPECT_NEAR(hit->point_W.z(), 10.06, 2e-3);
   // The robot's own sensors do not see it.
-  EXPECT_FALSE(world.CastRay(above_tip, above_tip - Vector3d(0, 0, 30), kAllGroups, -1, robot)
-                   .has_value());
+  EXPECT_FALSE(
+      world.CastRay(above_tip, above_tip - Vector3d(0, 0, 30), kAllGroups, -1, robot).has_value());
   // Bent 90 degrees tip to tip, the tip has gone down and inwards: the old ray
   // misses and a ray at the new tip hits it.
   for (int b = 1; b <= 20; ++b) {
@@ -246,7 +252,8 @@ TEST_F(RobotTest, RobotCollisionFollowsTheBentWingAndIgnoresItself) {
   X_WB.translation() += Vector3d(0, 0, 50);
   ASSERT_TRUE(state.SetPose(X_WB));
   world.UpdateRobot(robot, state);
-  EXPECT_FALSE(world.CastRay(tip_W + Vector3d(0, -5, 0), tip_W + Vector3d(0, 5, 0), kRobot).has_value());
+  EXPECT_FALSE(
+      world.CastRay(tip_W + Vector3d(0, -5, 0), tip_W + Vector3d(0, 5, 0), kRobot).has_value());
 }
 
 std::string LoadError(const std::string& toml) {
@@ -268,22 +275,27 @@ TEST(RobotLoadTest, BadBoneMapsAreClearErrors) {
                 .find(":1: robot 'r': bone 'elbow' is not a node of arm.gltf (nodes: base, link1"),
             std::string::npos)
       << LoadError(head + "bones = [\"base\", \"elbow\"]\n");
-  EXPECT_NE(LoadError(head + "bones = [\"b0\",\"b1\",\"b2\",\"b3\",\"b4\",\"b5\",\"b6\",\"b7\",\"b8\"]\n")
-                .find("the bone map lists 9 bones, the skeleton of arm.gltf has 8 nodes"),
-            std::string::npos);
-  EXPECT_NE(LoadError(head + "bones = [\"link3\", \"link1\"]\n")
-                .find("bone 0 'link3' must be the root of the bone map, but 'link1' is not below it"),
-            std::string::npos);
-  EXPECT_NE(LoadError("[[robot]]\nname = \"r\"\nfile = \"" + box + "\"\nbones = [\"box\"]\n")
-                .find("box.gltf has no skeleton (no bones and a single node), but 'bones' declares 1"),
-            std::string::npos);
-  EXPECT_NE(LoadError(head + "bones = [\"base\", \"base\"]\n").find(":4: robot 'r': bone 'base' is listed twice"),
+  EXPECT_NE(
+      LoadError(head + "bones = [\"b0\",\"b1\",\"b2\",\"b3\",\"b4\",\"b5\",\"b6\",\"b7\",\"b8\"]\n")
+          .find("the bone map lists 9 bones, the skeleton of arm.gltf has 8 nodes"),
+      std::string::npos);
+  EXPECT_NE(
+      LoadError(head + "bones = [\"link3\", \"link1\"]\n")
+          .find("bone 0 'link3' must be the root of the bone map, but 'link1' is not below it"),
+      std::string::npos);
+  EXPECT_NE(
+      LoadError("[[robot]]\nname = \"r\"\nfile = \"" + box + "\"\nbones = [\"box\"]\n")
+          .find("box.gltf has no skeleton (no bones and a single node), but 'bones' declares 1"),
+      std::string::npos);
+  EXPECT_NE(LoadError(head + "bones = [\"base\", \"base\"]\n")
+                .find(":4: robot 'r': bone 'base' is listed twice"),
             std::string::npos);
   EXPECT_NE(LoadError(head + "bones = [\"base\"]\nrotation = \"euler\"\n")
                 .find("'rotation' must be \"quaternion\" or \"angles\", got 'euler'"),
             std::string::npos);
-  EXPECT_NE(LoadError(head + "bones = [\"base\"]\nrotation = \"angles\"\n").find("needs 'angle_axes'"),
-            std::string::npos);
+  EXPECT_NE(
+      LoadError(head + "bones = [\"base\"]\nrotation = \"angles\"\n").find("needs 'angle_axes'"),
+      std::string::npos);
   EXPECT_NE(LoadError(head + "bones = [\"base\"]\nrotation = \"angles\"\nangle_axes = [\"w\"]\n")
                 .find(":6: robot 'r': 'angle_axes' takes axis names"),
             std::string::npos);

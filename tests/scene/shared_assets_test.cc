@@ -166,7 +166,8 @@ TEST_F(SharedAssetsTest, RotatingANamedBoneMovesItsVerticesByTheRotatedOffset) {
     EXPECT_LT((box.max() - still.bounds_W().max()).norm(), 1e-4);
 
     // Turn the bone 30 degrees about an oblique axis of its rest frame.
-    const Eigen::Quaterniond q(Eigen::AngleAxisd(0.5235987755982988, Vector3d(1, 2, 3).normalized()));
+    const Eigen::Quaterniond q(
+        Eigen::AngleAxisd(0.5235987755982988, Vector3d(1, 2, 3).normalized()));
     const double values[4] = {q.w(), q.x(), q.y(), q.z()};
     RobotState posed(model);
     ASSERT_TRUE(posed.SetBone(0, values, 4));
