@@ -1,6 +1,5 @@
 #include "scene/collision_world.h"
 
-#include <btBulletCollisionCommon.h>
 
 #include <algorithm>
 #include <map>
@@ -9,42 +8,12 @@
 #include <vector>
 
 #include "scene/check.h"
+#include "scene/collision_world_internal.h"
 
 namespace sandbox::scene {
 namespace {
 
-// Bullet's quantized BVH stores a part index in 10 bits and a triangle index
-// in 21 bits: more crashes on the first ray.
-constexpr std::size_t kMaxTrianglesPerPart = std::size_t{1} << 21;
-constexpr int kMaxPartsPerShape = 1024;
-
-btVector3 ToBullet(const Eigen::Vector3d& v) {
-  return {static_cast<btScalar>(v.x()), static_cast<btScalar>(v.y()), static_cast<btScalar>(v.z())};
-}
-
 Eigen::Vector3d FromBullet(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
-
-// Vertex and index arrays of one mesh, read in place by Bullet.
-struct MeshArrays {
-  const std::vector<Eigen::Vector3f>* positions;
-  const std::vector<std::uint32_t>* indices;
-};
-
-// One Bullet object: a shape over at most kMaxPartsPerShape mesh parts.
-struct MeshObject {
-  std::unique_ptr<btTriangleIndexVertexArray> mesh_interface;
-  std::unique_ptr<btBvhTriangleMeshShape> shape;
-  std::unique_ptr<btCollisionObject> object;
-  Eigen::Isometry3d X_BO{Eigen::Isometry3d::Identity()};  // in its body's frame
-};
-
-// A rigid piece of a robot's collision body: the triangles that mostly follow
-// one node, in that node's frame at rest.
-struct RobotPiece {
-  int node{-1};
-  std::vector<Eigen::Vector3f> positions;
-  std::vector<std::uint32_t> indices;
-};
 
 // Ray callback that skips the bodies (actors or robots) of the world it is told.
 struct ClosestHitIgnoring : btCollisionWorld::ClosestRayResultCallback {
@@ -59,93 +28,7 @@ struct ClosestHitIgnoring : btCollisionWorld::ClosestRayResultCallback {
   int ignore_second;
 };
 
-btTransform ToBulletTransform(const Eigen::Isometry3d& X, const Eigen::Vector3d& p_WO) {
-  btTransform transform;
-  transform.setOrigin(ToBullet(X.translation() - p_WO));
-  const Eigen::Matrix3d& R = X.linear();
-  transform.setBasis(btMatrix3x3(static_cast<btScalar>(R(0, 0)), static_cast<btScalar>(R(0, 1)),
-                                 static_cast<btScalar>(R(0, 2)), static_cast<btScalar>(R(1, 0)),
-                                 static_cast<btScalar>(R(1, 1)), static_cast<btScalar>(R(1, 2)),
-                                 static_cast<btScalar>(R(2, 0)), static_cast<btScalar>(R(2, 1)),
-                                 static_cast<btScalar>(R(2, 2))));
-  return transform;
-}
-
 }  // namespace
-
-// Bodies are the actors (0 .. A-1) and then the robots (A .. A+R-1); a Bullet
-// object's user index is its body.
-struct CollisionWorld::Impl {
-  // Bullet wants a dispatcher to build a collision world; it is never used to
-  // step anything.
-  btDefaultCollisionConfiguration configuration;
-  btCollisionDispatcher dispatcher{&configuration};
-  btDbvtBroadphase broadphase;
-  btCollisionWorld world{&dispatcher, &broadphase, &configuration};
-  std::vector<MeshObject> objects;
-  std::vector<std::vector<int>> objects_of_body;  // indices into `objects`
-  std::vector<Eigen::Isometry3d> X_W;             // pose of each body
-  std::vector<bool> movable;                      // actors only
-  int num_actors{0};
-  int num_parts{0};
-  // Robots: their models and rigid pieces (Bullet reads the pieces' arrays).
-  std::vector<const RobotModel*> robot_models;
-  std::vector<std::vector<std::unique_ptr<RobotPiece>>> robot_pieces;
-
-  ~Impl() {
-    for (MeshObject& object : objects) world.removeCollisionObject(object.object.get());
-  }
-
-  // Creates the objects of one body over `meshes` (split to Bullet's limits),
-  // placed at X_BO in the body's frame; returns their indices in `objects`.
-  std::vector<int> AddBody(int body, const std::vector<MeshArrays>& meshes, int group,
-                           const Eigen::Isometry3d& X_BO = Eigen::Isometry3d::Identity()) {
-    std::vector<int> added;
-    std::vector<btIndexedMesh> parts;
-    for (const MeshArrays& mesh : meshes) {
-      const std::size_t triangles = mesh.indices->size() / 3;
-      for (std::size_t first = 0; first < triangles; first += kMaxTrianglesPerPart) {
-        btIndexedMesh part;
-        part.m_numTriangles = static_cast<int>(std::min(kMaxTrianglesPerPart, triangles - first));
-        part.m_triangleIndexBase =
-            reinterpret_cast<const unsigned char*>(&(*mesh.indices)[3 * first]);
-        part.m_triangleIndexStride = 3 * sizeof(std::uint32_t);
-        part.m_indexType = PHY_INTEGER;
-        part.m_numVertices = static_cast<int>(mesh.positions->size());
-        part.m_vertexBase = reinterpret_cast<const unsigned char*>(mesh.positions->data());
-        part.m_vertexStride = sizeof(Eigen::Vector3f);
-        part.m_vertexType = PHY_FLOAT;
-        parts.push_back(part);
-      }
-    }
-    for (std::size_t first = 0; first < parts.size(); first += kMaxPartsPerShape) {
-      MeshObject object;
-      object.mesh_interface = std::make_unique<btTriangleIndexVertexArray>();
-      const std::size_t end = std::min(parts.size(), first + kMaxPartsPerShape);
-      for (std::size_t p = first; p < end; ++p) object.mesh_interface->addIndexedMesh(parts[p]);
-      object.shape = std::make_unique<btBvhTriangleMeshShape>(object.mesh_interface.get(), true);
-      object.object = std::make_unique<btCollisionObject>();
-      object.object->setCollisionShape(object.shape.get());
-      object.object->setUserIndex(body);
-      object.X_BO = X_BO;
-      world.addCollisionObject(object.object.get(), group, static_cast<int>(kAllGroups));
-      num_parts += static_cast<int>(end - first);
-      objects_of_body[static_cast<std::size_t>(body)].push_back(static_cast<int>(objects.size()));
-      added.push_back(static_cast<int>(objects.size()));
-      objects.push_back(std::move(object));
-    }
-    return added;
-  }
-
-  void Place(int body, const Eigen::Vector3d& p_WO) {
-    const Eigen::Isometry3d& X_WB = X_W[static_cast<std::size_t>(body)];
-    for (int index : objects_of_body[static_cast<std::size_t>(body)]) {
-      MeshObject& object = objects[static_cast<std::size_t>(index)];
-      object.object->setWorldTransform(ToBulletTransform(X_WB * object.X_BO, p_WO));
-      world.updateSingleAabb(object.object.get());
-    }
-  }
-};
 
 CollisionWorld::CollisionWorld(const Level& level) : impl_(std::make_unique<Impl>()) {
   Impl& w = *impl_;

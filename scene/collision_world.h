@@ -82,8 +82,11 @@ class CollisionWorld {
   int num_collision_objects() const;
   int num_parts() const;  // Bullet mesh parts over all shapes
 
- private:
+  // The Bullet objects inside, for sensors/ (scene/collision_world_internal.h).
   struct Impl;
+  const Impl& internals() const { return *impl_; }
+
+ private:
   std::unique_ptr<Impl> impl_;
   std::vector<std::string> actor_names_;
   Eigen::Vector3d p_WO_{Eigen::Vector3d::Zero()};
