@@ -1,0 +1,83 @@
+#pragma once
+// Batched ray casting over the Bullet world, split over worker threads.
+// Thread-safe by construction: every ray walks Bullet's quantized BVH nodes
+// and the level's own triangle arrays read-only, with its own stack; nothing
+// of Bullet's mutable query state (btCollisionWorld::rayTest) is used.
+
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "scene/collision_world.h"
+
+namespace sandbox::sensors {
+
+// Rays relative to a batch origin in the world frame: ray i starts at
+// origin_W + start[i] and runs along the unit direction[i] for length_m[i].
+// Float offsets from a double origin keep precision far from the world origin.
+struct RayBatch {
+  Eigen::Vector3d origin_W{Eigen::Vector3d::Zero()};
+  std::vector<Eigen::Vector3f> start;
+  std::vector<Eigen::Vector3f> direction;  // unit
+  std::vector<float> length_m;
+
+  std::size_t size() const { return start.size(); }
+  void Resize(std::size_t n);
+};
+
+// What rays may see.
+struct RayFilter {
+  std::uint32_t group_mask{scene::kAllGroups};
+  int ignore_actor{-1};
+  int ignore_robot{-1};  // a robot's own sensors set this to the robot
+};
+
+// One entry per ray. A ray that hits nothing has distance_m = length_m and
+// body = -1 (kNoHit).
+struct RayHits {
+  static constexpr int kNoHit = -1;
+  std::vector<float> distance_m;
+  std::vector<Eigen::Vector3f> normal_W;  // unit, facing the ray; zero without a hit
+  std::vector<std::int32_t> body;         // actor index, or num_actors + robot index
+
+  std::size_t size() const { return body.size(); }
+};
+
+class RayCaster {
+ public:
+  // Starts `threads` - 1 worker threads (0: one per core); the calling thread
+  // is the last worker.
+  explicit RayCaster(int threads = 0);
+  ~RayCaster();
+  RayCaster(const RayCaster&) = delete;
+  RayCaster& operator=(const RayCaster&) = delete;
+
+  // Casts every ray of `rays`. The world must not change during the call.
+  // Call from one thread at a time (the loop thread).
+  void Cast(const scene::CollisionWorld& world, const RayBatch& rays, const RayFilter& filter,
+            RayHits* hits);
+
+  int threads() const { return static_cast<int>(workers_.size()) + 1; }
+
+ private:
+  // Runs job(chunk) for chunk = 0 .. chunks-1 over all threads; returns when done.
+  void RunParallel(int chunks, const std::function<void(int)>& job);
+  void WorkerLoop();
+
+  std::vector<std::thread> workers_;
+  std::mutex mutex_;
+  std::condition_variable wake_, done_;
+  const std::function<void(int)>* job_{nullptr};
+  int chunks_{0};
+  int next_chunk_{0};
+  int busy_{0};
+  std::uint64_t generation_{0};
+  bool stop_{false};
+};
+
+}  // namespace sandbox::sensors

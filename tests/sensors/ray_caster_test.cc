@@ -1,0 +1,142 @@
+// The batched caster against Bullet's own rayTest, analytic heights, filters
+// and thread counts.
+
+#include "sensors/ray_caster.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "assets/generators/sample_terrain.h"
+#include "scene/level.h"
+#include "tests/test_util.h"
+
+namespace sandbox::sensors {
+namespace {
+
+using Eigen::Vector3d;
+using Eigen::Vector3f;
+
+class RayCasterTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    level_ = new scene::Level(scene::LoadLevel(testing::SampleLevel()));
+    world_ = new scene::CollisionWorld(*level_);
+  }
+  static void TearDownTestSuite() {
+    delete world_;
+    delete level_;
+  }
+  static scene::Level* level_;
+  static scene::CollisionWorld* world_;
+};
+scene::Level* RayCasterTest::level_ = nullptr;
+scene::CollisionWorld* RayCasterTest::world_ = nullptr;
+
+// Random rays over the valley, from 0-80 m up, in every direction, 5-300 m long.
+RayBatch RandomRays(int n, unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<float> xy(-180.f, 180.f), z(0.f, 80.f), unit(-1.f, 1.f),
+      length(5.f, 300.f);
+  RayBatch rays;
+  rays.origin_W = Vector3d(3.0, -2.0, 10.0);
+  for (int i = 0; i < n; ++i) {
+    Vector3f d(unit(random), unit(random), unit(random));
+    if (d.norm() < 0.1f) d = Vector3f::UnitZ();
+    rays.start.emplace_back(xy(random), xy(random), z(random));
+    rays.direction.push_back(d.normalized());
+    rays.length_m.push_back(length(random));
+  }
+  return rays;
+}
+
+TEST_F(RayCasterTest, AgreesWithBulletsRayTest) {
+  const RayBatch rays = RandomRays(20000, 7);
+  RayCaster caster(2);
+  RayHits hits;
+  caster.Cast(*world_, rays, {}, &hits);
+  int mismatches = 0, hits_count = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const Vector3d from = rays.origin_W + rays.start[i].cast<double>();
+    const Vector3d to = from + double(rays.length_m[i]) * rays.direction[i].cast<double>();
+    const auto expected = world_->CastRay(from, to);
+    if (expected.has_value() != (hits.body[i] != RayHits::kNoHit)) {
+      ++mismatches;  // grazing an edge or a silhouette can go either way
+      continue;
+    }
+    if (!expected) {
+      EXPECT_EQ(hits.distance_m[i], rays.length_m[i]);
+      continue;
+    }
+    ++hits_count;
+    EXPECT_NEAR(hits.distance_m[i], expected->distance_m, 1e-3)
+        << "ray " << i << " body " << hits.body[i] << " bullet actor " << expected->actor
+        << " robot " << expected->robot << " from " << from.transpose() << " dir "
+        << rays.direction[i].transpose();
+    const int expected_body =
+        expected->actor >= 0 ? expected->actor : int(level_->actors.size()) + expected->robot;
+    EXPECT_EQ(hits.body[i], expected_body) << "ray " << i;
+    EXPECT_GT(hits.normal_W[i].cast<double>().dot(expected->normal_W), 0.999) << "ray " << i;
+  }
+  EXPECT_GT(hits_count, 5000);
+  EXPECT_LE(mismatches, 2);
+}
+
+TEST_F(RayCasterTest, VerticalRaysHitTheAnalyticTerrain) {
+  namespace sample = assets::sample;
+  RayBatch rays;
+  std::vector<double> expected_z;
+  for (int row = 3; row < sample::kTerrainPoints; row += 9) {
+    for (int col = 3; col < sample::kTerrainPoints; col += 9) {
+      const double x = sample::GridX(col), y = sample::GridY(row);
+      rays.start.emplace_back(float(x), float(y), 0.f);
+      rays.direction.push_back(-Vector3f::UnitZ());
+      rays.length_m.push_back(300.f);
+      expected_z.push_back(double(float(sample::TerrainHeight(x, y))));
+    }
+  }
+  rays.origin_W = Vector3d(0, 0, 200);
+  RayCaster caster(1);
+  RayHits hits;
+  RayFilter only_terrain;
+  only_terrain.group_mask = scene::kWorldStatic;
+  caster.Cast(*world_, rays, only_terrain, &hits);
+  const int terrain = level_->FindActor("terrain");
+  int checked = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    if (hits.body[i] != terrain) continue;  // a rock, the wall or the tower
+    EXPECT_NEAR(200.0 - hits.distance_m[i], expected_z[i], 1e-3);
+    ++checked;
+  }
+  EXPECT_GT(checked, int(rays.size()) * 9 / 10);
+}
+
+TEST_F(RayCasterTest, FiltersAndThreadCountsChangeNothingElse) {
+  const RayBatch rays = RandomRays(5000, 11);
+  RayHits one, two, no_robot, static_only;
+  RayCaster single(1), pair(2);
+  single.Cast(*world_, rays, {}, &one);
+  pair.Cast(*world_, rays, {}, &two);
+  EXPECT_EQ(one.body, two.body);
+  EXPECT_EQ(one.distance_m, two.distance_m);
+  // Water has collision off: never hit.
+  const int water = level_->FindActor("water");
+  for (const int body : one.body) EXPECT_NE(body, water);
+  // Ignoring the robot or keeping only static actors never shows them.
+  const int robot_body = int(level_->actors.size());
+  RayFilter ignore;
+  ignore.ignore_robot = 0;
+  pair.Cast(*world_, rays, ignore, &no_robot);
+  RayFilter statics;
+  statics.group_mask = scene::kWorldStatic;
+  pair.Cast(*world_, rays, statics, &static_only);
+  const int gate = level_->FindActor("gate");
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    EXPECT_NE(no_robot.body[i], robot_body);
+    EXPECT_NE(static_only.body[i], robot_body);
+    EXPECT_NE(static_only.body[i], gate);
+  }
+}
+
+}  // namespace
+}  // namespace sandbox::sensors
