@@ -1,0 +1,139 @@
+#include "sensors/face_scanner.h"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace sandbox::sensors {
+namespace {
+
+// In-plane axes (u, v) of each face, in the sensor frame.
+void FaceFrame(int face, Eigen::Vector3d* u, Eigen::Vector3d* v) {
+  if (face < 2) {
+    *u = Eigen::Vector3d::UnitY(), *v = Eigen::Vector3d::UnitZ();
+  } else if (face < 4) {
+    *u = Eigen::Vector3d::UnitX(), *v = Eigen::Vector3d::UnitZ();
+  } else {
+    *u = Eigen::Vector3d::UnitX(), *v = Eigen::Vector3d::UnitY();
+  }
+}
+
+std::string Format(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+}  // namespace
+
+Eigen::Vector3d FaceAxis(int face) {
+  Eigen::Vector3d axis = Eigen::Vector3d::Zero();
+  axis[face / 2] = face % 2 == 0 ? 1.0 : -1.0;
+  return axis;
+}
+
+void FaceScannerConfig::ValidateOrThrow() const {
+  if (!(std::isfinite(resolution_m) && resolution_m > 0.0)) {
+    throw std::invalid_argument("resolution_m must be positive, got " + Format(resolution_m));
+  }
+  if (!(std::isfinite(half_extent_m) && half_extent_m > 0.0)) {
+    throw std::invalid_argument("half_extent_m must be positive, got " + Format(half_extent_m));
+  }
+  const double steps = 2.0 * half_extent_m / resolution_m;
+  if (steps > 1e5 || 6.0 * (steps + 1.0) * (steps + 1.0) > 1e7) {
+    throw std::invalid_argument("half_extent_m " + Format(half_extent_m) + " at resolution_m " +
+                                Format(resolution_m) + " makes more than 10 million rays");
+  }
+  if (std::abs(steps - std::round(steps)) > 1e-6) {
+    throw std::invalid_argument("half_extent_m (" + Format(half_extent_m) +
+                                ") must be a whole number of resolution_m / 2 (" +
+                                Format(resolution_m) + ")");
+  }
+}
+
+int FaceScannerConfig::points_per_side() const {
+  return static_cast<int>(std::lround(2.0 * half_extent_m / resolution_m)) + 1;
+}
+
+FaceScanner::FaceScanner(const FaceScannerConfig& config) : config_(config) {
+  config_.ValidateOrThrow();
+  n_ = config_.points_per_side();
+}
+
+FaceScan FaceScanner::EmptyScan() const {
+  FaceScan scan;
+  scan.n = n_;
+  const Eigen::Vector3d nan = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  for (ScanFace& face : scan.faces) {
+    face.occupancy.assign(std::size_t(n_) * std::size_t(n_), kUnvisited);
+    face.points_W.assign(std::size_t(n_) * std::size_t(n_), nan);
+  }
+  return scan;
+}
+
+std::vector<FaceScanner::Part> FaceScanner::DueAt(std::int64_t tick) const {
+  const auto t = static_cast<std::uint64_t>(tick < 0 ? 0 : tick);
+  switch (config_.refresh) {
+    case Refresh::kFull:
+      return {{0, 0, n_}, {1, 0, n_}, {2, 0, n_}, {3, 0, n_}, {4, 0, n_}, {5, 0, n_}};
+    case Refresh::kSixStage:
+      return {{int(t % 6), 0, n_}};
+    case Refresh::kTwelveStage: {
+      const int face = int((t / 2) % 6), half = n_ / 2;
+      return t % 2 == 0 ? std::vector<Part>{{face, 0, half}} : std::vector<Part>{{face, half, n_}};
+    }
+  }
+  return {};
+}
+
+void FaceScanner::AppendRays(const Part& part, const Eigen::Isometry3d& X_WS,
+                             RayBatch* rays) const {
+  const Eigen::Matrix3d R_WS = config_.alignment == Alignment::kBody
+                                   ? Eigen::Matrix3d(X_WS.linear())
+                                   : Eigen::Matrix3d::Identity();
+  Eigen::Vector3d u, v;
+  FaceFrame(part.face, &u, &v);
+  const Eigen::Vector3f axis_W = (R_WS * FaceAxis(part.face)).cast<float>();
+  const Eigen::Vector3d u_W = R_WS * u, v_W = R_WS * v;
+  const double E = config_.half_extent_m, res = config_.resolution_m;
+  const Eigen::Vector3d offset = X_WS.translation() - rays->origin_W;
+  for (int r = part.row_begin; r < part.row_end; ++r) {
+    for (int c = 0; c < n_; ++c) {
+      const Eigen::Vector3d start = offset + u_W * (-E + c * res) + v_W * (-E + r * res);
+      rays->start.push_back(start.cast<float>());
+      rays->direction.push_back(axis_W);
+      rays->length_m.push_back(static_cast<float>(E));
+    }
+  }
+}
+
+void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
+                       const RayFilter& filter, const Eigen::Isometry3d& X_WS, std::int64_t tick,
+                       FaceScan* scan) const {
+  if (!X_WS.matrix().allFinite()) throw std::invalid_argument("FaceScanner::Scan(): non-finite pose");
+  if (scan->n != n_) *scan = EmptyScan();
+  const std::vector<Part> parts = DueAt(tick);
+  RayBatch rays;
+  rays.origin_W = X_WS.translation();
+  for (const Part& part : parts) AppendRays(part, X_WS, &rays);
+  RayHits hits;
+  caster.Cast(world, rays, filter, &hits);
+  // Write each part's results back into its face.
+  std::size_t i = 0;
+  for (const Part& part : parts) {
+    ScanFace& face = scan->faces[std::size_t(part.face)];
+    face.tick = tick;
+    face.X_WS = X_WS;
+    for (int r = part.row_begin; r < part.row_end; ++r) {
+      for (int c = 0; c < n_; ++c, ++i) {
+        const std::size_t k = std::size_t(r) * std::size_t(n_) + std::size_t(c);
+        face.occupancy[k] = hits.body[i] == RayHits::kNoHit ? kFree : kOccupied;
+        face.points_W[k] = rays.origin_W + (rays.start[i] + hits.distance_m[i] * rays.direction[i])
+                                               .cast<double>();
+      }
+    }
+  }
+}
+
+}  // namespace sandbox::sensors

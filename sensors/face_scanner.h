@@ -1,0 +1,98 @@
+#pragma once
+// The face scanner (../shared/DESIGN.md): a box of six 2.5D occupancy maps
+// around the robot. Face f (0..5: +X, -X, +Y, -Y, +Z, -Z) is an n x n grid of
+// rays, n = 2 * half_extent / resolution + 1, starting on the plane through
+// the sensor origin perpendicular to the face axis and running along the axis
+// for half_extent. Points are in world coordinates.
+//
+// Grid order: row r, column c of face f starts at
+//   u_f * (-E + c * res) + v_f * (-E + r * res)   (E = half extent)
+// in the sensor frame, with (u, v) = (+Y, +Z) for the X faces, (+X, +Z) for
+// the Y faces and (+X, +Y) for the Z faces; index = r * n + c.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "sensors/ray_caster.h"
+
+namespace sandbox::sensors {
+
+enum class Refresh {
+  kFull,         // all six faces every scan
+  kSixStage,     // face (tick mod 6) each scan
+  kTwelveStage,  // half a face each scan: face (tick / 2) mod 6, lower rows then upper rows
+};
+
+enum class Alignment {
+  kBody,   // the box turns with the sensor
+  kWorld,  // the box keeps the world axes (only the sensor position counts)
+};
+
+struct FaceScannerConfig {
+  double resolution_m{1.0};
+  double half_extent_m{25.0};
+  Refresh refresh{Refresh::kSixStage};
+  Alignment alignment{Alignment::kBody};
+
+  // Throws std::invalid_argument naming the field and its value: a resolution
+  // or half extent that is not positive and finite, a half extent that is not
+  // a whole number of resolutions, or more than 10 million rays a scan.
+  void ValidateOrThrow() const;
+  int points_per_side() const;  // n
+};
+
+// Occupancy of a scanned point.
+enum Occupancy : std::int8_t { kUnvisited = -1, kFree = 0, kOccupied = 1 };
+
+struct ScanFace {
+  std::int64_t tick{-1};  // the tick its latest rows were scanned at; -1: never
+  Eigen::Isometry3d X_WS{Eigen::Isometry3d::Identity()};  // sensor pose of that scan
+  std::vector<std::int8_t> occupancy;   // n * n, Occupancy
+  std::vector<Eigen::Vector3d> points_W;  // n * n: the hit, or the ray's end when free
+};
+
+struct FaceScan {
+  int n{0};
+  std::array<ScanFace, 6> faces;
+};
+
+class FaceScanner {
+ public:
+  // Throws std::invalid_argument for a bad config (see ValidateOrThrow).
+  explicit FaceScanner(const FaceScannerConfig& config);
+
+  const FaceScannerConfig& config() const { return config_; }
+
+  // A scan sized for this scanner with every point unvisited.
+  FaceScan EmptyScan() const;
+
+  // Scans what is due at `tick` (see Refresh) from sensor pose X_WS and
+  // writes it into `scan`; the rest of `scan` keeps its earlier values.
+  void Scan(const scene::CollisionWorld& world, RayCaster& caster, const RayFilter& filter,
+            const Eigen::Isometry3d& X_WS, std::int64_t tick, FaceScan* scan) const;
+
+  // The faces and row ranges due at `tick`.
+  struct Part {
+    int face;
+    int row_begin;
+    int row_end;
+  };
+  std::vector<Part> DueAt(std::int64_t tick) const;
+
+  // Appends the rays of `part` from pose X_WS to `rays` (origin_W must be the
+  // sensor position).
+  void AppendRays(const Part& part, const Eigen::Isometry3d& X_WS, RayBatch* rays) const;
+
+ private:
+  FaceScannerConfig config_;
+  int n_;
+};
+
+// Face axes in the sensor frame, in face order.
+Eigen::Vector3d FaceAxis(int face);
+
+}  // namespace sandbox::sensors
