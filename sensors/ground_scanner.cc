@@ -1,0 +1,55 @@
+#include "sensors/ground_scanner.h"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "sensors/face_scanner.h"
+
+namespace sandbox::sensors {
+
+void GroundScannerConfig::ValidateOrThrow() const {
+  FaceScannerConfig grid;
+  grid.resolution_m = resolution_m;
+  grid.half_extent_m = half_extent_m;
+  grid.ValidateOrThrow();
+  if (!(std::isfinite(depth_m) && depth_m > 0.0)) {
+    throw std::invalid_argument("depth_m must be positive, got " + std::to_string(depth_m));
+  }
+}
+
+GroundScanner::GroundScanner(const GroundScannerConfig& config) : config_(config) {
+  config_.ValidateOrThrow();
+  n_ = static_cast<int>(std::lround(2.0 * config_.half_extent_m / config_.resolution_m)) + 1;
+}
+
+void GroundScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
+                         const RayFilter& filter, const Eigen::Vector3d& p_WS,
+                         HeightMap* map) const {
+  if (!p_WS.allFinite()) throw std::invalid_argument("GroundScanner::Scan(): non-finite position");
+  RayBatch rays;
+  rays.origin_W = p_WS;
+  rays.Resize(std::size_t(n_) * std::size_t(n_));
+  const double E = config_.half_extent_m, res = config_.resolution_m;
+  for (int r = 0; r < n_; ++r) {
+    for (int c = 0; c < n_; ++c) {
+      const std::size_t i = std::size_t(r) * std::size_t(n_) + std::size_t(c);
+      rays.start[i] = Eigen::Vector3f(float(-E + c * res), float(-E + r * res), 0.f);
+      rays.direction[i] = -Eigen::Vector3f::UnitZ();
+      rays.length_m[i] = static_cast<float>(config_.depth_m);
+    }
+  }
+  RayHits hits;
+  caster.Cast(world, rays, filter, &hits);
+  map->n = n_;
+  map->resolution_m = res;
+  map->corner_W = p_WS.head<2>() - Eigen::Vector2d::Constant(E);
+  map->height_m.resize(rays.size());
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    map->height_m[i] = hits.body[i] == RayHits::kNoHit
+                           ? std::numeric_limits<double>::quiet_NaN()
+                           : p_WS.z() - double(hits.distance_m[i]);
+  }
+}
+
+}  // namespace sandbox::sensors

@@ -1,0 +1,41 @@
+#pragma once
+// The ground scanner: the face scanner's -Z face along gravity only, as a
+// 2.5D height map. Point (row r, column c) lies at
+//   x = x_S - E + c * res,  y = y_S - E + r * res   (E = half extent)
+// and holds the height of the first surface within `depth_m` below the
+// sensor, or NaN where there is none.
+
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "sensors/ray_caster.h"
+
+namespace sandbox::sensors {
+
+struct GroundScannerConfig {
+  double resolution_m{1.0};
+  double half_extent_m{25.0};
+  double depth_m{100.0};  // how far below the sensor to look
+  void ValidateOrThrow() const;  // throws std::invalid_argument naming the field
+};
+
+struct HeightMap {
+  int n{0};
+  double resolution_m{1.0};
+  Eigen::Vector2d corner_W{Eigen::Vector2d::Zero()};  // x, y of row 0, column 0
+  std::vector<double> height_m;                         // n * n, NaN without ground
+};
+
+class GroundScanner {
+ public:
+  explicit GroundScanner(const GroundScannerConfig& config);
+  void Scan(const scene::CollisionWorld& world, RayCaster& caster, const RayFilter& filter,
+            const Eigen::Vector3d& p_WS, HeightMap* map) const;
+
+ private:
+  GroundScannerConfig config_;
+  int n_;
+};
+
+}  // namespace sandbox::sensors

@@ -1,0 +1,61 @@
+#pragma once
+// A spinning lidar: `channels` beams at fixed elevations, swept through
+// `azimuth_steps` azimuths per revolution. Each azimuth step is stamped with
+// its time within the sweep and cast from the sensor pose interpolated at that
+// time, so the scan shows no motion distortion.
+//
+// Beam (channel c, step k) points along (cos e cos a, cos e sin a, sin e) in
+// the sensor frame, e = elevation of channel c, a = 2 pi k / azimuth_steps
+// (counter-clockwise from +X); index = c * azimuth_steps + k.
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "sensors/ray_caster.h"
+
+namespace sandbox::sensors {
+
+struct LidarConfig {
+  std::vector<double> elevations_rad;  // one per channel
+  int azimuth_steps{1024};
+  double range_m{100.0};
+  double rotation_hz{10.0};  // one sweep lasts 1 / rotation_hz
+
+  // `channels` elevations evenly from min to max (degrees).
+  static LidarConfig Uniform(int channels, double min_deg, double max_deg, int azimuth_steps,
+                             double range_m = 100.0, double rotation_hz = 10.0);
+  // Throws std::invalid_argument naming the field: no channels, a non-positive
+  // step count, range or rate, a non-finite elevation, or over 10 million rays.
+  void ValidateOrThrow() const;
+  int channels() const { return static_cast<int>(elevations_rad.size()); }
+};
+
+struct LidarScan {
+  int channels{0};
+  int azimuth_steps{0};
+  std::vector<float> range_m;             // the hit distance, or range_m when nothing
+  std::vector<std::uint8_t> hit;          // 1 when the beam hit something
+  std::vector<Eigen::Vector3d> points_W;  // the hit, or the beam's end
+  std::vector<double> time_s;             // per azimuth step, from the sweep's start
+};
+
+class Lidar {
+ public:
+  explicit Lidar(const LidarConfig& config);  // throws std::invalid_argument
+  const LidarConfig& config() const { return config_; }
+
+  // One sweep from pose X_WS_start (at its start) to X_WS_end (at its end).
+  void Sweep(const scene::CollisionWorld& world, RayCaster& caster, const RayFilter& filter,
+             const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3d& X_WS_end,
+             LidarScan* scan) const;
+
+  // The rays of that sweep (origin_W is the start pose's position).
+  RayBatch Rays(const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3d& X_WS_end) const;
+
+ private:
+  LidarConfig config_;
+};
+
+}  // namespace sandbox::sensors

@@ -1,0 +1,38 @@
+#include "sensors/range_sensor.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace sandbox::sensors {
+
+void RangeSensorConfig::ValidateOrThrow() const {
+  if (!direction_S.allFinite() || std::abs(direction_S.norm() - 1.0) > 1e-6) {
+    throw std::invalid_argument("direction must be a unit vector");
+  }
+  if (!(std::isfinite(range_m) && range_m > 0.0)) {
+    throw std::invalid_argument("range_m must be positive, got " + std::to_string(range_m));
+  }
+}
+
+RangeReading MeasureRange(const RangeSensorConfig& config, const scene::CollisionWorld& world,
+                          RayCaster& caster, const RayFilter& filter,
+                          const Eigen::Isometry3d& X_WS) {
+  config.ValidateOrThrow();
+  if (!X_WS.matrix().allFinite()) throw std::invalid_argument("MeasureRange(): non-finite pose");
+  RayBatch ray;
+  ray.origin_W = X_WS.translation();
+  ray.start = {Eigen::Vector3f::Zero()};
+  ray.direction = {(X_WS.linear() * config.direction_S).cast<float>()};
+  ray.length_m = {static_cast<float>(config.range_m)};
+  RayHits hits;
+  caster.Cast(world, ray, filter, &hits);
+  RangeReading reading;
+  reading.hit = hits.body[0] != RayHits::kNoHit;
+  reading.range_m = hits.distance_m[0];
+  reading.point_W = ray.origin_W + double(hits.distance_m[0]) * ray.direction[0].cast<double>();
+  reading.normal_W = hits.normal_W[0].cast<double>();
+  reading.body = hits.body[0];
+  return reading;
+}
+
+}  // namespace sandbox::sensors

@@ -1,0 +1,29 @@
+#pragma once
+// A single ray (rangefinder, altimeter) along a fixed axis of the sensor frame.
+
+#include <Eigen/Geometry>
+
+#include "sensors/ray_caster.h"
+
+namespace sandbox::sensors {
+
+struct RangeSensorConfig {
+  Eigen::Vector3d direction_S{0.0, 0.0, -1.0};  // unit, in the sensor frame (default: down)
+  double range_m{100.0};
+  void ValidateOrThrow() const;  // throws std::invalid_argument naming the field
+};
+
+struct RangeReading {
+  bool hit{false};
+  double range_m{0.0};  // to the hit, or range_m when nothing
+  Eigen::Vector3d point_W{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d normal_W{Eigen::Vector3d::Zero()};
+  int body{RayHits::kNoHit};
+};
+
+// One ray from sensor pose X_WS.
+RangeReading MeasureRange(const RangeSensorConfig& config, const scene::CollisionWorld& world,
+                          RayCaster& caster, const RayFilter& filter,
+                          const Eigen::Isometry3d& X_WS);
+
+}  // namespace sandbox::sensors
