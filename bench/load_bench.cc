@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "assets/generators/gltf_writer.h"
+#include "bench/million_level.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
 #include "scene/manifest.h"
@@ -92,29 +92,6 @@ Figures AssimpReadOnly(const fs::path& level_file) {
   return {std::chrono::duration<double>(Clock::now() - start).count(), PeakMiB(), triangles};
 }
 
-// A 1000 x 500 cell terrain (1,000,000 triangles), 1 m apart, as glTF + manifest.
-fs::path WriteMillionTriangleLevel(const fs::path& dir) {
-  sandbox::assets::GeneratedMesh mesh{"terrain", {0.4f, 0.5f, 0.3f, 1.0f}};
-  const int cols = 1000, rows = 500;
-  for (int r = 0; r <= rows; ++r) {
-    for (int c = 0; c <= cols; ++c) {
-      mesh.AddVertex(float(c), float(r), float(5.0 * std::sin(c / 40.0) * std::cos(r / 25.0)));
-    }
-  }
-  for (int r = 0; r < rows; ++r) {
-    for (int c = 0; c < cols; ++c) {
-      const auto a = std::uint32_t(r * (cols + 1) + c), b = a + 1;
-      const auto d = a + std::uint32_t(cols + 1), e = d + 1;
-      mesh.AddTriangle(a, b, e);
-      mesh.AddTriangle(a, e, d);
-    }
-  }
-  fs::create_directories(dir);
-  sandbox::assets::WriteGltf(dir / "million.gltf", {mesh});
-  std::ofstream(dir / "million.toml") << "[[actor]]\nname = \"terrain\"\nfile = \"million.gltf\"\n";
-  return dir / "million.toml";
-}
-
 double Median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
   return values[values.size() / 2];
@@ -140,7 +117,7 @@ int main(int argc, char** argv) {
   std::fflush(stdout);
   // In a child, so that this process stays small for the children it forks.
   InChild([&] {
-    WriteMillionTriangleLevel(dir);
+    sandbox::bench::WriteMillionTriangleLevel(dir);
     return Figures{};
   });
   const fs::path million = dir / "million.toml";

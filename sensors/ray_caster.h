@@ -4,6 +4,7 @@
 // and the level's own triangle arrays read-only, with its own stack; nothing
 // of Bullet's mutable query state (btCollisionWorld::rayTest) is used.
 
+#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
@@ -69,15 +70,17 @@ class RayCaster {
   void RunParallel(int chunks, const std::function<void(int)>& job);
   void WorkerLoop();
 
+  // Work hand-out: a job generation counter the workers watch (spinning a
+  // little, then sleeping), and an atomic chunk counter they all draw from.
   std::vector<std::thread> workers_;
   std::mutex mutex_;
-  std::condition_variable wake_, done_;
+  std::condition_variable wake_;
   const std::function<void(int)>* job_{nullptr};
   int chunks_{0};
-  int next_chunk_{0};
-  int busy_{0};
-  std::uint64_t generation_{0};
-  bool stop_{false};
+  std::atomic<int> next_chunk_{0};
+  std::atomic<int> unfinished_{0};
+  std::atomic<std::uint64_t> generation_{0};
+  std::atomic<bool> stop_{false};
 };
 
 }  // namespace sandbox::sensors
