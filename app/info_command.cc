@@ -6,11 +6,13 @@
 #include <cstdlib>
 #include <iomanip>
 #include <sstream>
+#include <variant>
 
 #include "app/defaults.h"
 #include "app/process_stats.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
+#include "sensors/robot_sensors.h"
 
 namespace sandbox::app {
 namespace {
@@ -54,7 +56,27 @@ Eigen::Vector3d Hi(const Eigen::AlignedBox3d& b) {
   return b.isEmpty() ? Eigen::Vector3d::Zero() : b.max();
 }
 
-void PrintJson(const Level& level, const LoadFigures& figures, std::ostream& out) {
+// "face 51x51x6 six_stage" and the like.
+std::string Describe(const sensors::MountedSensor& sensor) {
+  std::ostringstream out;
+  out << sensor.spec.type;
+  if (const auto* face = std::get_if<sensors::FaceScannerConfig>(&sensor.config)) {
+    const int n = face->points_per_side();
+    out << " " << n << "x" << n << "x6 at " << face->resolution_m << " m";
+  } else if (const auto* ground = std::get_if<sensors::GroundScannerConfig>(&sensor.config)) {
+    out << " +-" << ground->half_extent_m << " m at " << ground->resolution_m << " m";
+  } else if (const auto* lidar = std::get_if<sensors::LidarConfig>(&sensor.config)) {
+    out << " " << lidar->channels() << "x" << lidar->azimuth_steps << ", " << lidar->range_m << " m";
+  } else if (const auto* ray = std::get_if<sensors::RangeSensorConfig>(&sensor.config)) {
+    out << " " << ray->range_m << " m";
+  }
+  out << " on " << (sensor.spec.mount.empty() ? "body" : sensor.spec.mount);
+  if (sensor.spec.rate_hz > 0.0) out << " at " << sensor.spec.rate_hz << " Hz";
+  return out.str();
+}
+
+void PrintJson(const Level& level, const std::vector<sensors::MountedSensor>& sensors,
+               const LoadFigures& figures, std::ostream& out) {
   std::size_t vertices = 0, collision_actors = 0, movable_actors = 0;
   out << "{\n  \"level\": {\"name\": " << JsonString(level.name)
       << ", \"file\": " << JsonString(level.file.string()) << "},\n  \"actors\": [";
@@ -78,7 +100,17 @@ void PrintJson(const Level& level, const LoadFigures& figures, std::ostream& out
         << ", \"bones\": " << r.bones.size() << ", \"bone_values\": " << r.num_values
         << ", \"vertices\": " << r.num_vertices() << ", \"triangles\": " << r.num_triangles()
         << ", \"collision\": " << (r.collision ? "true" : "false")
-        << ", \"spawn_position\": " << JsonVector(r.X_WB_spawn.translation()) << "}";
+        << ", \"spawn_position\": " << JsonVector(r.X_WB_spawn.translation()) << ", \"sensors\": [";
+    bool first = true;
+    for (const sensors::MountedSensor& sensor : sensors) {
+      if (sensor.robot != static_cast<int>(i)) continue;
+      out << (first ? "" : ", ") << "{\"name\": " << JsonString(sensor.spec.name)
+          << ", \"type\": " << JsonString(sensor.spec.type)
+          << ", \"mount\": " << JsonString(sensor.spec.mount.empty() ? "body" : sensor.spec.mount)
+          << ", \"rate_hz\": " << sensor.spec.rate_hz << "}";
+      first = false;
+    }
+    out << "]}";
   }
   out << "\n  ],\n  \"totals\": {\"actors\": " << level.actors.size()
       << ", \"collision_actors\": " << collision_actors
@@ -98,7 +130,8 @@ void PrintJson(const Level& level, const LoadFigures& figures, std::ostream& out
   out << "]\n}\n";
 }
 
-void PrintText(const Level& level, const LoadFigures& figures, std::ostream& out) {
+void PrintText(const Level& level, const std::vector<sensors::MountedSensor>& sensors,
+               const LoadFigures& figures, std::ostream& out) {
   std::size_t name_width = 5;
   for (const scene::Actor& a : level.actors) name_width = std::max(name_width, a.name.size());
   name_width = std::min<std::size_t>(name_width, 48);
@@ -122,6 +155,10 @@ void PrintText(const Level& level, const LoadFigures& figures, std::ostream& out
         << r.num_vertices() << " vertices, " << r.num_triangles() << " triangles, collision "
         << (r.collision ? "on" : "off") << ", spawn (" << p.x() << ", " << p.y() << ", " << p.z()
         << ")\n";
+    for (const sensors::MountedSensor& sensor : sensors) {
+      if (level.robots[static_cast<std::size_t>(sensor.robot)].name != r.name) continue;
+      out << "  sensor " << sensor.spec.name << ": " << Describe(sensor) << "\n";
+    }
   }
   const Eigen::AlignedBox3d bounds = level.bounds_W();
   const Eigen::Vector3d size = Hi(bounds) - Lo(bounds);
@@ -191,6 +228,7 @@ int RunInfo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     LoadFigures figures;
     const auto start = Clock::now();
     const Level level = scene::LoadLevel(file, conversion);
+    const std::vector<sensors::MountedSensor> sensors = sensors::MakeRobotSensors(level);
     const auto loaded = Clock::now();
     const scene::CollisionWorld world(level);
     const auto built = Clock::now();
@@ -199,9 +237,9 @@ int RunInfo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     figures.peak_memory_mib = PeakResidentMiB();
     figures.collision_objects = world.num_collision_objects();
     if (json) {
-      PrintJson(level, figures, out);
+      PrintJson(level, sensors, figures, out);
     } else {
-      PrintText(level, figures, out);
+      PrintText(level, sensors, figures, out);
     }
     return 0;
   } catch (const scene::LevelError& error) {

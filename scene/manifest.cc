@@ -200,6 +200,56 @@ std::vector<Eigen::Vector3d> ParseAxes(TableReader& read, const toml::node* node
   return axes;
 }
 
+// A [[robot.sensor]] table: name, type, mount, placement and rate here; every
+// other key is the sensor's own setting, checked by sensors/.
+SensorSpec ParseSensor(const fs::path& file, const toml::table& table, int index) {
+  SensorSpec sensor;
+  sensor.file = file;
+  sensor.line = static_cast<int>(table.source().begin.line);
+  sensor.name = ParseName(file, table, "sensor", index);
+  TableReader read(file, table, "sensor '" + sensor.name + "': ");
+  read.Find("name");
+  const std::optional<std::string> type = read.String("type");
+  if (!type) read.Fail(nullptr, "'type' is required: face, ground, lidar or ray");
+  if (*type != "face" && *type != "ground" && *type != "lidar" && *type != "ray") {
+    read.Fail(read.Find("type"), "'type' must be face, ground, lidar or ray, got '" + *type + "'");
+  }
+  sensor.type = *type;
+  sensor.mount = read.String("mount").value_or("");
+  const Placement placement = ParsePlacement(read);
+  if (!placement.scale.isOnes() || placement.conversion.up || placement.conversion.unit_scale_m) {
+    read.Fail(nullptr, "a sensor takes position and rpy_deg or quaternion_wxyz only");
+  }
+  sensor.X_MS = placement.pose();
+  if (const auto rate = read.Number("rate_hz")) {
+    if (*rate <= 0.0) read.Fail(read.Find("rate_hz"), "'rate_hz' must be positive");
+    sensor.rate_hz = *rate;
+  }
+  // The rest, as given.
+  static const std::set<std::string> kRead = {"name",    "type",    "mount",           "position",
+                                              "rpy_deg", "rate_hz", "quaternion_wxyz", "scale",
+                                              "up",      "unit_scale"};
+  for (const auto& [key_view, value] : table) {
+    const std::string key(key_view.str());
+    if (kRead.count(key) > 0) continue;
+    sensor.param_lines[key] = static_cast<int>(value.source().begin.line);
+    if (value.is_boolean()) {
+      sensor.params[key] = *value.value<bool>();
+    } else if (value.is_number()) {
+      sensor.params[key] = read.Number(&value, key);
+    } else if (value.is_string()) {
+      sensor.params[key] = *value.value<std::string>();
+    } else if (const toml::array* array = value.as_array()) {
+      std::vector<double> numbers;
+      for (const toml::node& item : *array) numbers.push_back(read.Number(&item, key));
+      sensor.params[key] = numbers;
+    } else {
+      read.Fail(&value, "'" + key + "' must be a number, a string, true/false or numbers");
+    }
+  }
+  return sensor;
+}
+
 RobotSpec ParseRobot(const fs::path& file, const toml::table& table, int index) {
   RobotSpec robot;
   robot.line = static_cast<int>(table.source().begin.line);
@@ -250,6 +300,21 @@ RobotSpec ParseRobot(const fs::path& file, const toml::table& table, int index) 
         read.Fail(&value, "'bone_axes' names '" + bone + "', which is not in 'bones'");
       }
       robot.bone_axes[bone] = ParseAxes(read, &value, "bone_axes." + bone);
+    }
+  }
+  if (const toml::node* sensors = read.Find("sensor")) {
+    const toml::array* array = sensors->as_array();
+    if (array == nullptr || !array->is_array_of_tables()) {
+      read.Fail(sensors, "'sensor' must be an array of tables: [[robot.sensor]]");
+    }
+    std::set<std::string> names;
+    int sensor_index = 0;
+    for (const toml::node& item : *array) {
+      SensorSpec sensor = ParseSensor(file, *item.as_table(), ++sensor_index);
+      if (!names.insert(sensor.name).second) {
+        TableReader(file, *item.as_table(), "").Fail(nullptr, "duplicate sensor name '" + sensor.name + "'");
+      }
+      robot.sensors.push_back(std::move(sensor));
     }
   }
   read.RejectUnknownKeys();

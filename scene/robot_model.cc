@@ -225,6 +225,10 @@ Eigen::Isometry3d RigidPart(const Eigen::Affine3d& X) {
   return out;
 }
 
+std::string SensorSpec::Where() const {
+  return file.string() + ":" + std::to_string(line) + ": sensor '" + name + "': ";
+}
+
 int RobotModel::FindNode(const std::string& node_name) const {
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     if (nodes[i].name == node_name) return static_cast<int>(i);
@@ -296,8 +300,21 @@ RobotModel LoadRobotModel(const RobotSpec& spec, const fs::path& manifest, Level
     level->warnings.push_back(spec.file.string() + ": skipped " + std::to_string(non_triangles) +
                               " point and line primitives");
   }
-  if (model.meshes.empty())
+  if (model.meshes.empty()) {
     throw LevelError(where + spec.file.string() + ": has no triangle meshes");
+  }
+
+  // Sensor mounts: a node of the robot, or its body frame.
+  for (SensorSpec sensor : spec.sensors) {
+    if (!sensor.mount.empty() && sensor.mount != "body") {
+      sensor.mount_node = model.FindNode(sensor.mount);
+      if (sensor.mount_node < 0) {
+        throw LevelError(sensor.Where() + "mount '" + sensor.mount + "' is not a node of " +
+                         spec.file.filename().string() + " (nodes: " + NodeList(model) + ")");
+      }
+    }
+    model.sensors.push_back(std::move(sensor));
+  }
   return model;
 }
 

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "scene/mesh.h"
@@ -25,6 +26,27 @@ enum class BoneRotation {
   kAngles,      // one angle (radians) per axis, applied in order about the bone's rest axes
 };
 
+// A value of a sensor's own settings, as the manifest gave it.
+using SensorParam = std::variant<double, bool, std::string, std::vector<double>>;
+
+// A [[robot.sensor]] table: a sensor mounted on the robot. The scene keeps its
+// settings as given; sensors/ reads and checks them (it knows each type's keys).
+struct SensorSpec {
+  std::string name;
+  std::string type;   // "face", "ground", "lidar", "ray"
+  std::string mount;  // a node of the robot (a bone), empty: the robot body frame
+  int mount_node{-1}; // resolved by LoadRobotModel; -1: the body frame
+  Eigen::Isometry3d X_MS{Eigen::Isometry3d::Identity()};  // sensor in its mount's frame
+  double rate_hz{0.0};  // 0: every tick
+  std::map<std::string, SensorParam> params;
+  std::map<std::string, int> param_lines;  // where each setting stands, for messages
+  std::filesystem::path file;  // the manifest
+  int line{0};
+
+  // "level.toml:12: sensor 'scanner': " for messages.
+  std::string Where() const;
+};
+
 // A [[robot]] table of the level manifest.
 struct RobotSpec {
   std::string name;
@@ -35,6 +57,7 @@ struct RobotSpec {
   BoneRotation rotation{BoneRotation::kQuaternion};
   std::vector<Eigen::Vector3d> angle_axes;                        // kAngles: the default axes
   std::map<std::string, std::vector<Eigen::Vector3d>> bone_axes;  // per-bone overrides
+  std::vector<SensorSpec> sensors;
   int line{0};
 };
 
@@ -100,6 +123,7 @@ struct RobotModel {
   Eigen::Affine3d X_BF{Eigen::Affine3d::Identity()};
   Eigen::Isometry3d X_WB_spawn{Eigen::Isometry3d::Identity()};
   bool collision{true};
+  std::vector<SensorSpec> sensors;  // mounts resolved
 
   int FindNode(const std::string& node_name) const;  // -1 when absent
   int FindBone(const std::string& bone_name) const;  // -1 when absent

@@ -1,0 +1,159 @@
+#include "sensors/robot_sensors.h"
+
+#include <cmath>
+#include <set>
+#include <stdexcept>
+
+namespace sandbox::sensors {
+namespace {
+
+using scene::LevelError;
+using scene::SensorSpec;
+
+// Typed access to a sensor's settings; remembers which keys were read.
+class Settings {
+ public:
+  explicit Settings(const SensorSpec& spec) : spec_(spec) {}
+
+  [[noreturn]] void Fail(const std::string& key, const std::string& what) const {
+    const auto line = spec_.param_lines.find(key);
+    const std::string where = line == spec_.param_lines.end()
+                                  ? spec_.Where()
+                                  : spec_.file.string() + ":" + std::to_string(line->second) +
+                                        ": sensor '" + spec_.name + "': ";
+    throw LevelError(where + what);
+  }
+
+  double Number(const std::string& key, double fallback) {
+    read_.insert(key);
+    const auto it = spec_.params.find(key);
+    if (it == spec_.params.end()) return fallback;
+    if (!std::holds_alternative<double>(it->second)) Fail(key, "'" + key + "' must be a number");
+    return std::get<double>(it->second);
+  }
+  int Whole(const std::string& key, int fallback) {
+    const double value = Number(key, fallback);
+    if (value != std::floor(value) || std::abs(value) > 1e9) {
+      Fail(key, "'" + key + "' must be a whole number");
+    }
+    return static_cast<int>(value);
+  }
+  std::string Text(const std::string& key, const std::string& fallback) {
+    read_.insert(key);
+    const auto it = spec_.params.find(key);
+    if (it == spec_.params.end()) return fallback;
+    if (!std::holds_alternative<std::string>(it->second)) Fail(key, "'" + key + "' must be a string");
+    return std::get<std::string>(it->second);
+  }
+  std::vector<double> Numbers(const std::string& key) {
+    read_.insert(key);
+    const auto it = spec_.params.find(key);
+    if (it == spec_.params.end()) return {};
+    if (!std::holds_alternative<std::vector<double>>(it->second)) {
+      Fail(key, "'" + key + "' must be an array of numbers");
+    }
+    return std::get<std::vector<double>>(it->second);
+  }
+  bool Has(const std::string& key) const { return spec_.params.count(key) > 0; }
+
+  void RejectUnknownKeys() const {
+    for (const auto& [key, value] : spec_.params) {
+      if (read_.count(key) == 0) Fail(key, "unknown key '" + key + "' for a " + spec_.type + " sensor");
+    }
+  }
+
+ private:
+  const SensorSpec& spec_;
+  std::set<std::string> read_;
+};
+
+SensorConfig ReadConfig(const SensorSpec& spec) {
+  Settings read(spec);
+  SensorConfig config;
+  if (spec.type == "face") {
+    FaceScannerConfig face;
+    face.resolution_m = read.Number("resolution_m", face.resolution_m);
+    face.half_extent_m = read.Number("half_extent_m", face.half_extent_m);
+    const std::string refresh = read.Text("refresh", "six_stage");
+    if (refresh == "full") {
+      face.refresh = Refresh::kFull;
+    } else if (refresh == "six_stage") {
+      face.refresh = Refresh::kSixStage;
+    } else if (refresh == "twelve_stage") {
+      face.refresh = Refresh::kTwelveStage;
+    } else {
+      read.Fail("refresh", "'refresh' must be full, six_stage or twelve_stage, got '" + refresh + "'");
+    }
+    const std::string aligned = read.Text("aligned", "body");
+    if (aligned != "body" && aligned != "world") {
+      read.Fail("aligned", "'aligned' must be body or world, got '" + aligned + "'");
+    }
+    face.alignment = aligned == "body" ? Alignment::kBody : Alignment::kWorld;
+    config = face;
+  } else if (spec.type == "ground") {
+    GroundScannerConfig ground;
+    ground.resolution_m = read.Number("resolution_m", ground.resolution_m);
+    ground.half_extent_m = read.Number("half_extent_m", ground.half_extent_m);
+    ground.depth_m = read.Number("depth_m", ground.depth_m);
+    config = ground;
+  } else if (spec.type == "lidar") {
+    LidarConfig lidar;
+    if (read.Has("elevations_deg")) {
+      for (const double deg : read.Numbers("elevations_deg")) {
+        lidar.elevations_rad.push_back(deg * M_PI / 180.0);
+      }
+    } else {
+      const int channels = read.Whole("channels", 16);
+      if (channels < 1) read.Fail("channels", "'channels' must be at least 1");
+      lidar = LidarConfig::Uniform(channels, read.Number("min_elevation_deg", -15.0),
+                                   read.Number("max_elevation_deg", 15.0), 1024);
+    }
+    lidar.azimuth_steps = read.Whole("azimuth_steps", 1024);
+    lidar.range_m = read.Number("range_m", 100.0);
+    lidar.rotation_hz = read.Number("rotation_hz", 10.0);
+    config = lidar;
+  } else {
+    RangeSensorConfig ray;
+    const std::vector<double> direction = read.Numbers("direction");
+    if (!direction.empty()) {
+      if (direction.size() != 3) read.Fail("direction", "'direction' must be [x, y, z]");
+      ray.direction_S = Eigen::Vector3d(direction[0], direction[1], direction[2]).normalized();
+    }
+    ray.range_m = read.Number("range_m", ray.range_m);
+    config = ray;
+  }
+  read.RejectUnknownKeys();
+  // The config's own checks, named with the sensor.
+  try {
+    std::visit([](const auto& c) { c.ValidateOrThrow(); }, config);
+  } catch (const std::invalid_argument& error) {
+    throw LevelError(spec.Where() + error.what());
+  }
+  return config;
+}
+
+}  // namespace
+
+Eigen::Isometry3d MountedSensor::Pose(const scene::RobotState& state) const {
+  const Eigen::Isometry3d X_BM =
+      spec.mount_node < 0
+          ? Eigen::Isometry3d::Identity()
+          : scene::RigidPart(state.node_poses_B()[static_cast<std::size_t>(spec.mount_node)]);
+  return state.pose() * X_BM * spec.X_MS;
+}
+
+std::vector<MountedSensor> MakeRobotSensors(const scene::Level& level) {
+  std::vector<MountedSensor> sensors;
+  for (std::size_t r = 0; r < level.robots.size(); ++r) {
+    for (const SensorSpec& spec : level.robots[r].sensors) {
+      MountedSensor sensor;
+      sensor.spec = spec;
+      sensor.robot = static_cast<int>(r);
+      sensor.config = ReadConfig(spec);
+      sensors.push_back(std::move(sensor));
+    }
+  }
+  return sensors;
+}
+
+}  // namespace sandbox::sensors

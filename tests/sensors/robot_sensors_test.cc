@@ -1,0 +1,105 @@
+// Sensors declared in level manifests: their configs, their mounts, and one
+// clear message per mistake.
+
+#include "sensors/robot_sensors.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "tests/test_util.h"
+
+namespace sandbox::sensors {
+namespace {
+
+using Eigen::Vector3d;
+
+std::filesystem::path Robots() {
+  return std::filesystem::path(SANDBOX_SOURCE_DIR) / "assets/robots/robots.toml";
+}
+
+TEST(RobotSensorsTest, BundledLevelsDeclareTheirSensors) {
+  const scene::Level level = scene::LoadLevel(Robots());
+  const std::vector<MountedSensor> sensors = MakeRobotSensors(level);
+  ASSERT_EQ(sensors.size(), 2u);
+  EXPECT_EQ(sensors[0].spec.name, "tip_ground");
+  EXPECT_EQ(sensors[0].robot, level.FindRobot("ELAHA"));
+  const auto& lidar = std::get<LidarConfig>(sensors[1].config);
+  EXPECT_EQ(lidar.channels(), 16);
+  EXPECT_EQ(lidar.azimuth_steps, 1024);
+  EXPECT_NEAR(lidar.elevations_rad.front(), -15.0 * M_PI / 180.0, 1e-12);
+  EXPECT_DOUBLE_EQ(sensors[1].spec.rate_hz, 10.0);
+
+  const scene::Level sample = scene::LoadLevel(testing::SampleLevel());
+  const std::vector<MountedSensor> on_wing = MakeRobotSensors(sample);
+  ASSERT_EQ(on_wing.size(), 2u);
+  const auto& face = std::get<FaceScannerConfig>(on_wing[0].config);
+  EXPECT_EQ(face.points_per_side(), 51);
+  EXPECT_EQ(face.refresh, Refresh::kSixStage);
+}
+
+TEST(RobotSensorsTest, ASensorOnABoneMovesWithTheBone) {
+  const scene::Level level = scene::LoadLevel(Robots());
+  const std::vector<MountedSensor> sensors = MakeRobotSensors(level);
+  const scene::RobotModel& wing = level.robots[static_cast<std::size_t>(level.FindRobot("ELAHA"))];
+  scene::RobotState state(wing);
+  const double roll = 4.5 * M_PI / 180.0;
+  for (int b = 1; b <= 10; ++b) {
+    const double values[2] = {roll, 0.0};
+    ASSERT_TRUE(state.SetBone(b, values, 2));
+  }
+  state.Update();
+  // Hand-built chain: spawn (0, 0, 10), joints 0.6 then 1.2 m along -y, each
+  // rolled 4.5 degrees; the sensor 1.2 m beyond joint 10.
+  Eigen::Isometry3d X = Eigen::Isometry3d(Eigen::Translation3d(0, 0, 10));
+  for (int k = 1; k <= 10; ++k) {
+    X = X * Eigen::Translation3d(0, k == 1 ? -0.6 : -1.2, 0) *
+        Eigen::AngleAxisd(roll, Vector3d::UnitX());
+  }
+  X = X * Eigen::Translation3d(0, -1.2, 0);
+  const Eigen::Isometry3d X_WS = sensors[0].Pose(state);
+  EXPECT_LT((X_WS.translation() - X.translation()).norm(), 1e-4)  // float glTF << X_WS.translation().transpose();
+  EXPECT_TRUE(X_WS.linear().isApprox(X.linear(), 1e-6));
+}
+
+std::string Error(const std::string& sensor_table) {
+  testing::TempDir dir;
+  const std::string arm = (Robots().parent_path() / "generated/arm.gltf").string();
+  const auto file = dir.Write("level.toml", "[[robot]]\nname = \"r\"\nfile = \"" + arm +
+                                                "\"\nbones = [\"base\", \"link1\"]\n\n" +
+                                                "[[robot.sensor]]\nname = \"s\"\n" + sensor_table);
+  try {
+    MakeRobotSensors(scene::LoadLevel(file));
+  } catch (const scene::LevelError& error) {
+    const std::string message = error.what();
+    return message.substr(message.find("level.toml"));
+  }
+  return "no error";
+}
+
+TEST(RobotSensorsTest, MistakesNameTheSensorAndField) {
+  EXPECT_EQ(Error("type = \"face\"\nmount = \"elbow\"\n"),
+            "level.toml:6: sensor 's': mount 'elbow' is not a node of arm.gltf (nodes: base, "
+            "link1, link2, link3, link4, link5, link6, tool)");
+  EXPECT_EQ(Error("type = \"face\"\nresolution_m = 0\n"),
+            "level.toml:6: sensor 's': resolution_m must be positive, got 0");
+  EXPECT_EQ(Error("type = \"face\"\nresolution_m = -0.5\n"),
+            "level.toml:6: sensor 's': resolution_m must be positive, got -0.5");
+  EXPECT_EQ(Error("type = \"face\"\nresolution_m = 0.01\nhalf_extent_m = 100\n"),
+            "level.toml:6: sensor 's': half_extent_m 100 at resolution_m 0.01 makes more than 10 "
+            "million rays");
+  EXPECT_EQ(Error("type = \"face\"\nresolutoin_m = 0.5\n"),
+            "level.toml:9: sensor 's': unknown key 'resolutoin_m' for a face sensor");
+  EXPECT_EQ(Error("type = \"face\"\nrefresh = 6\n"),
+            "level.toml:9: sensor 's': 'refresh' must be a string");
+  EXPECT_EQ(Error("type = \"sonar\"\n"),
+            "level.toml:8: sensor 's': 'type' must be face, ground, lidar or ray, got 'sonar'");
+  EXPECT_EQ(Error("type = \"lidar\"\nchannels = 0\n"),
+            "level.toml:9: sensor 's': 'channels' must be at least 1");
+  EXPECT_EQ(Error("type = \"ray\"\nrange_m = nan\n"),
+            "level.toml:9: sensor 's': 'range_m' must be finite, got nan");
+  EXPECT_EQ(Error("type = \"ray\"\nrate_hz = -1\n"), "level.toml:9: sensor 's': 'rate_hz' must be positive");
+}
+
+}  // namespace
+}  // namespace sandbox::sensors
