@@ -58,7 +58,7 @@ TEST(RobotSensorsTest, ASensorOnABoneMovesWithTheBone) {
   }
   X = X * Eigen::Translation3d(0, -1.2, 0);
   const Eigen::Isometry3d X_WS = sensors[0].Pose(state);
-  EXPECT_LT((X_WS.translation() - X.translation()).norm(), 1e-4)  // float glTF << X_WS.translation().transpose();
+  EXPECT_LT((X_WS.translation() - X.translation()).norm(), 1e-4) << X_WS.translation().transpose();
   EXPECT_TRUE(X_WS.linear().isApprox(X.linear(), 1e-6));
 }
 
