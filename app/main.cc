@@ -6,6 +6,7 @@
 
 #include "app/info_command.h"
 #include "app/pose_command.h"
+#include "app/scan_command.h"
 
 namespace {
 
@@ -14,6 +15,7 @@ const char* kUsage =
     "commands:\n"
     "  info [LEVEL] [--json]   actors, robots, triangles, bounds, load time and memory of a level\n"
     "  pose [LEVEL] --out M.ply  a robot posed from the command line, as a mesh and bone frames\n"
+    "  scan [LEVEL] --at X,Y,Z --out F  one sensor once at a pose, as CSV or PLY\n"
     "run 'sandbox COMMAND --help' for a command's options\n";
 
 }  // namespace
@@ -28,6 +30,7 @@ int main(int argc, char** argv) {
   try {
     if (args[0] == "info") return sandbox::app::RunInfo(rest, std::cout, std::cerr);
     if (args[0] == "pose") return sandbox::app::RunPose(rest, std::cout, std::cerr);
+    if (args[0] == "scan") return sandbox::app::RunScan(rest, std::cout, std::cerr);
   } catch (const std::exception& error) {
     std::cerr << "sandbox " << args[0] << ": " << error.what() << "\n";
     return 1;

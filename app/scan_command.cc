@@ -1,0 +1,247 @@
+#include "app/scan_command.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include "app/defaults.h"
+#include "scene/collision_world.h"
+#include "scene/level.h"
+#include "sensors/face_scanner.h"
+#include "sensors/ground_scanner.h"
+#include "sensors/lidar.h"
+#include "sensors/range_sensor.h"
+
+namespace sandbox::app {
+namespace {
+
+const char* kUsage =
+    "usage: sandbox scan [LEVEL] --at X,Y,Z[,ROLL,PITCH,YAW] [--sensor face|ground|lidar|ray]\n"
+    "                    [--resolution R] [--half-extent E] [--aligned body|world]\n"
+    "                    [--see-robots] --out FILE.csv|FILE.ply\n"
+    "  LEVEL          a level (default: the bundled sample level)\n"
+    "  --at           sensor pose: metres, roll/pitch/yaw in degrees\n"
+    "  --sensor       face (default): the six-face scanner, all faces; ground: height map\n"
+    "                 below; lidar: 16 x 1024 beams, -15..15 degrees, 100 m; ray: one ray down\n"
+    "  --resolution   grid spacing of face and ground, metres (default 1)\n"
+    "  --half-extent  half the box of face and ground, metres (default 25)\n"
+    "  --aligned      face box with the sensor's axes (body, default) or the world's\n"
+    "  --see-robots   rays see the level's robots too (default: world actors only)\n"
+    "  --out          CSV (face: face,row,col,occupancy,x,y,z; lidar: channel,step,hit,x,y,z,range;\n"
+    "                 ground: row,col,valid,x,y,z; ray: hit,x,y,z,range) or PLY when it ends\n"
+    "                 in .ply (occupied points red, free points green); see docs/sensors.md\n";
+
+struct ScanError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// One sample for the writers.
+struct Sample {
+  std::string key;  // the leading CSV columns, e.g. "0,12,7"
+  bool occupied;
+  Eigen::Vector3d point_W;
+  std::string extra;  // trailing CSV columns, e.g. ",37.2"
+};
+
+void WriteSamples(const std::string& file, const std::string& header,
+                  const std::vector<Sample>& samples) {
+  std::ofstream out(file);
+  const bool ply = file.size() > 4 && file.substr(file.size() - 4) == ".ply";
+  out << std::setprecision(10);
+  if (ply) {
+    out << "ply\nformat ascii 1.0\ncomment sandbox scan: occupied red, free green; world frame, "
+           "metres\nelement vertex "
+        << samples.size()
+        << "\nproperty double x\nproperty double y\nproperty double z\nproperty uchar red\n"
+           "property uchar green\nproperty uchar blue\nend_header\n";
+    for (const Sample& s : samples) {
+      out << s.point_W.x() << " " << s.point_W.y() << " " << s.point_W.z() << " "
+          << (s.occupied ? "255 0 0" : "0 255 0") << "\n";
+    }
+  } else {
+    out << header << "\n";
+    for (const Sample& s : samples) {
+      out << s.key << s.point_W.x() << "," << s.point_W.y() << "," << s.point_W.z() << s.extra
+          << "\n";
+    }
+  }
+  if (!out) throw ScanError("cannot write " + file);
+}
+
+std::vector<double> Numbers(const std::string& text, const std::string& option) {
+  std::vector<double> values;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    char* end = nullptr;
+    const double value = std::strtod(item.c_str(), &end);
+    if (item.empty() || *end != '\0' || !std::isfinite(value)) {
+      throw ScanError(option + ": '" + item + "' is not a finite number");
+    }
+    values.push_back(value);
+  }
+  return values;
+}
+
+double Positive(const std::string& text, const std::string& option) {
+  const std::vector<double> v = Numbers(text, option);
+  if (v.size() != 1 || !(v[0] > 0.0)) throw ScanError(option + " must be one positive number");
+  return v[0];
+}
+
+}  // namespace
+
+int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  std::string level_file = kDefaultLevel, at, sensor = "face", aligned = "body", out_file;
+  std::string resolution, half_extent;
+  bool see_robots = false, have_level = false;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    const bool has_value = i + 1 < args.size();
+    if (arg == "--help" || arg == "-h") {
+      out << kUsage;
+      return 0;
+    } else if (arg == "--at" && has_value) {
+      at = args[++i];
+    } else if (arg == "--sensor" && has_value) {
+      sensor = args[++i];
+    } else if (arg == "--resolution" && has_value) {
+      resolution = args[++i];
+    } else if (arg == "--half-extent" && has_value) {
+      half_extent = args[++i];
+    } else if (arg == "--aligned" && has_value) {
+      aligned = args[++i];
+    } else if (arg == "--see-robots") {
+      see_robots = true;
+    } else if (arg == "--out" && has_value) {
+      out_file = args[++i];
+    } else if (!arg.empty() && arg[0] == '-') {
+      err << "sandbox scan: unknown or incomplete option '" << arg << "'\n" << kUsage;
+      return 2;
+    } else if (!have_level) {
+      level_file = arg;
+      have_level = true;
+    } else {
+      err << "sandbox scan: more than one level given\n";
+      return 2;
+    }
+  }
+  if (at.empty() || out_file.empty()) {
+    err << "sandbox scan: --at and --out are required\n" << kUsage;
+    return 2;
+  }
+  if (sensor != "face" && sensor != "ground" && sensor != "lidar" && sensor != "ray") {
+    err << "sandbox scan: --sensor must be face, ground, lidar or ray, got '" << sensor << "'\n";
+    return 2;
+  }
+  if (aligned != "body" && aligned != "world") {
+    err << "sandbox scan: --aligned must be body or world, got '" << aligned << "'\n";
+    return 2;
+  }
+  try {
+    const std::vector<double> pose = Numbers(at, "--at");
+    if (pose.size() != 3 && pose.size() != 6) {
+      throw ScanError("--at takes X,Y,Z or X,Y,Z,ROLL,PITCH,YAW");
+    }
+    Eigen::Isometry3d X_WS = Eigen::Isometry3d::Identity();
+    X_WS.translation() = Eigen::Vector3d(pose[0], pose[1], pose[2]);
+    if (pose.size() == 6) {
+      X_WS.linear() = scene::RotationFromRollPitchYaw(
+          pose[3] * scene::kDegToRad, pose[4] * scene::kDegToRad, pose[5] * scene::kDegToRad);
+    }
+    const double res = resolution.empty() ? 1.0 : Positive(resolution, "--resolution");
+    const double extent = half_extent.empty() ? 25.0 : Positive(half_extent, "--half-extent");
+
+    const scene::Level level = scene::LoadLevel(level_file);
+    const scene::CollisionWorld world(level);
+    sensors::RayCaster caster;
+    sensors::RayFilter filter;
+    if (!see_robots) filter.group_mask = scene::kWorldStatic | scene::kWorldMovable;
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<Sample> samples;
+    std::string header;
+    if (sensor == "face") {
+      sensors::FaceScannerConfig config;
+      config.resolution_m = res;
+      config.half_extent_m = extent;
+      config.refresh = sensors::Refresh::kFull;
+      config.alignment = aligned == "body" ? sensors::Alignment::kBody : sensors::Alignment::kWorld;
+      const sensors::FaceScanner scanner(config);
+      sensors::FaceScan scan = scanner.EmptyScan();
+      scanner.Scan(world, caster, filter, X_WS, 0, &scan);
+      header = "face,row,col,occupancy,x,y,z";
+      for (int f = 0; f < 6; ++f) {
+        for (int k = 0; k < scan.n * scan.n; ++k) {
+          const int occupancy = scan.faces[std::size_t(f)].occupancy[std::size_t(k)];
+          samples.push_back({std::to_string(f) + "," + std::to_string(k / scan.n) + "," +
+                                 std::to_string(k % scan.n) + "," + std::to_string(occupancy) + ",",
+                             occupancy == sensors::kOccupied,
+                             scan.faces[std::size_t(f)].points_W[std::size_t(k)], ""});
+        }
+      }
+    } else if (sensor == "ground") {
+      sensors::GroundScannerConfig config;
+      config.resolution_m = res;
+      config.half_extent_m = extent;
+      sensors::HeightMap map;
+      sensors::GroundScanner(config).Scan(world, caster, filter, X_WS.translation(), &map);
+      header = "row,col,valid,x,y,z";
+      for (int k = 0; k < map.n * map.n; ++k) {
+        const int r = k / map.n, c = k % map.n;
+        const double h = map.height_m[std::size_t(k)];
+        const bool valid = !std::isnan(h);
+        const Eigen::Vector3d p(map.corner_W.x() + c * map.resolution_m,
+                                map.corner_W.y() + r * map.resolution_m,
+                                valid ? h : X_WS.translation().z() - config.depth_m);
+        samples.push_back({std::to_string(r) + "," + std::to_string(c) + "," +
+                               std::to_string(int(valid)) + ",",
+                           valid, p, ""});
+      }
+    } else if (sensor == "lidar") {
+      const sensors::Lidar lidar(sensors::LidarConfig::Uniform(16, -15, 15, 1024, 100.0));
+      sensors::LidarScan scan;
+      lidar.Sweep(world, caster, filter, X_WS, X_WS, &scan);
+      header = "channel,step,hit,x,y,z,range";
+      for (std::size_t i = 0; i < scan.range_m.size(); ++i) {
+        const std::size_t c = i / std::size_t(scan.azimuth_steps);
+        const std::size_t k = i % std::size_t(scan.azimuth_steps);
+        std::ostringstream range;
+        range << "," << scan.range_m[i];
+        samples.push_back({std::to_string(c) + "," + std::to_string(k) + "," +
+                               std::to_string(int(scan.hit[i])) + ",",
+                           scan.hit[i] != 0, scan.points_W[i], range.str()});
+      }
+    } else {
+      const sensors::RangeReading reading =
+          sensors::MeasureRange({}, world, caster, filter, X_WS);
+      header = "hit,x,y,z,range";
+      std::ostringstream range;
+      range << "," << reading.range_m;
+      samples.push_back({std::to_string(int(reading.hit)) + ",", reading.hit, reading.point_W,
+                         range.str()});
+    }
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    WriteSamples(out_file, header, samples);
+    std::size_t occupied = 0;
+    for (const Sample& s : samples) occupied += s.occupied ? 1 : 0;
+    out << sensor << " scan at (" << pose[0] << ", " << pose[1] << ", " << pose[2] << "): "
+        << samples.size() << " rays, " << occupied << " hit, " << std::fixed
+        << std::setprecision(2) << ms << " ms -> " << out_file << "\n";
+    return 0;
+  } catch (const scene::LevelError& error) {
+    err << "sandbox scan: " << error.what() << "\n";
+    return 1;
+  } catch (const ScanError& error) {
+    err << "sandbox scan: " << error.what() << "\n";
+    return 1;
+  } catch (const std::invalid_argument& error) {
+    err << "sandbox scan: " << error.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace sandbox::app

@@ -1,0 +1,95 @@
+// `sandbox scan` as a user runs it: CSV and PLY contents against the
+// analytic terrain, and clear errors.
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "assets/generators/sample_terrain.h"
+#include "tests/app/run_sandbox.h"
+#include "tests/test_util.h"
+
+namespace {
+
+using sandbox::testing::RunSandbox;
+
+std::vector<std::string> Lines(const std::string& file) {
+  std::ifstream in(file);
+  std::vector<std::string> lines;
+  std::string line;
+  while (std::getline(in, line)) lines.push_back(line);
+  return lines;
+}
+
+std::vector<double> Cells(const std::string& line) {
+  std::vector<double> cells;
+  std::stringstream in(line);
+  std::string cell;
+  while (std::getline(in, cell, ',')) cells.push_back(std::stod(cell));
+  return cells;
+}
+
+TEST(ScanCommandTest, FaceScanCsvMatchesTheTerrainBelow) {
+  sandbox::testing::TempDir dir;
+  const std::string csv = (dir.path() / "scan.csv").string();
+  // World-aligned box 10 m above the ground at (-20, 150), 100 m from any rock or
+  // building: the -Z face's rows and
+  // columns are world y and x, 1 m apart.
+  const double x = -20, y = 150, z = sandbox::assets::sample::TerrainHeight(-20, 150) + 10.0;
+  std::ostringstream at;
+  at << x << "," << y << "," << z;
+  const auto run = RunSandbox("scan --at " + at.str() + " --aligned world --out " + csv);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  const std::vector<std::string> lines = Lines(csv);
+  ASSERT_EQ(lines.size(), 1u + 6u * 51u * 51u);
+  EXPECT_EQ(lines[0], "face,row,col,occupancy,x,y,z");
+  int checked = 0;
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    const std::vector<double> c = Cells(lines[i]);
+    if (c[0] != 5 || c[3] != 1) continue;  // -Z face, occupied
+    EXPECT_DOUBLE_EQ(c[4], x - 25 + c[2]);
+    EXPECT_DOUBLE_EQ(c[5], y - 25 + c[1]);
+    // The terrain is piecewise flat between 2 m grid points: within 5 cm of the function.
+    EXPECT_NEAR(c[6], sandbox::assets::sample::TerrainHeight(c[4], c[5]), 0.05);
+    ++checked;
+  }
+  EXPECT_GT(checked, 2000);
+}
+
+TEST(ScanCommandTest, LidarCsvAndPlyColours) {
+  sandbox::testing::TempDir dir;
+  const std::string csv = (dir.path() / "lidar.csv").string();
+  ASSERT_EQ(RunSandbox("scan --at 0,0,30 --sensor lidar --out " + csv).exit_code, 0);
+  const std::vector<std::string> lines = Lines(csv);
+  ASSERT_EQ(lines.size(), 1u + 16u * 1024u);
+  EXPECT_EQ(lines[0], "channel,step,hit,x,y,z,range");
+  const std::string ply = (dir.path() / "face.ply").string();
+  ASSERT_EQ(RunSandbox("scan --at 0,0,30 --out " + ply).exit_code, 0);
+  const std::vector<std::string> points = Lines(ply);
+  ASSERT_GT(points.size(), 10u);
+  EXPECT_EQ(points[0], "ply");
+  int red = 0, green = 0;
+  for (const std::string& line : points) {
+    red += line.size() > 8 && line.substr(line.size() - 8) == " 255 0 0";
+    green += line.size() > 8 && line.substr(line.size() - 8) == " 0 255 0";
+  }
+  EXPECT_EQ(red + green, 6 * 51 * 51);
+  EXPECT_GT(red, 51 * 51 - 100);  // nearly every down ray hits the valley
+}
+
+TEST(ScanCommandTest, BadArgumentsAreOneClearMessage) {
+  sandbox::testing::TempDir dir;
+  const std::string out = " --out " + (dir.path() / "x.csv").string();
+  auto run = RunSandbox("scan --at 0,0,nan" + out);
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_EQ(run.out, "sandbox scan: --at: 'nan' is not a finite number\n");
+  run = RunSandbox("scan --at 0,0,30 --resolution 0.01 --half-extent 100" + out);
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_EQ(run.out,
+            "sandbox scan: half_extent_m 100 at resolution_m 0.01 makes more than 10 million rays\n");
+  EXPECT_EQ(RunSandbox("scan --at 0,0,30 --sensor sonar" + out).exit_code, 2);
+  EXPECT_EQ(RunSandbox("scan --out x.csv").exit_code, 2);
+}
+
+}  // namespace
