@@ -8,6 +8,7 @@
 #include <sstream>
 #include <variant>
 
+#include "app/command_line.h"
 #include "app/defaults.h"
 #include "app/process_stats.h"
 #include "scene/collision_world.h"
@@ -66,7 +67,8 @@ std::string Describe(const sensors::MountedSensor& sensor) {
   } else if (const auto* ground = std::get_if<sensors::GroundScannerConfig>(&sensor.config)) {
     out << " +-" << ground->half_extent_m << " m at " << ground->resolution_m << " m";
   } else if (const auto* lidar = std::get_if<sensors::LidarConfig>(&sensor.config)) {
-    out << " " << lidar->channels() << "x" << lidar->azimuth_steps << ", " << lidar->range_m << " m";
+    out << " " << lidar->channels() << "x" << lidar->azimuth_steps << ", " << lidar->range_m
+        << " m";
   } else if (const auto* ray = std::get_if<sensors::RangeSensorConfig>(&sensor.config)) {
     out << " " << ray->range_m << " m";
   }
@@ -185,42 +187,32 @@ const char* kUsage =
 }  // namespace
 
 int RunInfo(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  std::string file = kDefaultLevel;
-  bool json = false;
+  const auto parsed = ParseArgs(args, "info", {"--up", "--unit-scale"}, {"--json"}, kUsage, err);
+  if (!parsed) return 2;
+  if (parsed->help) {
+    out << kUsage;
+    return 0;
+  }
+  const std::string file = parsed->level.value_or(kDefaultLevel);
+  const bool json = parsed->flags.count("--json") > 0;
   scene::AssetConversion conversion;
-  bool have_file = false;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& arg = args[i];
-    const bool has_value = i + 1 < args.size();
-    if (arg == "--json") {
-      json = true;
-    } else if (arg == "--help" || arg == "-h") {
-      out << kUsage;
-      return 0;
-    } else if (arg == "--up" && has_value) {
-      conversion.up = scene::ParseUpAxis(args[++i]);
-      if (!conversion.up) {
-        err << "sandbox info: --up must be one of x, -x, y, -y, z, -z, got '" << args[i] << "'\n";
-        return 2;
-      }
-    } else if (arg == "--unit-scale" && has_value) {
-      char* end = nullptr;
-      const double value = std::strtod(args[++i].c_str(), &end);
-      if (*end != '\0' || !(value > 0.0) || !std::isfinite(value)) {
-        err << "sandbox info: --unit-scale must be a positive number, got '" << args[i] << "'\n";
-        return 2;
-      }
-      conversion.unit_scale_m = value;
-    } else if (!arg.empty() && arg[0] == '-') {
-      err << "sandbox info: unknown or incomplete option '" << arg << "'\n" << kUsage;
-      return 2;
-    } else if (!have_file) {
-      file = arg;
-      have_file = true;
-    } else {
-      err << "sandbox info: more than one level given ('" << file << "', '" << arg << "')\n";
+  if (parsed->values.count("--up") > 0) {
+    conversion.up = scene::ParseUpAxis(parsed->Value("--up"));
+    if (!conversion.up) {
+      err << "sandbox info: --up must be one of x, -x, y, -y, z, -z, got '" << parsed->Value("--up")
+          << "'\n";
       return 2;
     }
+  }
+  if (parsed->values.count("--unit-scale") > 0) {
+    const std::string text = parsed->Value("--unit-scale");
+    char* end = nullptr;
+    const double value = std::strtod(text.c_str(), &end);
+    if (*end != '\0' || !(value > 0.0) || !std::isfinite(value)) {
+      err << "sandbox info: --unit-scale must be a positive number, got '" << text << "'\n";
+      return 2;
+    }
+    conversion.unit_scale_m = value;
   }
 
   using Clock = std::chrono::steady_clock;

@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "app/command_line.h"
 #include "app/defaults.h"
 #include "scene/level.h"
 #include "scene/robot_state.h"
@@ -29,41 +30,6 @@ const char* kUsage =
     "                or a file with one entry a line ('#' starts a comment)\n"
     "  --out         the posed mesh (ASCII PLY, world frame); bone frames go to\n"
     "                MESH.bones.csv beside it\n";
-
-// Thrown for a bad pose argument; the message is shown to the user.
-struct PoseError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-std::vector<double> ParseNumbers(const std::string& text, const std::string& what) {
-  std::vector<double> values;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    char* end = nullptr;
-    const double value = std::strtod(item.c_str(), &end);
-    if (item.empty() || *end != '\0' || !std::isfinite(value)) {
-      throw PoseError(what + ": '" + item + "' is not a finite number");
-    }
-    values.push_back(value);
-  }
-  return values;
-}
-
-Eigen::Isometry3d ParseRobotPose(const std::string& text) {
-  const std::vector<double> v = ParseNumbers(text, "--robot-pose");
-  if (v.size() != 3 && v.size() != 6) {
-    throw PoseError("--robot-pose takes X,Y,Z or X,Y,Z,ROLL,PITCH,YAW, got " +
-                    std::to_string(v.size()) + " numbers");
-  }
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
-  if (v.size() == 6) {
-    X.linear() = scene::RotationFromRollPitchYaw(v[3] * scene::kDegToRad, v[4] * scene::kDegToRad,
-                                                 v[5] * scene::kDegToRad);
-  }
-  return X;
-}
 
 // Applies "BONE V1 V2 ...; BONE ..." (or the lines of a file) to `state`.
 void ApplyBones(const std::string& spec, const RobotModel& model, RobotState* state) {
@@ -90,25 +56,25 @@ void ApplyBones(const std::string& spec, const RobotModel& model, RobotState* st
       bone = std::atoi(bone_word.c_str());
     }
     if (bone < 0 || bone >= static_cast<int>(model.bones.size())) {
-      throw PoseError("--bones: robot '" + model.name + "' has no bone '" + bone_word + "' (" +
-                      std::to_string(model.bones.size()) + " bones)");
+      throw CommandError("--bones: robot '" + model.name + "' has no bone '" + bone_word + "' (" +
+                         std::to_string(model.bones.size()) + " bones)");
     }
     const scene::Bone& b = model.bones[static_cast<std::size_t>(bone)];
     std::vector<double> values;
     std::string word;
     while (words >> word) values.push_back(ParseNumbers(word, "--bones " + bone_word).at(0));
     if (static_cast<int>(values.size()) != b.num_values) {
-      throw PoseError("--bones: bone '" + b.name + "' takes " + std::to_string(b.num_values) +
-                      (b.rotation == scene::BoneRotation::kQuaternion
-                           ? " values (quaternion w x y z)"
-                           : " values (angles in degrees)") +
-                      ", got " + std::to_string(values.size()));
+      throw CommandError("--bones: bone '" + b.name + "' takes " + std::to_string(b.num_values) +
+                         (b.rotation == scene::BoneRotation::kQuaternion
+                              ? " values (quaternion w x y z)"
+                              : " values (angles in degrees)") +
+                         ", got " + std::to_string(values.size()));
     }
     if (b.rotation == scene::BoneRotation::kAngles) {
       for (double& v : values) v *= scene::kDegToRad;
     }
     if (!state->SetBone(bone, values.data(), b.num_values)) {
-      throw PoseError("--bones: bone '" + b.name + "' rejected: " + state->last_rejection());
+      throw CommandError("--bones: bone '" + b.name + "' rejected: " + state->last_rejection());
     }
   }
 }
@@ -142,7 +108,7 @@ void WritePly(const fs::path& file, const RobotState& state) {
     }
     base += mesh.bind.positions_A.size();
   }
-  if (!out) throw PoseError("cannot write " + file.string());
+  if (!out) throw CommandError("cannot write " + file.string());
 }
 
 void WriteBoneFrames(const fs::path& file, const RobotState& state) {
@@ -158,52 +124,36 @@ void WriteBoneFrames(const fs::path& file, const RobotState& state) {
         << X.translation().y() << "," << X.translation().z() << "," << q.w() << "," << q.x() << ","
         << q.y() << "," << q.z() << "\n";
   }
-  if (!out) throw PoseError("cannot write " + file.string());
+  if (!out) throw CommandError("cannot write " + file.string());
 }
 
 }  // namespace
 
 int RunPose(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  std::string level_file = kDefaultLevel, robot_name, pose_text, bones_text, out_file;
-  bool have_level = false;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& arg = args[i];
-    const bool has_value = i + 1 < args.size();
-    if (arg == "--help" || arg == "-h") {
-      out << kUsage;
-      return 0;
-    } else if (arg == "--robot" && has_value) {
-      robot_name = args[++i];
-    } else if (arg == "--robot-pose" && has_value) {
-      pose_text = args[++i];
-    } else if (arg == "--bones" && has_value) {
-      bones_text = args[++i];
-    } else if (arg == "--out" && has_value) {
-      out_file = args[++i];
-    } else if (!arg.empty() && arg[0] == '-') {
-      err << "sandbox pose: unknown or incomplete option '" << arg << "'\n" << kUsage;
-      return 2;
-    } else if (!have_level) {
-      level_file = arg;
-      have_level = true;
-    } else {
-      err << "sandbox pose: more than one level given\n";
-      return 2;
-    }
+  const auto parsed =
+      ParseArgs(args, "pose", {"--robot", "--robot-pose", "--bones", "--out"}, {}, kUsage, err);
+  if (!parsed) return 2;
+  if (parsed->help) {
+    out << kUsage;
+    return 0;
   }
+  const std::string level_file = parsed->level.value_or(kDefaultLevel);
+  const std::string robot_name = parsed->Value("--robot"),
+                    pose_text = parsed->Value("--robot-pose");
+  const std::string bones_text = parsed->Value("--bones"), out_file = parsed->Value("--out");
   if (out_file.empty()) {
     err << "sandbox pose: --out MESH.ply is required\n" << kUsage;
     return 2;
   }
   try {
     const scene::Level level = scene::LoadLevel(level_file);
-    if (level.robots.empty()) throw PoseError(level_file + ": the level declares no [[robot]]");
+    if (level.robots.empty()) throw CommandError(level_file + ": the level declares no [[robot]]");
     const int robot = robot_name.empty() ? 0 : level.FindRobot(robot_name);
-    if (robot < 0) throw PoseError("the level has no robot '" + robot_name + "'");
+    if (robot < 0) throw CommandError("the level has no robot '" + robot_name + "'");
     const RobotModel& model = level.robots[static_cast<std::size_t>(robot)];
     RobotState state(model);
-    if (!pose_text.empty() && !state.SetPose(ParseRobotPose(pose_text))) {
-      throw PoseError("--robot-pose rejected: " + state.last_rejection());
+    if (!pose_text.empty() && !state.SetPose(ParsePose(pose_text, "--robot-pose"))) {
+      throw CommandError("--robot-pose rejected: " + state.last_rejection());
     }
     if (!bones_text.empty()) ApplyBones(bones_text, model, &state);
     state.Update();
@@ -218,7 +168,7 @@ int RunPose(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   } catch (const scene::LevelError& error) {
     err << "sandbox pose: " << error.what() << "\n";
     return 1;
-  } catch (const PoseError& error) {
+  } catch (const CommandError& error) {
     err << "sandbox pose: " << error.what() << "\n";
     return 1;
   }

@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "app/command_line.h"
 #include "app/defaults.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
@@ -30,13 +31,10 @@ const char* kUsage =
     "  --half-extent  half the box of face and ground, metres (default 25)\n"
     "  --aligned      face box with the sensor's axes (body, default) or the world's\n"
     "  --see-robots   rays see the level's robots too (default: world actors only)\n"
-    "  --out          CSV (face: face,row,col,occupancy,x,y,z; lidar: channel,step,hit,x,y,z,range;\n"
+    "  --out          CSV (face: face,row,col,occupancy,x,y,z; lidar: "
+    "channel,step,hit,x,y,z,range;\n"
     "                 ground: row,col,valid,x,y,z; ray: hit,x,y,z,range) or PLY when it ends\n"
     "                 in .ply (occupied points red, free points green); see docs/sensors.md\n";
-
-struct ScanError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 
 // One sample for the writers.
 struct Sample {
@@ -68,67 +66,33 @@ void WriteSamples(const std::string& file, const std::string& header,
           << "\n";
     }
   }
-  if (!out) throw ScanError("cannot write " + file);
-}
-
-std::vector<double> Numbers(const std::string& text, const std::string& option) {
-  std::vector<double> values;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    char* end = nullptr;
-    const double value = std::strtod(item.c_str(), &end);
-    if (item.empty() || *end != '\0' || !std::isfinite(value)) {
-      throw ScanError(option + ": '" + item + "' is not a finite number");
-    }
-    values.push_back(value);
-  }
-  return values;
+  if (!out) throw CommandError("cannot write " + file);
 }
 
 double Positive(const std::string& text, const std::string& option) {
-  const std::vector<double> v = Numbers(text, option);
-  if (v.size() != 1 || !(v[0] > 0.0)) throw ScanError(option + " must be one positive number");
+  const std::vector<double> v = ParseNumbers(text, option);
+  if (v.size() != 1 || !(v[0] > 0.0)) throw CommandError(option + " must be one positive number");
   return v[0];
 }
 
 }  // namespace
 
 int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  std::string level_file = kDefaultLevel, at, sensor = "face", aligned = "body", out_file;
-  std::string resolution, half_extent;
-  bool see_robots = false, have_level = false;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& arg = args[i];
-    const bool has_value = i + 1 < args.size();
-    if (arg == "--help" || arg == "-h") {
-      out << kUsage;
-      return 0;
-    } else if (arg == "--at" && has_value) {
-      at = args[++i];
-    } else if (arg == "--sensor" && has_value) {
-      sensor = args[++i];
-    } else if (arg == "--resolution" && has_value) {
-      resolution = args[++i];
-    } else if (arg == "--half-extent" && has_value) {
-      half_extent = args[++i];
-    } else if (arg == "--aligned" && has_value) {
-      aligned = args[++i];
-    } else if (arg == "--see-robots") {
-      see_robots = true;
-    } else if (arg == "--out" && has_value) {
-      out_file = args[++i];
-    } else if (!arg.empty() && arg[0] == '-') {
-      err << "sandbox scan: unknown or incomplete option '" << arg << "'\n" << kUsage;
-      return 2;
-    } else if (!have_level) {
-      level_file = arg;
-      have_level = true;
-    } else {
-      err << "sandbox scan: more than one level given\n";
-      return 2;
-    }
+  const auto parsed = ParseArgs(
+      args, "scan", {"--at", "--sensor", "--resolution", "--half-extent", "--aligned", "--out"},
+      {"--see-robots"}, kUsage, err);
+  if (!parsed) return 2;
+  if (parsed->help) {
+    out << kUsage;
+    return 0;
   }
+  const std::string level_file = parsed->level.value_or(kDefaultLevel);
+  const std::string at = parsed->Value("--at"), out_file = parsed->Value("--out");
+  const std::string sensor = parsed->Value("--sensor", "face");
+  const std::string aligned = parsed->Value("--aligned", "body");
+  const std::string resolution = parsed->Value("--resolution");
+  const std::string half_extent = parsed->Value("--half-extent");
+  const bool see_robots = parsed->flags.count("--see-robots") > 0;
   if (at.empty() || out_file.empty()) {
     err << "sandbox scan: --at and --out are required\n" << kUsage;
     return 2;
@@ -142,16 +106,7 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     return 2;
   }
   try {
-    const std::vector<double> pose = Numbers(at, "--at");
-    if (pose.size() != 3 && pose.size() != 6) {
-      throw ScanError("--at takes X,Y,Z or X,Y,Z,ROLL,PITCH,YAW");
-    }
-    Eigen::Isometry3d X_WS = Eigen::Isometry3d::Identity();
-    X_WS.translation() = Eigen::Vector3d(pose[0], pose[1], pose[2]);
-    if (pose.size() == 6) {
-      X_WS.linear() = scene::RotationFromRollPitchYaw(
-          pose[3] * scene::kDegToRad, pose[4] * scene::kDegToRad, pose[5] * scene::kDegToRad);
-    }
+    const Eigen::Isometry3d X_WS = ParsePose(at, "--at");
     const double res = resolution.empty() ? 1.0 : Positive(resolution, "--resolution");
     const double extent = half_extent.empty() ? 25.0 : Positive(half_extent, "--half-extent");
 
@@ -196,9 +151,9 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
         const Eigen::Vector3d p(map.corner_W.x() + c * map.resolution_m,
                                 map.corner_W.y() + r * map.resolution_m,
                                 valid ? h : X_WS.translation().z() - config.depth_m);
-        samples.push_back({std::to_string(r) + "," + std::to_string(c) + "," +
-                               std::to_string(int(valid)) + ",",
-                           valid, p, ""});
+        samples.push_back(
+            {std::to_string(r) + "," + std::to_string(c) + "," + std::to_string(int(valid)) + ",",
+             valid, p, ""});
       }
     } else if (sensor == "lidar") {
       const sensors::Lidar lidar(sensors::LidarConfig::Uniform(16, -15, 15, 1024, 100.0));
@@ -215,27 +170,27 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
                            scan.hit[i] != 0, scan.points_W[i], range.str()});
       }
     } else {
-      const sensors::RangeReading reading =
-          sensors::MeasureRange({}, world, caster, filter, X_WS);
+      const sensors::RangeReading reading = sensors::MeasureRange({}, world, caster, filter, X_WS);
       header = "hit,x,y,z,range";
       std::ostringstream range;
       range << "," << reading.range_m;
-      samples.push_back({std::to_string(int(reading.hit)) + ",", reading.hit, reading.point_W,
-                         range.str()});
+      samples.push_back(
+          {std::to_string(int(reading.hit)) + ",", reading.hit, reading.point_W, range.str()});
     }
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     WriteSamples(out_file, header, samples);
     std::size_t occupied = 0;
     for (const Sample& s : samples) occupied += s.occupied ? 1 : 0;
-    out << sensor << " scan at (" << pose[0] << ", " << pose[1] << ", " << pose[2] << "): "
-        << samples.size() << " rays, " << occupied << " hit, " << std::fixed
+    const Eigen::Vector3d p = X_WS.translation();
+    out << sensor << " scan at (" << p.x() << ", " << p.y() << ", " << p.z()
+        << "): " << samples.size() << " rays, " << occupied << " hit, " << std::fixed
         << std::setprecision(2) << ms << " ms -> " << out_file << "\n";
     return 0;
   } catch (const scene::LevelError& error) {
     err << "sandbox scan: " << error.what() << "\n";
     return 1;
-  } catch (const ScanError& error) {
+  } catch (const CommandError& error) {
     err << "sandbox scan: " << error.what() << "\n";
     return 1;
   } catch (const std::invalid_argument& error) {

@@ -7,18 +7,18 @@
 //
 //   bench_rays [--seconds S]   (time per measurement, default 0.3)
 
+#include <embree3/rtcore.h>
+
 #include <algorithm>
-#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <embree3/rtcore.h>
 
 #include "bench/million_level.h"
 #include "scene/collision_world_internal.h"
@@ -45,18 +45,18 @@ class EmbreeScene {
       for (int p = 0; p < parts.size(); ++p) {
         const btIndexedMesh& part = parts[p];
         RTCGeometry geometry = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-        auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
-            geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-            std::size_t(part.m_numVertices)));
+        auto* vertices = static_cast<float*>(
+            rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                    3 * sizeof(float), std::size_t(part.m_numVertices)));
         for (int v = 0; v < part.m_numVertices; ++v) {
           const auto* in = reinterpret_cast<const float*>(part.m_vertexBase +
                                                           std::ptrdiff_t(v) * part.m_vertexStride);
           const btVector3 w = X * btVector3(in[0], in[1], in[2]);
           vertices[3 * v] = w.x(), vertices[3 * v + 1] = w.y(), vertices[3 * v + 2] = w.z();
         }
-        auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-            geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
-            std::size_t(part.m_numTriangles)));
+        auto* indices = static_cast<unsigned*>(
+            rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                    3 * sizeof(unsigned), std::size_t(part.m_numTriangles)));
         std::memcpy(indices, part.m_triangleIndexBase,
                     std::size_t(part.m_numTriangles) * 3 * sizeof(unsigned));
         rtcCommitGeometry(geometry);
@@ -123,8 +123,8 @@ bool DisagreeWhenMoved(const scene::CollisionWorld& world, const EmbreeScene& em
   const Eigen::Vector3f side = d.unitOrthogonal(), up = d.cross(side);
   sensors::RayBatch moved;
   moved.origin_W = rays.origin_W;
-  for (const Eigen::Vector3f& offset : {Eigen::Vector3f(1e-3f * (side + up)),
-                                        Eigen::Vector3f(-1e-3f * (side - up))}) {
+  for (const Eigen::Vector3f& offset :
+       {Eigen::Vector3f(1e-3f * (side + up)), Eigen::Vector3f(-1e-3f * (side - up))}) {
     moved.start.push_back(rays.start[i] + offset);
     moved.direction.push_back(d);
     moved.length_m.push_back(rays.length_m[i]);
@@ -136,7 +136,8 @@ bool DisagreeWhenMoved(const scene::CollisionWorld& world, const EmbreeScene& em
   std::vector<char> hit(2);
   embree.Cast(moved, (moved.origin_W - world.origin()).cast<float>(), 0, 2, &distance, &hit);
   for (int k = 0; k < 2; ++k) {
-    if ((ours.body[std::size_t(k)] != sensors::RayHits::kNoHit) != bool(hit[std::size_t(k)])) return true;
+    if ((ours.body[std::size_t(k)] != sensors::RayHits::kNoHit) != bool(hit[std::size_t(k)]))
+      return true;
   }
   return false;
 }
@@ -195,12 +196,14 @@ void Compare(const char* level, const char* name, const scene::CollisionWorld& w
     // it is not thread-safe), for perspective.
     std::string ray_test = "-";
     if (threads == 1) {
-      const double rate = n * CallsPerSecond(seconds, [&] {
-        for (std::size_t i = 0; i < n; ++i) {
-          const Eigen::Vector3d from = rays.origin_W + rays.start[i].cast<double>();
-          world.CastRay(from, from + double(rays.length_m[i]) * rays.direction[i].cast<double>());
-        }
-      });
+      const double rate =
+          n * CallsPerSecond(seconds, [&] {
+            for (std::size_t i = 0; i < n; ++i) {
+              const Eigen::Vector3d from = rays.origin_W + rays.start[i].cast<double>();
+              world.CastRay(from,
+                            from + double(rays.length_m[i]) * rays.direction[i].cast<double>());
+            }
+          });
       char text[32];
       std::snprintf(text, sizeof(text), "%.2f (%.2fx)", rate / 1e6, rate / embree_rate);
       ray_test = text;
@@ -251,9 +254,10 @@ int main(int argc, char** argv) {
   const fs::path million = bench::WriteMillionTriangleLevel(dir);
   RunLevel("1M-triangle", million, Eigen::Isometry3d(Eigen::Translation3d(500, 250, 8)), seconds);
   fs::remove_all(dir);
-  std::printf("\nsame rays, same triangles, same thread count; mismatches: hit in one, miss in "
-              "the other,\n(in brackets: those that stay when the ray moves 1 mm sideways, i.e. "
-              "not a ray grazing an edge);\nmax diff: largest hit distance difference where both "
-              "hit\n");
+  std::printf(
+      "\nsame rays, same triangles, same thread count; mismatches: hit in one, miss in "
+      "the other,\n(in brackets: those that stay when the ray moves 1 mm sideways, i.e. "
+      "not a ray grazing an edge);\nmax diff: largest hit distance difference where both "
+      "hit\n");
   return 0;
 }

@@ -1,6 +1,5 @@
 #include "scene/collision_world.h"
 
-
 #include <algorithm>
 #include <map>
 #include <stdexcept>

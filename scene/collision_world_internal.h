@@ -2,11 +2,11 @@
 // Scene-internal, and for sensors/ (which may use Bullet): the inside of
 // CollisionWorld. Includes Bullet; no public header includes this one.
 
+#include <btBulletCollisionCommon.h>
+
 #include <map>
 #include <memory>
 #include <vector>
-
-#include <btBulletCollisionCommon.h>
 
 #include "scene/collision_world.h"
 

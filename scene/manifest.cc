@@ -226,8 +226,8 @@ SensorSpec ParseSensor(const fs::path& file, const toml::table& table, int index
     sensor.rate_hz = *rate;
   }
   // The rest, as given.
-  static const std::set<std::string> kRead = {"name",    "type",    "mount",           "position",
-                                              "rpy_deg", "rate_hz", "quaternion_wxyz", "scale",
+  static const std::set<std::string> kRead = {"name",    "type",      "mount",           "position",
+                                              "rpy_deg", "rate_hz",   "quaternion_wxyz", "scale",
                                               "up",      "unit_scale"};
   for (const auto& [key_view, value] : table) {
     const std::string key(key_view.str());
@@ -312,7 +312,8 @@ RobotSpec ParseRobot(const fs::path& file, const toml::table& table, int index) 
     for (const toml::node& item : *array) {
       SensorSpec sensor = ParseSensor(file, *item.as_table(), ++sensor_index);
       if (!names.insert(sensor.name).second) {
-        TableReader(file, *item.as_table(), "").Fail(nullptr, "duplicate sensor name '" + sensor.name + "'");
+        TableReader(file, *item.as_table(), "")
+            .Fail(nullptr, "duplicate sensor name '" + sensor.name + "'");
       }
       robot.sensors.push_back(std::move(sensor));
     }

@@ -33,14 +33,14 @@ using SensorParam = std::variant<double, bool, std::string, std::vector<double>>
 // settings as given; sensors/ reads and checks them (it knows each type's keys).
 struct SensorSpec {
   std::string name;
-  std::string type;   // "face", "ground", "lidar", "ray"
-  std::string mount;  // a node of the robot (a bone), empty: the robot body frame
-  int mount_node{-1}; // resolved by LoadRobotModel; -1: the body frame
+  std::string type;    // "face", "ground", "lidar", "ray"
+  std::string mount;   // a node of the robot (a bone), empty: the robot body frame
+  int mount_node{-1};  // resolved by LoadRobotModel; -1: the body frame
   Eigen::Isometry3d X_MS{Eigen::Isometry3d::Identity()};  // sensor in its mount's frame
-  double rate_hz{0.0};  // 0: every tick
+  double rate_hz{0.0};                                    // 0: every tick
   std::map<std::string, SensorParam> params;
   std::map<std::string, int> param_lines;  // where each setting stands, for messages
-  std::filesystem::path file;  // the manifest
+  std::filesystem::path file;              // the manifest
   int line{0};
 
   // "level.toml:12: sensor 'scanner': " for messages.

@@ -111,7 +111,8 @@ void FaceScanner::AppendRays(const Part& part, const Eigen::Isometry3d& X_WS,
 void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
                        const RayFilter& filter, const Eigen::Isometry3d& X_WS, std::int64_t tick,
                        FaceScan* scan) const {
-  if (!X_WS.matrix().allFinite()) throw std::invalid_argument("FaceScanner::Scan(): non-finite pose");
+  if (!X_WS.matrix().allFinite())
+    throw std::invalid_argument("FaceScanner::Scan(): non-finite pose");
   if (scan->n != n_) *scan = EmptyScan();
   const std::vector<Part> parts = DueAt(tick);
   RayBatch rays;
@@ -129,8 +130,8 @@ void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
       for (int c = 0; c < n_; ++c, ++i) {
         const std::size_t k = std::size_t(r) * std::size_t(n_) + std::size_t(c);
         face.occupancy[k] = hits.body[i] == RayHits::kNoHit ? kFree : kOccupied;
-        face.points_W[k] = rays.origin_W + (rays.start[i] + hits.distance_m[i] * rays.direction[i])
-                                               .cast<double>();
+        face.points_W[k] =
+            rays.origin_W + (rays.start[i] + hits.distance_m[i] * rays.direction[i]).cast<double>();
       }
     }
   }

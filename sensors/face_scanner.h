@@ -10,12 +10,11 @@
 // in the sensor frame, with (u, v) = (+Y, +Z) for the X faces, (+X, +Z) for
 // the Y faces and (+X, +Y) for the Z faces; index = r * n + c.
 
+#include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "sensors/ray_caster.h"
 
@@ -51,7 +50,7 @@ enum Occupancy : std::int8_t { kUnvisited = -1, kFree = 0, kOccupied = 1 };
 struct ScanFace {
   std::int64_t tick{-1};  // the tick its latest rows were scanned at; -1: never
   Eigen::Isometry3d X_WS{Eigen::Isometry3d::Identity()};  // sensor pose of that scan
-  std::vector<std::int8_t> occupancy;   // n * n, Occupancy
+  std::vector<std::int8_t> occupancy;                     // n * n, Occupancy
   std::vector<Eigen::Vector3d> points_W;  // n * n: the hit, or the ray's end when free
 };
 

@@ -46,9 +46,8 @@ void GroundScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
   map->corner_W = p_WS.head<2>() - Eigen::Vector2d::Constant(E);
   map->height_m.resize(rays.size());
   for (std::size_t i = 0; i < rays.size(); ++i) {
-    map->height_m[i] = hits.body[i] == RayHits::kNoHit
-                           ? std::numeric_limits<double>::quiet_NaN()
-                           : p_WS.z() - double(hits.distance_m[i]);
+    map->height_m[i] = hits.body[i] == RayHits::kNoHit ? std::numeric_limits<double>::quiet_NaN()
+                                                       : p_WS.z() - double(hits.distance_m[i]);
   }
 }
 

@@ -5,9 +5,8 @@
 // and holds the height of the first surface within `depth_m` below the
 // sensor, or NaN where there is none.
 
-#include <vector>
-
 #include <Eigen/Geometry>
+#include <vector>
 
 #include "sensors/ray_caster.h"
 
@@ -16,7 +15,7 @@ namespace sandbox::sensors {
 struct GroundScannerConfig {
   double resolution_m{1.0};
   double half_extent_m{25.0};
-  double depth_m{100.0};  // how far below the sensor to look
+  double depth_m{100.0};         // how far below the sensor to look
   void ValidateOrThrow() const;  // throws std::invalid_argument naming the field
 };
 
@@ -24,7 +23,7 @@ struct HeightMap {
   int n{0};
   double resolution_m{1.0};
   Eigen::Vector2d corner_W{Eigen::Vector2d::Zero()};  // x, y of row 0, column 0
-  std::vector<double> height_m;                         // n * n, NaN without ground
+  std::vector<double> height_m;                       // n * n, NaN without ground
 };
 
 class GroundScanner {

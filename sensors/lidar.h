@@ -8,10 +8,9 @@
 // the sensor frame, e = elevation of channel c, a = 2 pi k / azimuth_steps
 // (counter-clockwise from +X); index = c * azimuth_steps + k.
 
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "sensors/ray_caster.h"
 

@@ -91,10 +91,11 @@ inline float EnterBox(const btQuantizedBvhNode& node, const Eigen::Vector3f& qo,
 inline bool HitTriangle(const Target& target, int part_id, int triangle, const Eigen::Vector3f& o,
                         const Eigen::Vector3f& d, float* t_max, Eigen::Vector3f* normal) {
   const Target::Part& part = target.parts[static_cast<std::size_t>(part_id)];
-  const auto* index = reinterpret_cast<const std::uint32_t*>(part.indices +
-                                                            std::ptrdiff_t(triangle) * part.index_stride);
+  const auto* index = reinterpret_cast<const std::uint32_t*>(
+      part.indices + std::ptrdiff_t(triangle) * part.index_stride);
   auto vertex = [&](std::uint32_t i) {
-    const auto* p = reinterpret_cast<const float*>(part.vertices + std::ptrdiff_t(i) * part.vertex_stride);
+    const auto* p =
+        reinterpret_cast<const float*>(part.vertices + std::ptrdiff_t(i) * part.vertex_stride);
     return Eigen::Vector3f(p[0], p[1], p[2]);
   };
   const Eigen::Vector3f v0 = vertex(index[0]);
@@ -174,7 +175,6 @@ inline bool RayMeetsBox(const Eigen::Vector3f& o, const Eigen::Vector3f& inverse
   return t_enter <= t_exit;
 }
 
-
 #if defined(__SSE2__)
 // Four rays walked together (SSE2): a node is visited when any of them
 // enters it, and every test is done for the four at once. Rays of a sensor
@@ -184,7 +184,7 @@ struct Packet {
   __m128 t_max;                   // per lane
   __m128 active;                  // all bits set in lanes that hold a ray
   int body[4];
-  Eigen::Vector3f normal[4];      // in the Bullet frame, unnormalised
+  Eigen::Vector3f normal[4];  // in the Bullet frame, unnormalised
 };
 
 inline __m128 AwayFromZero(__m128 x) {
@@ -198,12 +198,14 @@ inline __m128 Add(__m128 a, __m128 b) { return _mm_add_ps(a, b); }
 inline __m128 Sub(__m128 a, __m128 b) { return _mm_sub_ps(a, b); }
 
 // Lanes whose rays enter the box [lo, hi] (quantized space) before their t_max.
-inline __m128 EnterBox4(const btQuantizedBvhNode& node, const __m128 qo[3],
-                        const __m128 inverse[3], __m128 t_max) {
+inline __m128 EnterBox4(const btQuantizedBvhNode& node, const __m128 qo[3], const __m128 inverse[3],
+                        __m128 t_max) {
   __m128 t_enter = _mm_setzero_ps(), t_exit = t_max;
   for (int k = 0; k < 3; ++k) {
-    const __m128 t1 = Mul(Sub(_mm_set1_ps(float(node.m_quantizedAabbMin[k]) - 1.0f), qo[k]), inverse[k]);
-    const __m128 t2 = Mul(Sub(_mm_set1_ps(float(node.m_quantizedAabbMax[k]) + 1.0f), qo[k]), inverse[k]);
+    const __m128 t1 =
+        Mul(Sub(_mm_set1_ps(float(node.m_quantizedAabbMin[k]) - 1.0f), qo[k]), inverse[k]);
+    const __m128 t2 =
+        Mul(Sub(_mm_set1_ps(float(node.m_quantizedAabbMax[k]) + 1.0f), qo[k]), inverse[k]);
     t_enter = _mm_max_ps(t_enter, _mm_min_ps(t1, t2));
     t_exit = _mm_min_ps(t_exit, _mm_max_ps(t1, t2));
   }
@@ -243,7 +245,8 @@ inline void HitTriangle4(const Target& target, int part_id, int triangle, const 
   const __m128 t = Mul(Add(Add(Mul(e2[0], qx), Mul(e2[1], qy)), Mul(e2[2], qz)), inverse);
   const __m128 slack = _mm_set1_ps(kBarycentricSlack);
   const __m128 one = _mm_set1_ps(1.0f + kBarycentricSlack);
-  __m128 hit = _mm_and_ps(lanes, _mm_cmpgt_ps(_mm_andnot_ps(_mm_set1_ps(-0.0f), det), _mm_set1_ps(1e-20f)));
+  __m128 hit =
+      _mm_and_ps(lanes, _mm_cmpgt_ps(_mm_andnot_ps(_mm_set1_ps(-0.0f), det), _mm_set1_ps(1e-20f)));
   hit = _mm_and_ps(hit, _mm_cmpge_ps(u, _mm_sub_ps(_mm_setzero_ps(), slack)));
   hit = _mm_and_ps(hit, _mm_cmple_ps(u, one));
   hit = _mm_and_ps(hit, _mm_cmpge_ps(v, _mm_sub_ps(_mm_setzero_ps(), slack)));
@@ -253,8 +256,8 @@ inline void HitTriangle4(const Target& target, int part_id, int triangle, const 
   const int mask = _mm_movemask_ps(hit);
   if (mask == 0) return;
   *t_max = _mm_or_ps(_mm_and_ps(hit, t), _mm_andnot_ps(hit, *t_max));
-  const Eigen::Vector3f normal_L = Eigen::Vector3f(e1s[0], e1s[1], e1s[2])
-                                       .cross(Eigen::Vector3f(e2s[0], e2s[1], e2s[2]));
+  const Eigen::Vector3f normal_L =
+      Eigen::Vector3f(e1s[0], e1s[1], e1s[2]).cross(Eigen::Vector3f(e2s[0], e2s[1], e2s[2]));
   const Eigen::Vector3f normal_B = target.R_BL * normal_L;
   for (int lane = 0; lane < 4; ++lane) {
     if (mask & (1 << lane)) {

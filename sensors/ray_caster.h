@@ -4,6 +4,7 @@
 // and the level's own triangle arrays read-only, with its own stack; nothing
 // of Bullet's mutable query state (btCollisionWorld::rayTest) is used.
 
+#include <Eigen/Core>
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
@@ -11,8 +12,6 @@
 #include <mutex>
 #include <thread>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "scene/collision_world.h"
 

@@ -42,7 +42,8 @@ class Settings {
     read_.insert(key);
     const auto it = spec_.params.find(key);
     if (it == spec_.params.end()) return fallback;
-    if (!std::holds_alternative<std::string>(it->second)) Fail(key, "'" + key + "' must be a string");
+    if (!std::holds_alternative<std::string>(it->second))
+      Fail(key, "'" + key + "' must be a string");
     return std::get<std::string>(it->second);
   }
   std::vector<double> Numbers(const std::string& key) {
@@ -58,7 +59,8 @@ class Settings {
 
   void RejectUnknownKeys() const {
     for (const auto& [key, value] : spec_.params) {
-      if (read_.count(key) == 0) Fail(key, "unknown key '" + key + "' for a " + spec_.type + " sensor");
+      if (read_.count(key) == 0)
+        Fail(key, "unknown key '" + key + "' for a " + spec_.type + " sensor");
     }
   }
 
@@ -82,7 +84,8 @@ SensorConfig ReadConfig(const SensorSpec& spec) {
     } else if (refresh == "twelve_stage") {
       face.refresh = Refresh::kTwelveStage;
     } else {
-      read.Fail("refresh", "'refresh' must be full, six_stage or twelve_stage, got '" + refresh + "'");
+      read.Fail("refresh",
+                "'refresh' must be full, six_stage or twelve_stage, got '" + refresh + "'");
     }
     const std::string aligned = read.Text("aligned", "body");
     if (aligned != "body" && aligned != "world") {

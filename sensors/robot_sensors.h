@@ -2,11 +2,10 @@
 // The sensors a level's robots declare ([[robot.sensor]] tables), read into
 // the sensors' own configs, and where each one is at a robot state.
 
+#include <Eigen/Geometry>
 #include <string>
 #include <variant>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "scene/level.h"
 #include "scene/robot_state.h"

@@ -40,7 +40,8 @@ std::string Cone(double radius, double height, int segments) {
     const double a = 2.0 * M_PI * i / segments;
     out << "v " << radius * std::cos(a) << " " << radius * std::sin(a) << " 0\n";
   }
-  for (int i = 0; i < segments; ++i) out << "f 1 " << 2 + i << " " << 2 + (i + 1) % segments << "\n";
+  for (int i = 0; i < segments; ++i)
+    out << "f 1 " << 2 + i << " " << 2 + (i + 1) % segments << "\n";
   return out.str();
 }
 
@@ -168,7 +169,7 @@ TEST(FaceScannerTest, SixStageScansOneFaceATickInOrder) {
   FaceScan half_scan = halves.EmptyScan();
   halves.Scan(world, caster, {}, At(0, 0, 5), 0, &half_scan);
   const ScanFace& first = half_scan.faces[0];
-  EXPECT_NE(first.occupancy[0], kUnvisited);                 // row 0
+  EXPECT_NE(first.occupancy[0], kUnvisited);                     // row 0
   EXPECT_EQ(first.occupancy[std::size_t(50 * 51)], kUnvisited);  // row 50
   halves.Scan(world, caster, {}, At(0, 0, 5), 1, &half_scan);
   EXPECT_NE(first.occupancy[std::size_t(50 * 51)], kUnvisited);
@@ -226,7 +227,8 @@ TEST(FaceScannerTest, BadConfigsNameTheField) {
   EXPECT_EQ(message(config), "resolution_m must be positive, got -1");
   config.resolution_m = 0.01;
   config.half_extent_m = 100;
-  EXPECT_EQ(message(config), "half_extent_m 100 at resolution_m 0.01 makes more than 10 million rays");
+  EXPECT_EQ(message(config),
+            "half_extent_m 100 at resolution_m 0.01 makes more than 10 million rays");
   config = FaceScannerConfig();
   config.half_extent_m = 25.3;
   EXPECT_NE(message(config).find("must be a whole number"), std::string::npos);

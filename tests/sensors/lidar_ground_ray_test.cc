@@ -71,7 +71,8 @@ TEST_F(PlaneTest, LidarCastsEachStepFromThePoseAtItsTime) {
   lidar.Sweep(world_, caster_, {}, start, end, &scan);
   for (int k = 0; k < 100; ++k) {
     const double s = k / 100.0;
-    EXPECT_NEAR(scan.points_W[std::size_t(k)].x(), 10.0 * s, 1e-3) << k;  // channel 0, straight down
+    EXPECT_NEAR(scan.points_W[std::size_t(k)].x(), 10.0 * s, 1e-3)
+        << k;  // channel 0, straight down
     // Channel 1 at 45 degrees down: 10 m out along azimuth 2 pi s + (pi / 2) s.
     const double a = 2 * M_PI * s + M_PI / 2 * s;
     const Vector3d expected(10.0 * s + 10.0 * std::cos(a), 10.0 * std::sin(a), 0.0);
@@ -91,13 +92,15 @@ TEST_F(PlaneTest, GroundScannerAndAltimeter) {
   GroundScanner(config).Scan(world_, caster_, {}, Vector3d(3, 4, 25), &map);  // too high
   for (const double h : map.height_m) EXPECT_TRUE(std::isnan(h));
 
-  const RangeReading down = MeasureRange({}, world_, caster_, {}, Isometry3d(Eigen::Translation3d(0, 0, 7.5)));
+  const RangeReading down =
+      MeasureRange({}, world_, caster_, {}, Isometry3d(Eigen::Translation3d(0, 0, 7.5)));
   EXPECT_TRUE(down.hit);
   EXPECT_NEAR(down.range_m, 7.5, 1e-4);
   EXPECT_NEAR(down.normal_W.z(), 1.0, 1e-6);
   RangeSensorConfig forward;
   forward.direction_S = Vector3d::UnitX();
-  EXPECT_FALSE(MeasureRange(forward, world_, caster_, {}, Isometry3d(Eigen::Translation3d(0, 0, 1))).hit);
+  EXPECT_FALSE(
+      MeasureRange(forward, world_, caster_, {}, Isometry3d(Eigen::Translation3d(0, 0, 1))).hit);
 }
 
 TEST(SensorConfigTest, BadConfigsNameTheField) {

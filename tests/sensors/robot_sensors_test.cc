@@ -98,7 +98,8 @@ TEST(RobotSensorsTest, MistakesNameTheSensorAndField) {
             "level.toml:9: sensor 's': 'channels' must be at least 1");
   EXPECT_EQ(Error("type = \"ray\"\nrange_m = nan\n"),
             "level.toml:9: sensor 's': 'range_m' must be finite, got nan");
-  EXPECT_EQ(Error("type = \"ray\"\nrate_hz = -1\n"), "level.toml:9: sensor 's': 'rate_hz' must be positive");
+  EXPECT_EQ(Error("type = \"ray\"\nrate_hz = -1\n"),
+            "level.toml:9: sensor 's': 'rate_hz' must be positive");
 }
 
 }  // namespace
