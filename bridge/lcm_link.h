@@ -1,0 +1,86 @@
+#pragma once
+// The LCM connection the loop owns, and latest-value input channels on it.
+// Threads: everything here belongs to the loop thread.
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace sandbox::bridge {
+
+// A subscriber URL with a receive buffer big enough for 250 KB messages:
+// UDP multicast URLs ("udpm://...", and LCM's default, the empty URL) get
+// recv_buf_size=4194304 unless they set one; others are returned as they are.
+std::string WithReceiveBuffer(const std::string& url);
+
+class LcmLink {
+ public:
+  // `url` as LCM takes it (empty: LCM's default). Throws std::runtime_error
+  // naming the URL when LCM cannot open it.
+  explicit LcmLink(const std::string& url = "");
+  ~LcmLink();
+  LcmLink(const LcmLink&) = delete;
+  LcmLink& operator=(const LcmLink&) = delete;
+
+  const std::string& url() const { return url_; }
+
+  // Handles every message already waiting, without blocking; returns how many.
+  int Drain();
+  // Publishes raw bytes (an encoded LCM message). Returns false on failure.
+  bool Publish(const std::string& channel, const void* data, unsigned size);
+
+  struct Impl;
+  Impl& impl() { return *impl_; }
+
+ private:
+  std::string url_;
+  std::unique_ptr<Impl> impl_;
+};
+
+// One subscribed channel that keeps only its newest message, copied raw and
+// decoded by the user only when taken. Counts what arrived, what newer
+// messages superseded before anyone took them, and what the user rejected.
+class LatestInput {
+ public:
+  LatestInput(LcmLink& link, std::string channel);
+  ~LatestInput();
+  LatestInput(const LatestInput&) = delete;
+  LatestInput& operator=(const LatestInput&) = delete;
+
+  const std::string& channel() const { return channel_; }
+
+  // The newest message that arrived since the last call, or nullptr.
+  const std::vector<std::uint8_t>* TakeNewest();
+  // Counts a taken message as rejected, by reason; the user keeps its last good value.
+  void Reject(const std::string& reason);
+  // Marks the last taken message as applied (its time makes the input fresh).
+  void Accept(std::int64_t receive_utime);
+
+  std::int64_t received() const { return received_; }
+  std::int64_t superseded() const { return superseded_; }
+  std::int64_t rejected() const { return rejected_; }
+  const std::map<std::string, std::int64_t>& rejected_by_reason() const { return reasons_; }
+  const std::string& last_reject_reason() const { return last_reason_; }
+  std::int64_t last_receive_utime() const { return last_receive_utime_; }
+  std::int64_t last_accept_utime() const { return last_accept_utime_; }
+  // No good message within `max_age_s` of `now_utime` (or never one).
+  bool Stale(std::int64_t now_utime, double max_age_s) const;
+
+  // Called by the subscription (loop thread, inside LcmLink::Drain()).
+  void OnMessage(const void* data, unsigned size, std::int64_t receive_utime);
+
+ private:
+  LcmLink& link_;
+  std::string channel_;
+  void* subscription_{nullptr};
+  std::vector<std::uint8_t> newest_, taken_;
+  bool fresh_{false};
+  std::int64_t received_{0}, superseded_{0}, rejected_{0};
+  std::int64_t last_receive_utime_{0}, last_accept_utime_{-1};
+  std::map<std::string, std::int64_t> reasons_;
+  std::string last_reason_;
+};
+
+}  // namespace sandbox::bridge

@@ -1,0 +1,119 @@
+#include "bridge/robot_inputs.h"
+
+#include <cmath>
+
+#include "sandbox_msgs/actor_placements_t.hpp"
+#include "sandbox_msgs/bone_values_t.hpp"
+#include "sandbox_msgs/robot_pose_t.hpp"
+
+namespace sandbox::bridge {
+namespace {
+
+// Decodes `bytes` as Message; false when they are not exactly one.
+template <typename Message>
+bool Decode(const std::vector<std::uint8_t>& bytes, Message* message) {
+  return message->decode(bytes.data(), 0, static_cast<int>(bytes.size())) ==
+         static_cast<int>(bytes.size());
+}
+
+bool AllFinite(const double* values, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(values[i])) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+RobotInputs::RobotInputs(LcmLink& link, const scene::Level& level, int robot,
+                         const Translation& pose_translation)
+    : level_(level),
+      robot_(robot),
+      translation_(pose_translation),
+      pose_(link, level.robots.at(std::size_t(robot)).name + "/POSE"),
+      bones_(link, level.robots.at(std::size_t(robot)).name + "/BONES"),
+      actors_(link, level.robots.at(std::size_t(robot)).name + "/ACTORS") {}
+
+RobotInputs::Applied RobotInputs::Apply(scene::RobotState* state, scene::CollisionWorld* world) {
+  Applied applied;
+  // Pose.
+  if (const auto* bytes = pose_.TakeNewest()) {
+    sandbox_msgs::robot_pose_t message{};
+    if (!Decode(*bytes, &message)) {
+      pose_.Reject("cannot decode as robot_pose_t");
+    } else if (!AllFinite(message.position, 3) || !AllFinite(message.orientation, 4)) {
+      pose_.Reject("non-finite pose");
+    } else {
+      const Eigen::Quaterniond q(message.orientation[0], message.orientation[1],
+                                 message.orientation[2], message.orientation[3]);
+      if (std::abs(q.norm() - 1.0) > 1e-3) {
+        pose_.Reject("non-unit quaternion");
+      } else if (!state->SetPose(translation_.ToWorld(
+                     Eigen::Vector3d(message.position[0], message.position[1], message.position[2]),
+                     q))) {
+        pose_.Reject(state->last_rejection());
+      } else {
+        pose_.Accept(pose_.last_receive_utime());
+        applied.pose = true;
+        applied.pose_seq = message.seq;
+        applied.pose_utime = message.utime;
+      }
+    }
+  }
+  // Bones.
+  if (const auto* bytes = bones_.TakeNewest()) {
+    sandbox_msgs::bone_values_t message{};
+    const int expected = state->model().num_values;
+    if (!Decode(*bytes, &message)) {
+      bones_.Reject("cannot decode as bone_values_t");
+    } else if (message.num_values != expected) {
+      bones_.Reject("expected " + std::to_string(expected) + " bone values, got " +
+                    std::to_string(message.num_values));
+    } else if (!state->SetBones(message.values)) {
+      bones_.Reject(state->last_rejection());
+    } else {
+      bones_.Accept(bones_.last_receive_utime());
+      applied.bones = true;
+    }
+  }
+  // Actor placements: all of a message or none.
+  if (const auto* bytes = actors_.TakeNewest()) {
+    sandbox_msgs::actor_placements_t message{};
+    std::string reason;
+    std::vector<std::pair<int, Eigen::Isometry3d>> placements;
+    if (!Decode(*bytes, &message)) {
+      reason = "cannot decode as actor_placements_t";
+    } else if (message.num_positions != 3 * message.num_actors ||
+               message.num_orientations != 4 * message.num_actors) {
+      reason = "positions and orientations must hold 3 and 4 values per actor";
+    }
+    for (int i = 0; reason.empty() && i < message.num_actors; ++i) {
+      const int actor = level_.FindActor(message.names[std::size_t(i)]);
+      const double* p = &message.positions[std::size_t(3 * i)];
+      const double* o = &message.orientations[std::size_t(4 * i)];
+      if (actor < 0) {
+        reason = "unknown actor '" + message.names[std::size_t(i)] + "'";
+      } else if (!level_.actors[std::size_t(actor)].movable) {
+        reason = "actor '" + message.names[std::size_t(i)] + "' is not movable";
+      } else if (!AllFinite(p, 3) || !AllFinite(o, 4)) {
+        reason = "non-finite placement";
+      } else if (std::abs(Eigen::Quaterniond(o[0], o[1], o[2], o[3]).norm() - 1.0) > 1e-3) {
+        reason = "non-unit quaternion";
+      } else {
+        placements.emplace_back(actor, Eigen::Translation3d(p[0], p[1], p[2]) *
+                                           Eigen::Quaterniond(o[0], o[1], o[2], o[3]).normalized());
+      }
+    }
+    if (!reason.empty()) {
+      actors_.Reject(reason);
+    } else {
+      for (const auto& [actor, X_WA] : placements) world->SetActorPose(actor, X_WA);
+      actors_.Accept(actors_.last_receive_utime());
+      applied.actors = true;
+    }
+  }
+  if (applied.pose || applied.bones) world->UpdateRobot(robot_, *state);
+  return applied;
+}
+
+}  // namespace sandbox::bridge

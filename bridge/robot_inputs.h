@@ -1,0 +1,45 @@
+#pragma once
+// A robot's inputs from external models: <ROBOT>/POSE (robot_pose_t),
+// <ROBOT>/BONES (bone_values_t) and <ROBOT>/ACTORS (actor_placements_t), each
+// the newest message of its channel, checked, translated and applied; bad
+// messages are rejected, counted by reason, and the last good value stays.
+
+#include <cstdint>
+#include <string>
+
+#include "bridge/lcm_link.h"
+#include "bridge/translation.h"
+#include "scene/collision_world.h"
+#include "scene/level.h"
+#include "scene/robot_state.h"
+
+namespace sandbox::bridge {
+
+class RobotInputs {
+ public:
+  // Subscribes the robot's channels on `link`; `pose_translation` is the
+  // convention its pose publisher speaks. `level` must outlive this.
+  RobotInputs(LcmLink& link, const scene::Level& level, int robot,
+              const Translation& pose_translation = {});
+
+  // What the last Apply() used.
+  struct Applied {
+    bool pose{false}, bones{false}, actors{false};
+    std::int64_t pose_seq{-1}, pose_utime{-1};  // of the pose message applied
+  };
+  // After LcmLink::Drain(): applies the newest good message of each channel to
+  // the robot state and, for actor placements, to the world.
+  Applied Apply(scene::RobotState* state, scene::CollisionWorld* world);
+
+  const LatestInput& pose() const { return pose_; }
+  const LatestInput& bones() const { return bones_; }
+  const LatestInput& actors() const { return actors_; }
+
+ private:
+  const scene::Level& level_;
+  int robot_;
+  Translation translation_;
+  LatestInput pose_, bones_, actors_;
+};
+
+}  // namespace sandbox::bridge

@@ -1,0 +1,161 @@
+// Latest-value inputs over LCM (memq://, one process): newest wins, bad
+// messages are rejected with a reason and the last good value stays.
+
+#include "bridge/robot_inputs.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "sandbox_msgs/actor_placements_t.hpp"
+#include "sandbox_msgs/bone_values_t.hpp"
+#include "sandbox_msgs/robot_pose_t.hpp"
+#include "tests/test_util.h"
+
+namespace sandbox::bridge {
+namespace {
+
+using Eigen::Vector3d;
+
+template <typename Message>
+void Publish(LcmLink& link, const std::string& channel, const Message& message) {
+  std::vector<std::uint8_t> bytes(std::size_t(message.getEncodedSize()));
+  message.encode(bytes.data(), 0, int(bytes.size()));
+  ASSERT_TRUE(link.Publish(channel, bytes.data(), unsigned(bytes.size())));
+}
+
+sandbox_msgs::robot_pose_t Pose(std::int64_t seq, double x, double y, double z) {
+  sandbox_msgs::robot_pose_t pose{};
+  pose.utime = 1000 * seq;
+  pose.seq = seq;
+  pose.position[0] = x, pose.position[1] = y, pose.position[2] = z;
+  pose.orientation[0] = 1.0;
+  return pose;
+}
+
+class RobotInputsTest : public ::testing::Test {
+ protected:
+  RobotInputsTest()
+      : level_(scene::LoadLevel(testing::SampleLevel())),
+        world_(level_),
+        state_(level_.robots.at(0)),
+        link_("memq://"),
+        inputs_(link_, level_, 0) {}
+  scene::Level level_;
+  scene::CollisionWorld world_;
+  scene::RobotState state_;
+  LcmLink link_;
+  RobotInputs inputs_;
+};
+
+TEST_F(RobotInputsTest, NewestPoseWinsAndOlderOnesAreCountedAsSuperseded) {
+  for (int seq = 1; seq <= 5; ++seq) Publish(link_, "ELAHA/POSE", Pose(seq, seq, 0, 50));
+  EXPECT_EQ(link_.Drain(), 5);
+  const RobotInputs::Applied applied = inputs_.Apply(&state_, &world_);
+  EXPECT_TRUE(applied.pose) << inputs_.pose().last_reject_reason();
+  EXPECT_EQ(applied.pose_seq, 5);
+  EXPECT_TRUE(state_.pose().translation().isApprox(Vector3d(5, 0, 50)));
+  EXPECT_EQ(inputs_.pose().received(), 5);
+  EXPECT_EQ(inputs_.pose().superseded(), 4);
+  // Nothing new: nothing applied.
+  link_.Drain();
+  EXPECT_FALSE(inputs_.Apply(&state_, &world_).pose);
+}
+
+TEST_F(RobotInputsTest, BadMessagesAreRejectedAndTheLastGoodValueStays) {
+  Publish(link_, "ELAHA/POSE", Pose(1, 10, 20, 30));
+  link_.Drain();
+  inputs_.Apply(&state_, &world_);
+  // Random bytes on every channel.
+  std::mt19937 random(3);
+  for (const char* channel : {"ELAHA/POSE", "ELAHA/BONES", "ELAHA/ACTORS"}) {
+    std::vector<std::uint8_t> junk(64);
+    for (auto& b : junk) b = std::uint8_t(random());
+    link_.Publish(channel, junk.data(), unsigned(junk.size()));
+    link_.Drain();
+    inputs_.Apply(&state_, &world_);
+  }
+  EXPECT_EQ(inputs_.pose().last_reject_reason(), "cannot decode as robot_pose_t");
+  EXPECT_EQ(inputs_.bones().last_reject_reason(), "cannot decode as bone_values_t");
+  EXPECT_EQ(inputs_.actors().last_reject_reason(), "cannot decode as actor_placements_t");
+  // NaN, a long quaternion.
+  Publish(link_, "ELAHA/POSE", Pose(2, std::nan(""), 0, 0));
+  link_.Drain();
+  inputs_.Apply(&state_, &world_);
+  EXPECT_EQ(inputs_.pose().last_reject_reason(), "non-finite pose");
+  sandbox_msgs::robot_pose_t long_q = Pose(3, 1, 2, 3);
+  long_q.orientation[1] = 1.0;
+  Publish(link_, "ELAHA/POSE", long_q);
+  link_.Drain();
+  inputs_.Apply(&state_, &world_);
+  EXPECT_EQ(inputs_.pose().last_reject_reason(), "non-unit quaternion");
+  EXPECT_TRUE(state_.pose().translation().isApprox(Vector3d(10, 20, 30)));
+  EXPECT_EQ(inputs_.pose().rejected(), 3);
+  // A bone message of the wrong length.
+  sandbox_msgs::bone_values_t bones{};
+  bones.num_values = 10;
+  bones.values.assign(10, 0.0);
+  Publish(link_, "ELAHA/BONES", bones);
+  link_.Drain();
+  inputs_.Apply(&state_, &world_);
+  EXPECT_EQ(inputs_.bones().last_reject_reason(), "expected 45 bone values, got 10");
+  // An unknown actor and a static one.
+  sandbox_msgs::actor_placements_t actors{};
+  actors.num_actors = 1;
+  actors.names = {"drawbridge"};
+  actors.num_positions = 3;
+  actors.positions = {0, 0, 0};
+  actors.num_orientations = 4;
+  actors.orientations = {1, 0, 0, 0};
+  Publish(link_, "ELAHA/ACTORS", actors);
+  link_.Drain();
+  inputs_.Apply(&state_, &world_);
+  EXPECT_EQ(inputs_.actors().last_reject_reason(), "unknown actor 'drawbridge'");
+  actors.names = {"wall"};
+  Publish(link_, "ELAHA/ACTORS", actors);
+  link_.Drain();
+  inputs_.Apply(&state_, &world_);
+  EXPECT_EQ(inputs_.actors().last_reject_reason(), "actor 'wall' is not movable");
+}
+
+TEST_F(RobotInputsTest, BonesAndActorPlacementsApply) {
+  sandbox_msgs::bone_values_t bones{};
+  bones.num_values = 45;
+  bones.values.assign(45, 0.0);
+  const double roll = 4.5 * M_PI / 180.0;
+  for (int b = 1; b <= 10; ++b) bones.values[std::size_t(2 * b)] = roll;  // bone b: values 2b, 2b+1
+  Publish(link_, "ELAHA/BONES", bones);
+  sandbox_msgs::actor_placements_t actors{};
+  actors.num_actors = 1;
+  actors.names = {"gate"};
+  actors.num_positions = 3;
+  actors.positions = {-100, 100, 60};
+  actors.num_orientations = 4;
+  actors.orientations = {1, 0, 0, 0};
+  Publish(link_, "ELAHA/ACTORS", actors);
+  link_.Drain();
+  const RobotInputs::Applied applied = inputs_.Apply(&state_, &world_);
+  EXPECT_TRUE(applied.bones);
+  EXPECT_TRUE(applied.actors);
+  state_.Update();
+  const int r10 = level_.robots[0].bones[10].node;
+  EXPECT_NEAR(Eigen::AngleAxisd(state_.node_poses_B()[std::size_t(r10)].linear()).angle(),
+              10 * roll, 1e-5);
+  EXPECT_EQ(world_.CastRay({-100, 100, 80}, {-100, 100, 0})->actor, level_.FindActor("gate"));
+  EXPECT_FALSE(inputs_.bones().Stale(inputs_.bones().last_receive_utime(), 0.5));
+  EXPECT_TRUE(inputs_.pose().Stale(inputs_.bones().last_receive_utime(), 0.5));  // never came
+}
+
+TEST(LcmLinkTest, MulticastUrlsGetABigReceiveBuffer) {
+  EXPECT_EQ(WithReceiveBuffer(""), "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304");
+  EXPECT_EQ(WithReceiveBuffer("udpm://239.255.76.67:7667"),
+            "udpm://239.255.76.67:7667?recv_buf_size=4194304");
+  EXPECT_EQ(WithReceiveBuffer("udpm://239.255.76.67:7667?recv_buf_size=1000"),
+            "udpm://239.255.76.67:7667?recv_buf_size=1000");
+  EXPECT_EQ(WithReceiveBuffer("memq://"), "memq://");
+  EXPECT_THROW(LcmLink("nonsense://"), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace sandbox::bridge
