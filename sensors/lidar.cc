@@ -78,6 +78,7 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
   caster.Cast(world, rays, filter, &hits);
   const std::size_t n = rays.size();
   scan->channels = config_.channels();
+  scan->origin_W = rays.origin_W;
   scan->azimuth_steps = config_.azimuth_steps;
   scan->range_m = hits.distance_m;
   scan->hit.resize(n);

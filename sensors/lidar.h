@@ -38,6 +38,7 @@ struct LidarScan {
   std::vector<std::uint8_t> hit;          // 1 when the beam hit something
   std::vector<Eigen::Vector3d> points_W;  // the hit, or the beam's end
   std::vector<double> time_s;             // per azimuth step, from the sweep's start
+  Eigen::Vector3d origin_W{Eigen::Vector3d::Zero()};  // the sensor at the sweep's start
 };
 
 class Lidar {

@@ -1,0 +1,193 @@
+#include "app/run_command.h"
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cmath>
+#include <iomanip>
+#include <memory>
+#include <thread>
+#include <variant>
+
+#include "app/command_line.h"
+#include "app/defaults.h"
+#include "bridge/lcm_link.h"
+#include "bridge/outputs.h"
+#include "bridge/robot_inputs.h"
+#include "scene/collision_world.h"
+#include "scene/level.h"
+#include "sensors/robot_sensors.h"
+
+namespace sandbox::app {
+namespace {
+
+const char* kUsage =
+    "usage: sandbox run [LEVEL] [--rate HZ] [--duration S] [--lcm-url URL]\n"
+    "  LEVEL        a level (default: the bundled sample level)\n"
+    "  --rate       loop rate in Hz (default 100)\n"
+    "  --duration   stop after this many seconds (default: run until Ctrl-C)\n"
+    "  --lcm-url    LCM URL (default: LCM's own; multicast URLs get a 4 MB receive buffer)\n"
+    "Inputs per robot: <ROBOT>/POSE, /BONES, /ACTORS. Outputs: <ROBOT>/SCAN_FACE, /GROUND,\n"
+    "/LIDAR, /STATE, /STATUS (docs/bridge.md).\n";
+
+std::atomic<bool> stop_requested{false};
+void OnSignal(int) { stop_requested = true; }
+
+std::int64_t NowUtime() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+// A robot with its state, inputs, outputs and sensors' latest results.
+struct RobotRun {
+  std::unique_ptr<scene::RobotState> state;
+  std::unique_ptr<bridge::RobotInputs> inputs;
+  std::unique_ptr<bridge::RobotOutputs> outputs;
+  bridge::InputTag input;
+  std::vector<double> bone_values;
+};
+
+struct SensorRun {
+  const sensors::MountedSensor* mounted;
+  double next_due_s{0.0};
+  sensors::FaceScan face_scan;
+};
+
+}  // namespace
+
+int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  const auto parsed = ParseArgs(args, "run", {"--rate", "--duration", "--lcm-url"}, {}, kUsage, err);
+  if (!parsed) return 2;
+  if (parsed->help) {
+    out << kUsage;
+    return 0;
+  }
+  try {
+    const double rate_hz =
+        parsed->values.count("--rate") ? ParseNumbers(parsed->Value("--rate"), "--rate").at(0) : 100.0;
+    const double duration_s = parsed->values.count("--duration")
+                                  ? ParseNumbers(parsed->Value("--duration"), "--duration").at(0)
+                                  : -1.0;
+    if (!(rate_hz > 0.0)) throw CommandError("--rate must be positive");
+
+    const scene::Level level = scene::LoadLevel(parsed->level.value_or(kDefaultLevel));
+    const std::vector<sensors::MountedSensor> mounted = sensors::MakeRobotSensors(level);
+    scene::CollisionWorld world(level);
+    bridge::LcmLink link(parsed->Value("--lcm-url"));
+    sensors::RayCaster caster;
+
+    std::vector<RobotRun> robots(level.robots.size());
+    for (std::size_t r = 0; r < level.robots.size(); ++r) {
+      robots[r].state = std::make_unique<scene::RobotState>(level.robots[r]);
+      robots[r].inputs = std::make_unique<bridge::RobotInputs>(link, level, int(r));
+      robots[r].outputs = std::make_unique<bridge::RobotOutputs>(link, level.robots[r].name);
+      robots[r].bone_values.assign(std::size_t(level.robots[r].num_values), 0.0);
+    }
+    std::vector<SensorRun> sensor_runs;
+    for (const sensors::MountedSensor& m : mounted) sensor_runs.push_back({&m, 0.0, {}});
+
+    out << "sandbox run: " << level.name << ", " << level.robots.size() << " robots, "
+        << mounted.size() << " sensors, " << rate_hz << " Hz, LCM " << link.url() << "\n"
+        << std::flush;
+    stop_requested = false;
+    std::signal(SIGINT, OnSignal);
+    std::signal(SIGTERM, OnSignal);
+
+    using Clock = std::chrono::steady_clock;
+    const auto period = std::chrono::duration<double>(1.0 / rate_hz);
+    const auto start = Clock::now();
+    auto deadline = start;
+    std::int64_t tick = 0, overruns = 0;
+    double next_status_s = 0.0, busy_s = 0.0;
+    while (!stop_requested) {
+      const double t = std::chrono::duration<double>(Clock::now() - start).count();
+      if (duration_s >= 0.0 && t >= duration_s) break;
+      const auto tick_start = Clock::now();
+      const std::int64_t now = NowUtime();
+      // 1-2. Inputs: the newest message per channel, applied.
+      link.Drain();
+      for (RobotRun& robot : robots) {
+        const bridge::RobotInputs::Applied applied = robot.inputs->Apply(robot.state.get(), &world);
+        if (applied.pose) robot.input = {applied.pose_seq, applied.pose_utime};
+        if (applied.pose || applied.bones) robot.state->Update();
+      }
+      // 3-4. Sensors that are due, and their outputs.
+      for (SensorRun& run : sensor_runs) {
+        if (t < run.next_due_s) continue;
+        const double rate = run.mounted->spec.rate_hz;
+        run.next_due_s = rate > 0.0 ? std::max(run.next_due_s + 1.0 / rate, t) : t;
+        RobotRun& robot = robots[std::size_t(run.mounted->robot)];
+        sensors::RayFilter filter;
+        filter.ignore_robot = run.mounted->robot;
+        const Eigen::Isometry3d X_WS = run.mounted->Pose(*robot.state);
+        if (const auto* face = std::get_if<sensors::FaceScannerConfig>(&run.mounted->config)) {
+          const sensors::FaceScanner scanner(*face);
+          scanner.Scan(world, caster, filter, X_WS, tick, &run.face_scan);
+          robot.outputs->PublishFaces(run.face_scan, tick, robot.input, now);
+        } else if (const auto* ground = std::get_if<sensors::GroundScannerConfig>(&run.mounted->config)) {
+          sensors::HeightMap map;
+          sensors::GroundScanner(*ground).Scan(world, caster, filter, X_WS.translation(), &map);
+          robot.outputs->PublishGround(map, robot.input, now);
+        } else if (const auto* lidar = std::get_if<sensors::LidarConfig>(&run.mounted->config)) {
+          sensors::LidarScan scan;
+          sensors::Lidar(*lidar).Sweep(world, caster, filter, X_WS, X_WS, &scan);
+          robot.outputs->PublishLidar(scan, robot.input, now);
+        }
+      }
+      for (RobotRun& robot : robots) {
+        robot.outputs->PublishState(*robot.state, robot.bone_values, robot.input, now);
+      }
+      if (t >= next_status_s) {
+        next_status_s = t + 1.0;
+        for (RobotRun& robot : robots) {
+          std::vector<bridge::ChannelStatus> channels;
+          for (const bridge::LatestInput* input :
+               {&robot.inputs->pose(), &robot.inputs->bones(), &robot.inputs->actors()}) {
+            channels.push_back({input->channel(), input->received(), input->superseded(),
+                                input->rejected(), input->Stale(now, 1.0),
+                                input->last_reject_reason()});
+          }
+          const double rate_now = t > 0.0 ? double(tick) / t : 0.0;
+          robot.outputs->PublishStatus(rate_now, tick, overruns, channels, now);
+        }
+      }
+      ++tick;
+      busy_s += std::chrono::duration<double>(Clock::now() - tick_start).count();
+      // 6. Wait for the next tick; a late tick starts the next at once, no catching up.
+      deadline += std::chrono::duration_cast<Clock::duration>(period);
+      const auto after = Clock::now();
+      if (after > deadline) {
+        ++overruns;
+        deadline = after;
+      } else {
+        std::this_thread::sleep_until(deadline);
+      }
+    }
+    std::signal(SIGINT, SIG_DFL);
+    std::signal(SIGTERM, SIG_DFL);
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    out << "sandbox run: " << tick << " ticks in " << std::fixed << std::setprecision(2) << elapsed
+        << " s (" << (elapsed > 0 ? tick / elapsed : 0.0) << " Hz), mean tick "
+        << std::setprecision(3) << (tick > 0 ? 1e3 * busy_s / double(tick) : 0.0) << " ms, "
+        << overruns << " overruns\n";
+    for (const RobotRun& robot : robots) {
+      for (const bridge::LatestInput* input :
+           {&robot.inputs->pose(), &robot.inputs->bones(), &robot.inputs->actors()}) {
+        out << "  " << input->channel() << ": " << input->received() << " received, "
+            << input->superseded() << " superseded, " << input->rejected() << " rejected"
+            << (input->rejected() > 0 ? " (last: " + input->last_reject_reason() + ")" : "")
+            << "\n";
+      }
+    }
+    return 0;
+  } catch (const scene::LevelError& error) {
+    err << "sandbox run: " << error.what() << "\n";
+    return 1;
+  } catch (const std::exception& error) {
+    err << "sandbox run: " << error.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace sandbox::app

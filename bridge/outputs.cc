@@ -1,0 +1,136 @@
+#include "bridge/outputs.h"
+
+#include "sandbox_msgs/ground_map_t.hpp"
+#include "sandbox_msgs/lidar_scan_t.hpp"
+#include "sandbox_msgs/robot_state_t.hpp"
+#include "sandbox_msgs/scan_face_t.hpp"
+#include "sandbox_msgs/status_t.hpp"
+
+namespace sandbox::bridge {
+
+RobotOutputs::RobotOutputs(LcmLink& link, std::string robot_name)
+    : link_(link), prefix_(std::move(robot_name) + "/") {}
+
+template <typename Message>
+void RobotOutputs::Send(const std::string& topic, const Message& message) {
+  buffer_.resize(std::size_t(message.getEncodedSize()));
+  message.encode(buffer_.data(), 0, int(buffer_.size()));
+  if (link_.Publish(prefix_ + topic, buffer_.data(), unsigned(buffer_.size()))) ++published_;
+}
+
+void RobotOutputs::PublishFaces(const sensors::FaceScan& scan, std::int64_t tick,
+                                const InputTag& input, std::int64_t now_utime) {
+  for (int f = 0; f < 6; ++f) {
+    const sensors::ScanFace& face = scan.faces[std::size_t(f)];
+    if (face.tick != tick) continue;
+    sandbox_msgs::scan_face_t message{};
+    message.utime = now_utime;
+    message.seq = seq_++;
+    message.input_seq = input.seq;
+    message.input_utime = input.utime;
+    message.tick = tick;
+    message.face = std::int8_t(f);
+    message.n = scan.n;
+    const Eigen::Vector3d p = face.X_WS.translation();
+    const Eigen::Quaterniond q(face.X_WS.linear());
+    for (int k = 0; k < 3; ++k) message.sensor_position[k] = p[k], message.origin[k] = p[k];
+    message.sensor_orientation[0] = q.w(), message.sensor_orientation[1] = q.x();
+    message.sensor_orientation[2] = q.y(), message.sensor_orientation[3] = q.z();
+    const std::size_t n = face.occupancy.size();
+    message.num_points = int(n);
+    message.occupancy = face.occupancy;
+    message.num_xyz = int(3 * n);
+    message.xyz.resize(3 * n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Eigen::Vector3d offset = face.points_W[i] - p;
+      for (int k = 0; k < 3; ++k) message.xyz[3 * i + std::size_t(k)] = float(offset[k]);
+    }
+    Send("SCAN_FACE", message);
+  }
+}
+
+void RobotOutputs::PublishGround(const sensors::HeightMap& map, const InputTag& input,
+                                 std::int64_t now_utime) {
+  sandbox_msgs::ground_map_t message{};
+  message.utime = now_utime;
+  message.seq = seq_++;
+  message.input_seq = input.seq;
+  message.input_utime = input.utime;
+  message.n = map.n;
+  message.resolution_m = map.resolution_m;
+  message.corner[0] = map.corner_W.x(), message.corner[1] = map.corner_W.y();
+  message.origin_z = 0.0;
+  message.num_points = int(map.height_m.size());
+  message.height.assign(map.height_m.begin(), map.height_m.end());
+  Send("GROUND", message);
+}
+
+void RobotOutputs::PublishLidar(const sensors::LidarScan& scan, const InputTag& input,
+                                std::int64_t now_utime) {
+  sandbox_msgs::lidar_scan_t message{};
+  message.utime = now_utime;
+  message.seq = seq_++;
+  message.input_seq = input.seq;
+  message.input_utime = input.utime;
+  message.channels = scan.channels;
+  message.steps = scan.azimuth_steps;
+  const Eigen::Vector3d& origin = scan.origin_W;
+  for (int k = 0; k < 3; ++k) message.origin[k] = origin[k];
+  const std::size_t n = scan.range_m.size();
+  message.num_beams = int(n);
+  message.range_m = scan.range_m;
+  message.hit.assign(scan.hit.begin(), scan.hit.end());
+  message.num_xyz = int(3 * n);
+  message.xyz.resize(3 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d offset = scan.points_W[i] - origin;
+    for (int k = 0; k < 3; ++k) message.xyz[3 * i + std::size_t(k)] = float(offset[k]);
+  }
+  message.time_s.assign(scan.time_s.begin(), scan.time_s.end());
+  Send("LIDAR", message);
+}
+
+void RobotOutputs::PublishState(const scene::RobotState& state,
+                                const std::vector<double>& bone_values, const InputTag& input,
+                                std::int64_t now_utime) {
+  sandbox_msgs::robot_state_t message{};
+  message.utime = now_utime;
+  message.seq = seq_++;
+  message.input_seq = input.seq;
+  message.input_utime = input.utime;
+  const Eigen::Vector3d p = state.pose().translation();
+  const Eigen::Quaterniond q(state.pose().linear());
+  for (int k = 0; k < 3; ++k) message.position[k] = p[k];
+  message.orientation[0] = q.w(), message.orientation[1] = q.x();
+  message.orientation[2] = q.y(), message.orientation[3] = q.z();
+  message.num_values = int(bone_values.size());
+  message.bone_values = bone_values;
+  // Face frames: at the robot origin, face f's axis along the robot's axis f.
+  for (int f = 0; f < 6; ++f) {
+    message.face_orientations[4 * f] = 1.0;
+  }
+  Send("STATE", message);
+}
+
+void RobotOutputs::PublishStatus(double loop_rate_hz, std::int64_t ticks, std::int64_t overruns,
+                                 const std::vector<ChannelStatus>& channels,
+                                 std::int64_t now_utime) {
+  sandbox_msgs::status_t message{};
+  message.utime = now_utime;
+  message.seq = seq_++;
+  message.loop_rate_hz = loop_rate_hz;
+  message.ticks = ticks;
+  message.overruns = overruns;
+  message.num_channels = int(channels.size());
+  for (const ChannelStatus& c : channels) {
+    message.channels.push_back(c.channel);
+    message.received.push_back(c.received);
+    message.superseded.push_back(c.superseded);
+    message.rejected.push_back(c.rejected);
+    message.stale.push_back(c.stale ? 1 : 0);
+    message.last_reject_reason.push_back(c.last_reject_reason);
+  }
+  Send("STATUS", message);
+}
+
+}  // namespace sandbox::bridge

@@ -1,0 +1,62 @@
+#pragma once
+// What the sandbox publishes for a robot: <ROBOT>/SCAN_FACE, /GROUND, /LIDAR,
+// /STATE and /STATUS, each tagged with the sequence number and time of the
+// pose input it was computed from. Threads: the loop thread.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "bridge/lcm_link.h"
+#include "scene/robot_state.h"
+#include "sensors/face_scanner.h"
+#include "sensors/ground_scanner.h"
+#include "sensors/lidar.h"
+
+namespace sandbox::bridge {
+
+// The input an output was computed from.
+struct InputTag {
+  std::int64_t seq{-1};
+  std::int64_t utime{-1};
+};
+
+// One input channel's counters, for the status heartbeat.
+struct ChannelStatus {
+  std::string channel;
+  std::int64_t received{0}, superseded{0}, rejected{0};
+  bool stale{false};
+  std::string last_reject_reason;
+};
+
+class RobotOutputs {
+ public:
+  RobotOutputs(LcmLink& link, std::string robot_name);
+
+  // Publishes the faces of `scan` scanned at `tick` (the ones this tick refreshed).
+  void PublishFaces(const sensors::FaceScan& scan, std::int64_t tick, const InputTag& input,
+                    std::int64_t now_utime);
+  void PublishGround(const sensors::HeightMap& map, const InputTag& input, std::int64_t now_utime);
+  void PublishLidar(const sensors::LidarScan& scan, const InputTag& input, std::int64_t now_utime);
+  // The robot pose and bones in use, and the face scanner's face frames in
+  // the robot frame (identity rotations for a body-aligned box at the origin).
+  void PublishState(const scene::RobotState& state, const std::vector<double>& bone_values,
+                    const InputTag& input, std::int64_t now_utime);
+  void PublishStatus(double loop_rate_hz, std::int64_t ticks, std::int64_t overruns,
+                     const std::vector<ChannelStatus>& channels, std::int64_t now_utime);
+
+  const std::string& prefix() const { return prefix_; }
+  std::int64_t published() const { return published_; }
+
+ private:
+  template <typename Message>
+  void Send(const std::string& topic, const Message& message);
+
+  LcmLink& link_;
+  std::string prefix_;
+  std::int64_t seq_{0};
+  std::int64_t published_{0};
+  std::vector<std::uint8_t> buffer_;
+};
+
+}  // namespace sandbox::bridge
