@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Three processes over LCM multicast inside a private network namespace
+# (scripts/netns-run): the example model flies the wing, the sandbox runs its
+# loop, and face_check compares the scan faces it receives with one-shot scans
+# at the same poses.
+#
+#   multiprocess.sh SANDBOX FLY_WING FACE_CHECK LEVEL
+set -euo pipefail
+sandbox=$1 fly_wing=$2 face_check=$3 level=$4
+"$sandbox" run "$level" --duration 5 > /tmp/sandbox-multiprocess-run.log &
+run_pid=$!
+"$fly_wing" --duration 4 --rate 200 > /dev/null &
+fly_pid=$!
+sleep 1  # let the first external poses arrive
+"$face_check" "$level" --faces 24 --seconds 3
+status=$?
+wait "$fly_pid" "$run_pid"
+cat /tmp/sandbox-multiprocess-run.log
+exit "$status"
