@@ -200,12 +200,43 @@ std::vector<Eigen::Vector3d> ParseAxes(TableReader& read, const toml::node* node
   return axes;
 }
 
+// Every key of `table` not in `skip`, as given, for another module to read.
+SettingsTable ReadSettings(const fs::path& file, const toml::table& table, TableReader& read,
+                           const std::set<std::string>& skip, const std::string& context) {
+  SettingsTable settings;
+  settings.file = file;
+  settings.line = static_cast<int>(table.source().begin.line);
+  settings.context = context;
+  for (const auto& [key_view, value] : table) {
+    const std::string key(key_view.str());
+    if (skip.count(key) > 0) continue;
+    settings.lines[key] = static_cast<int>(value.source().begin.line);
+    if (value.is_boolean()) {
+      settings.values[key] = *value.value<bool>();
+    } else if (value.is_number()) {
+      settings.values[key] = read.Number(&value, key);
+    } else if (value.is_string()) {
+      settings.values[key] = *value.value<std::string>();
+    } else if (const toml::array* array = value.as_array(); array != nullptr && !array->empty() &&
+                                                            array->is_homogeneous(toml::node_type::string)) {
+      std::vector<std::string> texts;
+      for (const toml::node& item : *array) texts.push_back(*item.value<std::string>());
+      settings.values[key] = texts;
+    } else if (array != nullptr) {
+      std::vector<double> numbers;
+      for (const toml::node& item : *array) numbers.push_back(read.Number(&item, key));
+      settings.values[key] = numbers;
+    } else {
+      read.Fail(&value, "'" + key + "' must be a number, a string, true/false or an array");
+    }
+  }
+  return settings;
+}
+
 // A [[robot.sensor]] table: name, type, mount, placement and rate here; every
 // other key is the sensor's own setting, checked by sensors/.
 SensorSpec ParseSensor(const fs::path& file, const toml::table& table, int index) {
   SensorSpec sensor;
-  sensor.file = file;
-  sensor.line = static_cast<int>(table.source().begin.line);
   sensor.name = ParseName(file, table, "sensor", index);
   TableReader read(file, table, "sensor '" + sensor.name + "': ");
   read.Find("name");
@@ -226,27 +257,10 @@ SensorSpec ParseSensor(const fs::path& file, const toml::table& table, int index
     sensor.rate_hz = *rate;
   }
   // The rest, as given.
-  static const std::set<std::string> kRead = {"name",    "type",      "mount",           "position",
-                                              "rpy_deg", "rate_hz",   "quaternion_wxyz", "scale",
-                                              "up",      "unit_scale"};
-  for (const auto& [key_view, value] : table) {
-    const std::string key(key_view.str());
-    if (kRead.count(key) > 0) continue;
-    sensor.param_lines[key] = static_cast<int>(value.source().begin.line);
-    if (value.is_boolean()) {
-      sensor.params[key] = *value.value<bool>();
-    } else if (value.is_number()) {
-      sensor.params[key] = read.Number(&value, key);
-    } else if (value.is_string()) {
-      sensor.params[key] = *value.value<std::string>();
-    } else if (const toml::array* array = value.as_array()) {
-      std::vector<double> numbers;
-      for (const toml::node& item : *array) numbers.push_back(read.Number(&item, key));
-      sensor.params[key] = numbers;
-    } else {
-      read.Fail(&value, "'" + key + "' must be a number, a string, true/false or numbers");
-    }
-  }
+  sensor.settings = ReadSettings(file, table, read,
+                                 {"name", "type", "mount", "position", "rpy_deg", "rate_hz",
+                                  "quaternion_wxyz", "scale", "up", "unit_scale"},
+                                 "sensor '" + sensor.name + "'");
   return sensor;
 }
 
@@ -317,6 +331,12 @@ RobotSpec ParseRobot(const fs::path& file, const toml::table& table, int index) 
       }
       robot.sensors.push_back(std::move(sensor));
     }
+  }
+  if (const toml::node* bridge = read.Find("bridge")) {
+    if (!bridge->is_table()) read.Fail(bridge, "'bridge' must be a table: [robot.bridge]");
+    TableReader bridge_read(file, *bridge->as_table(), "robot '" + robot.name + "' bridge: ");
+    robot.bridge = ReadSettings(file, *bridge->as_table(), bridge_read, {},
+                                "robot '" + robot.name + "' bridge");
   }
   read.RejectUnknownKeys();
   return robot;

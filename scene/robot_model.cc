@@ -225,10 +225,6 @@ Eigen::Isometry3d RigidPart(const Eigen::Affine3d& X) {
   return out;
 }
 
-std::string SensorSpec::Where() const {
-  return file.string() + ":" + std::to_string(line) + ": sensor '" + name + "': ";
-}
-
 int RobotModel::FindNode(const std::string& node_name) const {
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     if (nodes[i].name == node_name) return static_cast<int>(i);
@@ -262,6 +258,7 @@ RobotModel LoadRobotModel(const RobotSpec& spec, const fs::path& manifest, Level
   model.name = spec.name;
   model.file = spec.file;
   model.collision = spec.collision;
+  model.bridge = spec.bridge;
   model.X_WB_spawn = spec.placement.pose();
 
   Assimp::Importer importer;

@@ -15,6 +15,7 @@
 
 #include "scene/mesh.h"
 #include "scene/placement.h"
+#include "scene/settings.h"
 
 namespace sandbox::scene {
 
@@ -26,9 +27,6 @@ enum class BoneRotation {
   kAngles,      // one angle (radians) per axis, applied in order about the bone's rest axes
 };
 
-// A value of a sensor's own settings, as the manifest gave it.
-using SensorParam = std::variant<double, bool, std::string, std::vector<double>>;
-
 // A [[robot.sensor]] table: a sensor mounted on the robot. The scene keeps its
 // settings as given; sensors/ reads and checks them (it knows each type's keys).
 struct SensorSpec {
@@ -38,13 +36,10 @@ struct SensorSpec {
   int mount_node{-1};  // resolved by LoadRobotModel; -1: the body frame
   Eigen::Isometry3d X_MS{Eigen::Isometry3d::Identity()};  // sensor in its mount's frame
   double rate_hz{0.0};                                    // 0: every tick
-  std::map<std::string, SensorParam> params;
-  std::map<std::string, int> param_lines;  // where each setting stands, for messages
-  std::filesystem::path file;              // the manifest
-  int line{0};
+  SettingsTable settings;  // the type's own settings, as given
 
   // "level.toml:12: sensor 'scanner': " for messages.
-  std::string Where() const;
+  std::string Where() const { return settings.Where(); }
 };
 
 // A [[robot]] table of the level manifest.
@@ -58,6 +53,7 @@ struct RobotSpec {
   std::vector<Eigen::Vector3d> angle_axes;                        // kAngles: the default axes
   std::map<std::string, std::vector<Eigen::Vector3d>> bone_axes;  // per-bone overrides
   std::vector<SensorSpec> sensors;
+  SettingsTable bridge;  // [robot.bridge]: how the bridge connects it (bridge/ reads it)
   int line{0};
 };
 
@@ -124,6 +120,7 @@ struct RobotModel {
   Eigen::Isometry3d X_WB_spawn{Eigen::Isometry3d::Identity()};
   bool collision{true};
   std::vector<SensorSpec> sensors;  // mounts resolved
+  SettingsTable bridge;
 
   int FindNode(const std::string& node_name) const;  // -1 when absent
   int FindBone(const std::string& bone_name) const;  // -1 when absent

@@ -1,7 +1,6 @@
 #include "sensors/robot_sensors.h"
 
 #include <cmath>
-#include <set>
 #include <stdexcept>
 
 namespace sandbox::sensors {
@@ -10,67 +9,8 @@ namespace {
 using scene::LevelError;
 using scene::SensorSpec;
 
-// Typed access to a sensor's settings; remembers which keys were read.
-class Settings {
- public:
-  explicit Settings(const SensorSpec& spec) : spec_(spec) {}
-
-  [[noreturn]] void Fail(const std::string& key, const std::string& what) const {
-    const auto line = spec_.param_lines.find(key);
-    const std::string where = line == spec_.param_lines.end()
-                                  ? spec_.Where()
-                                  : spec_.file.string() + ":" + std::to_string(line->second) +
-                                        ": sensor '" + spec_.name + "': ";
-    throw LevelError(where + what);
-  }
-
-  double Number(const std::string& key, double fallback) {
-    read_.insert(key);
-    const auto it = spec_.params.find(key);
-    if (it == spec_.params.end()) return fallback;
-    if (!std::holds_alternative<double>(it->second)) Fail(key, "'" + key + "' must be a number");
-    return std::get<double>(it->second);
-  }
-  int Whole(const std::string& key, int fallback) {
-    const double value = Number(key, fallback);
-    if (value != std::floor(value) || std::abs(value) > 1e9) {
-      Fail(key, "'" + key + "' must be a whole number");
-    }
-    return static_cast<int>(value);
-  }
-  std::string Text(const std::string& key, const std::string& fallback) {
-    read_.insert(key);
-    const auto it = spec_.params.find(key);
-    if (it == spec_.params.end()) return fallback;
-    if (!std::holds_alternative<std::string>(it->second))
-      Fail(key, "'" + key + "' must be a string");
-    return std::get<std::string>(it->second);
-  }
-  std::vector<double> Numbers(const std::string& key) {
-    read_.insert(key);
-    const auto it = spec_.params.find(key);
-    if (it == spec_.params.end()) return {};
-    if (!std::holds_alternative<std::vector<double>>(it->second)) {
-      Fail(key, "'" + key + "' must be an array of numbers");
-    }
-    return std::get<std::vector<double>>(it->second);
-  }
-  bool Has(const std::string& key) const { return spec_.params.count(key) > 0; }
-
-  void RejectUnknownKeys() const {
-    for (const auto& [key, value] : spec_.params) {
-      if (read_.count(key) == 0)
-        Fail(key, "unknown key '" + key + "' for a " + spec_.type + " sensor");
-    }
-  }
-
- private:
-  const SensorSpec& spec_;
-  std::set<std::string> read_;
-};
-
 SensorConfig ReadConfig(const SensorSpec& spec) {
-  Settings read(spec);
+  scene::SettingsReader read(spec.settings);
   SensorConfig config;
   if (spec.type == "face") {
     FaceScannerConfig face;
@@ -125,7 +65,7 @@ SensorConfig ReadConfig(const SensorSpec& spec) {
     ray.range_m = read.Number("range_m", ray.range_m);
     config = ray;
   }
-  read.RejectUnknownKeys();
+  read.RejectUnknownKeys(spec.type + " sensor");
   // The config's own checks, named with the sensor.
   try {
     std::visit([](const auto& c) { c.ValidateOrThrow(); }, config);

@@ -1,0 +1,54 @@
+#pragma once
+// Settings of a manifest table that another module interprets (a sensor's,
+// a robot's bridge): kept as given, with where each stands, and read with one
+// clear LevelError per mistake.
+
+#include <filesystem>
+#include <map>
+#include <set>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "scene/placement.h"
+
+namespace sandbox::scene {
+
+using SettingValue =
+    std::variant<double, bool, std::string, std::vector<double>, std::vector<std::string>>;
+
+struct SettingsTable {
+  std::map<std::string, SettingValue> values;
+  std::map<std::string, int> lines;  // the line of each key
+  std::filesystem::path file;        // the manifest
+  int line{0};                       // the table's line
+  std::string context;               // "sensor 'scanner'", "robot 'ELAHA' bridge"
+
+  // "level.toml:12: sensor 'scanner': ", at the key's line when it is known.
+  std::string Where(const std::string& key = "") const;
+};
+
+// Typed access; remembers which keys were read so that the rest can be
+// rejected as unknown.
+class SettingsReader {
+ public:
+  explicit SettingsReader(const SettingsTable& table) : table_(table) {}
+
+  [[noreturn]] void Fail(const std::string& key, const std::string& what) const;
+  double Number(const std::string& key, double fallback);
+  int Whole(const std::string& key, int fallback);
+  bool Flag(const std::string& key, bool fallback);
+  std::string Text(const std::string& key, const std::string& fallback);
+  std::vector<double> Numbers(const std::string& key);
+  std::vector<std::string> Texts(const std::string& key);
+  bool Has(const std::string& key) const { return table_.values.count(key) > 0; }
+  // Throws for every key not read, naming `kind` ("face sensor").
+  void RejectUnknownKeys(const std::string& kind) const;
+
+ private:
+  const SettingValue* Find(const std::string& key);
+  const SettingsTable& table_;
+  std::set<std::string> read_;
+};
+
+}  // namespace sandbox::scene
