@@ -14,6 +14,7 @@
 #include "bridge/lcm_link.h"
 #include "bridge/outputs.h"
 #include "bridge/robot_inputs.h"
+#include "bridge/udp_inputs.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
 #include "sensors/robot_sensors.h"
@@ -41,8 +42,11 @@ std::int64_t NowUtime() {
 
 // A robot with its state, inputs, outputs and sensors' latest results.
 struct RobotRun {
+  bridge::RobotBridgeConfig config;
   std::unique_ptr<scene::RobotState> state;
   std::unique_ptr<bridge::RobotInputs> inputs;
+  std::unique_ptr<bridge::NetFdmInput> net_fdm;
+  std::unique_ptr<bridge::DoublesInput> doubles;
   std::unique_ptr<bridge::RobotOutputs> outputs;
   bridge::InputTag input;
   std::vector<double> bone_values;
@@ -79,9 +83,19 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
 
     std::vector<RobotRun> robots(level.robots.size());
     for (std::size_t r = 0; r < level.robots.size(); ++r) {
+      robots[r].config = bridge::RobotBridgeConfig::FromModel(level.robots[r]);
       robots[r].state = std::make_unique<scene::RobotState>(level.robots[r]);
-      robots[r].inputs = std::make_unique<bridge::RobotInputs>(link, level, int(r));
-      robots[r].outputs = std::make_unique<bridge::RobotOutputs>(link, level.robots[r].name);
+      robots[r].inputs =
+          std::make_unique<bridge::RobotInputs>(link, level, int(r), robots[r].config);
+      robots[r].outputs =
+          std::make_unique<bridge::RobotOutputs>(link, robots[r].config.channel_prefix);
+      if (robots[r].config.net_fdm_port > 0) {
+        robots[r].net_fdm = std::make_unique<bridge::NetFdmInput>(robots[r].config);
+      }
+      if (robots[r].config.udp_doubles_port > 0) {
+        robots[r].doubles =
+            std::make_unique<bridge::DoublesInput>(robots[r].config, level.robots[r]);
+      }
       robots[r].bone_values.assign(std::size_t(level.robots[r].num_values), 0.0);
     }
     std::vector<SensorRun> sensor_runs;
@@ -110,7 +124,19 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       for (RobotRun& robot : robots) {
         const bridge::RobotInputs::Applied applied = robot.inputs->Apply(robot.state.get(), &world);
         if (applied.pose) robot.input = {applied.pose_seq, applied.pose_utime};
-        if (applied.pose || applied.bones) robot.state->Update();
+        bool moved = applied.pose || applied.bones;
+        if (robot.net_fdm && robot.net_fdm->Apply(robot.state.get())) {
+          moved = true;
+          robot.input = {robot.net_fdm->socket().received(), now};
+        }
+        if (robot.doubles && robot.doubles->Apply(robot.state.get())) {
+          moved = true;
+          robot.input = {robot.doubles->socket().received(), now};
+        }
+        if (moved) {
+          robot.state->Update();
+          world.UpdateRobot(int(&robot - robots.data()), *robot.state);
+        }
       }
       // 3-4. Sensors that are due, and their outputs.
       for (SensorRun& run : sensor_runs) {
@@ -145,8 +171,15 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
           for (const bridge::LatestInput* input :
                {&robot.inputs->pose(), &robot.inputs->bones(), &robot.inputs->actors()}) {
             channels.push_back({input->channel(), input->received(), input->superseded(),
-                                input->rejected(), input->Stale(now, 1.0),
+                                input->rejected(), input->Stale(now, robot.config.stale_after_s),
                                 input->last_reject_reason()});
+          }
+          for (const bridge::UdpLatest* socket :
+               {robot.net_fdm ? &robot.net_fdm->socket() : nullptr,
+                robot.doubles ? &robot.doubles->socket() : nullptr}) {
+            if (socket == nullptr) continue;
+            channels.push_back({socket->name(), socket->received(), socket->superseded(),
+                                socket->rejected(), false, socket->last_reject_reason()});
           }
           const double rate_now = t > 0.0 ? double(tick) / t : 0.0;
           robot.outputs->PublishStatus(rate_now, tick, overruns, channels, now);

@@ -25,14 +25,17 @@ bool AllFinite(const double* values, std::size_t n) {
 
 }  // namespace
 
-RobotInputs::RobotInputs(LcmLink& link, const scene::Level& level, int robot,
-                         const Translation& pose_translation)
+RobotInputs::RobotInputs(LcmLink& link, const scene::Level& level, int /*robot*/,
+                         const RobotBridgeConfig& config)
     : level_(level),
-      robot_(robot),
-      translation_(pose_translation),
-      pose_(link, level.robots.at(std::size_t(robot)).name + "/POSE"),
-      bones_(link, level.robots.at(std::size_t(robot)).name + "/BONES"),
-      actors_(link, level.robots.at(std::size_t(robot)).name + "/ACTORS") {}
+      translation_(config.pose),
+      pose_(link, config.channel_prefix + "/POSE"),
+      bones_(link, config.channel_prefix + "/BONES"),
+      actors_(link, config.channel_prefix + "/ACTORS") {}
+
+RobotInputs::RobotInputs(LcmLink& link, const scene::Level& level, int robot)
+    : RobotInputs(link, level, robot,
+                  RobotBridgeConfig::FromModel(level.robots.at(std::size_t(robot)))) {}
 
 RobotInputs::Applied RobotInputs::Apply(scene::RobotState* state, scene::CollisionWorld* world) {
   Applied applied;
@@ -112,7 +115,6 @@ RobotInputs::Applied RobotInputs::Apply(scene::RobotState* state, scene::Collisi
       applied.actors = true;
     }
   }
-  if (applied.pose || applied.bones) world->UpdateRobot(robot_, *state);
   return applied;
 }
 

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "bridge/lcm_link.h"
+#include "bridge/robot_bridge_config.h"
 #include "bridge/translation.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
@@ -17,10 +18,13 @@ namespace sandbox::bridge {
 
 class RobotInputs {
  public:
-  // Subscribes the robot's channels on `link`; `pose_translation` is the
-  // convention its pose publisher speaks. `level` must outlive this.
+  // Subscribes the robot's channels (<prefix>/POSE, /BONES, /ACTORS) on
+  // `link`; the config also says the convention its pose publisher speaks.
+  // `level` must outlive this.
   RobotInputs(LcmLink& link, const scene::Level& level, int robot,
-              const Translation& pose_translation = {});
+              const RobotBridgeConfig& config);
+  // With the robot's own [robot.bridge] settings.
+  RobotInputs(LcmLink& link, const scene::Level& level, int robot);
 
   // What the last Apply() used.
   struct Applied {
@@ -28,7 +32,9 @@ class RobotInputs {
     std::int64_t pose_seq{-1}, pose_utime{-1};  // of the pose message applied
   };
   // After LcmLink::Drain(): applies the newest good message of each channel to
-  // the robot state and, for actor placements, to the world.
+  // the robot state and, for actor placements, to the world. The caller then
+  // runs RobotState::Update() and CollisionWorld::UpdateRobot() when the pose
+  // or bones changed.
   Applied Apply(scene::RobotState* state, scene::CollisionWorld* world);
 
   const LatestInput& pose() const { return pose_; }
@@ -37,7 +43,6 @@ class RobotInputs {
 
  private:
   const scene::Level& level_;
-  int robot_;
   Translation translation_;
   LatestInput pose_, bones_, actors_;
 };

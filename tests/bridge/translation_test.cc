@@ -56,17 +56,21 @@ TEST(TranslationTest, UnrealIsLeftHandedCentimetres) {
 }
 
 TEST(TranslationTest, GeodeticLocalTangentPlane) {
-  // Origin at 47 N, 8 E, 500 m. One arc second of latitude north is 30.87 m.
+  // Origin at 47 N, 8 E, 500 m. One arc second of latitude north is the
+  // meridian radius of curvature there (plus the altitude) times the step.
+  const double e2 = 0.00669437999014, s47 = std::sin(47.0 * M_PI / 180.0);
+  const double meridian = 6378137.0 * (1 - e2) / std::pow(1 - e2 * s47 * s47, 1.5);
+  const double north_m = (meridian + 500.0) * (1.0 / 3600.0) * M_PI / 180.0;
   Translation geo{Convention::kGeodetic, {47.0, 8.0, 500.0}};
   const Eigen::Isometry3d north =
       geo.ToWorld(Vector3d(47.0 + 1.0 / 3600.0, 8.0, 500.0), NedAttitude(0, 0, 0));
-  EXPECT_NEAR(north.translation().y(), 30.87, 0.02);
+  EXPECT_NEAR(north.translation().y(), north_m, 1e-3);
   EXPECT_NEAR(north.translation().x(), 0.0, 1e-6);
   EXPECT_NEAR(north.translation().z(), 0.0, 1e-3);  // curvature over 31 m: under 0.1 mm
   // Heading north: nose along world +y, tilted down by the earth's curvature
   // over 31 m (31 / 6.37e6 = 4.9e-6 rad).
   EXPECT_TRUE((north.linear() * Vector3d::UnitX()).isApprox(Vector3d::UnitY(), 1e-5));
-  EXPECT_NEAR((north.linear() * Vector3d::UnitX()).z(), -30.87 / 6.37e6, 2e-7);
+  EXPECT_NEAR((north.linear() * Vector3d::UnitX()).z(), -north_m / 6.37e6, 2e-7);
   // Straight up 100 m.
   EXPECT_NEAR(geo.ToWorld(Vector3d(47.0, 8.0, 600.0), NedAttitude(0, 0, 0)).translation().z(),
               100.0, 1e-6);

@@ -1,0 +1,79 @@
+#pragma once
+// Inputs for senders without LCM (Simulink's UDP Send block, its FlightGear
+// blocks): a UDP socket bound to bind_address:port that keeps only the newest
+// datagram, decoded and applied to a robot like the LCM inputs, with the same
+// counting of superseded and rejected packets. Threads: the loop thread.
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "bridge/net_fdm.h"
+#include "bridge/robot_bridge_config.h"
+#include "scene/robot_state.h"
+
+namespace sandbox::bridge {
+
+// A non-blocking UDP socket that keeps the newest datagram.
+class UdpLatest {
+ public:
+  // Throws std::runtime_error naming the address and port when it cannot bind.
+  UdpLatest(const std::string& address, int port);
+  ~UdpLatest();
+  UdpLatest(const UdpLatest&) = delete;
+  UdpLatest& operator=(const UdpLatest&) = delete;
+
+  // Reads every waiting datagram; returns the newest or nullptr.
+  const std::vector<std::uint8_t>* TakeNewest();
+  void Reject(const std::string& reason);
+
+  const std::string& name() const { return name_; }  // "udp:127.0.0.1:5505"
+  std::int64_t received() const { return received_; }
+  std::int64_t superseded() const { return superseded_; }
+  std::int64_t rejected() const { return rejected_; }
+  const std::string& last_reject_reason() const { return last_reason_; }
+  const std::map<std::string, std::int64_t>& rejected_by_reason() const { return reasons_; }
+
+ private:
+  int socket_{-1};
+  std::string name_;
+  std::vector<std::uint8_t> buffer_, newest_;
+  std::int64_t received_{0}, superseded_{0}, rejected_{0};
+  std::map<std::string, std::int64_t> reasons_;
+  std::string last_reason_;
+};
+
+// FlightGear net_fdm: geodetic position and NED attitude drive the robot
+// pose; control-surface fields drive the bones the config names.
+class NetFdmInput {
+ public:
+  NetFdmInput(const RobotBridgeConfig& config);
+  // Applies the newest good packet; true when the pose changed.
+  bool Apply(scene::RobotState* state);
+  const UdpLatest& socket() const { return socket_; }
+  const NetFdm& last_good() const { return last_; }
+
+ private:
+  RobotBridgeConfig config_;
+  UdpLatest socket_;
+  NetFdm last_;
+  std::vector<double> values_;  // bone values kept between packets
+};
+
+// A plain vector of doubles in the configured layout and byte order.
+class DoublesInput {
+ public:
+  DoublesInput(const RobotBridgeConfig& config, const scene::RobotModel& model);
+  bool Apply(scene::RobotState* state);
+  const UdpLatest& socket() const { return socket_; }
+  std::size_t expected_doubles() const { return expected_; }
+
+ private:
+  RobotBridgeConfig config_;
+  UdpLatest socket_;
+  std::size_t expected_{0};
+  int num_values_{0};
+};
+
+}  // namespace sandbox::bridge
