@@ -81,6 +81,7 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     bridge::LcmLink link(parsed->Value("--lcm-url"));
     sensors::RayCaster caster;
 
+    bridge::RejectLog reject_log(&err);
     std::vector<RobotRun> robots(level.robots.size());
     for (std::size_t r = 0; r < level.robots.size(); ++r) {
       robots[r].config = bridge::RobotBridgeConfig::FromModel(level.robots[r]);
@@ -89,12 +90,15 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
           std::make_unique<bridge::RobotInputs>(link, level, int(r), robots[r].config);
       robots[r].outputs =
           std::make_unique<bridge::RobotOutputs>(link, robots[r].config.channel_prefix);
+      robots[r].inputs->set_log(&reject_log);
       if (robots[r].config.net_fdm_port > 0) {
         robots[r].net_fdm = std::make_unique<bridge::NetFdmInput>(robots[r].config);
+        robots[r].net_fdm->set_log(&reject_log);
       }
       if (robots[r].config.udp_doubles_port > 0) {
         robots[r].doubles =
             std::make_unique<bridge::DoublesInput>(robots[r].config, level.robots[r]);
+        robots[r].doubles->set_log(&reject_log);
       }
       robots[r].bone_values.assign(std::size_t(level.robots[r].num_values), 0.0);
     }

@@ -72,6 +72,7 @@ void LatestInput::Reject(const std::string& reason) {
   ++rejected_;
   ++reasons_[reason];
   last_reason_ = reason;
+  if (log_ != nullptr) log_->Note(channel_, reason);
 }
 
 void LatestInput::Accept(std::int64_t receive_utime) { last_accept_utime_ = receive_utime; }

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "bridge/reject_log.h"
+
 namespace sandbox::bridge {
 
 // A subscriber URL with a receive buffer big enough for 250 KB messages:
@@ -55,6 +57,8 @@ class LatestInput {
   const std::vector<std::uint8_t>* TakeNewest();
   // Counts a taken message as rejected, by reason; the user keeps its last good value.
   void Reject(const std::string& reason);
+  // Where rejections are also logged, once per cause per second (nullptr: nowhere).
+  void set_log(RejectLog* log) { log_ = log; }
   // Marks the last taken message as applied (its time makes the input fresh).
   void Accept(std::int64_t receive_utime);
 
@@ -80,6 +84,7 @@ class LatestInput {
   std::int64_t received_{0}, superseded_{0}, rejected_{0};
   std::int64_t last_receive_utime_{0}, last_accept_utime_{-1};
   std::map<std::string, std::int64_t> reasons_;
+  RejectLog* log_{nullptr};
   std::string last_reason_;
 };
 

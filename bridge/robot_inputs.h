@@ -40,6 +40,10 @@ class RobotInputs {
   const LatestInput& pose() const { return pose_; }
   const LatestInput& bones() const { return bones_; }
   const LatestInput& actors() const { return actors_; }
+  // Logs rejections of all three inputs to `log`.
+  void set_log(RejectLog* log) {
+    pose_.set_log(log), bones_.set_log(log), actors_.set_log(log);
+  }
 
  private:
   const scene::Level& level_;

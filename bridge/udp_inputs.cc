@@ -48,6 +48,7 @@ void UdpLatest::Reject(const std::string& reason) {
   ++rejected_;
   ++reasons_[reason];
   last_reason_ = reason;
+  if (log_ != nullptr) log_->Note(name_, reason);
 }
 
 NetFdmInput::NetFdmInput(const RobotBridgeConfig& config)

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "bridge/reject_log.h"
+
 #include "bridge/net_fdm.h"
 #include "bridge/robot_bridge_config.h"
 #include "scene/robot_state.h"
@@ -27,6 +29,8 @@ class UdpLatest {
   // Reads every waiting datagram; returns the newest or nullptr.
   const std::vector<std::uint8_t>* TakeNewest();
   void Reject(const std::string& reason);
+  // Where rejections are also logged, once per cause per second (nullptr: nowhere).
+  void set_log(RejectLog* log) { log_ = log; }
 
   const std::string& name() const { return name_; }  // "udp:127.0.0.1:5505"
   std::int64_t received() const { return received_; }
@@ -41,6 +45,7 @@ class UdpLatest {
   std::vector<std::uint8_t> buffer_, newest_;
   std::int64_t received_{0}, superseded_{0}, rejected_{0};
   std::map<std::string, std::int64_t> reasons_;
+  RejectLog* log_{nullptr};
   std::string last_reason_;
 };
 
@@ -52,6 +57,7 @@ class NetFdmInput {
   // Applies the newest good packet; true when the pose changed.
   bool Apply(scene::RobotState* state);
   const UdpLatest& socket() const { return socket_; }
+  void set_log(RejectLog* log) { socket_.set_log(log); }
   const NetFdm& last_good() const { return last_; }
 
  private:
@@ -67,6 +73,7 @@ class DoublesInput {
   DoublesInput(const RobotBridgeConfig& config, const scene::RobotModel& model);
   bool Apply(scene::RobotState* state);
   const UdpLatest& socket() const { return socket_; }
+  void set_log(RejectLog* log) { socket_.set_log(log); }
   std::size_t expected_doubles() const { return expected_; }
 
  private:

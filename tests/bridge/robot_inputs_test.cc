@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <random>
+#include <sstream>
 
 #include "sandbox_msgs/actor_placements_t.hpp"
 #include "sandbox_msgs/bone_values_t.hpp"
@@ -155,6 +156,24 @@ TEST(LcmLinkTest, MulticastUrlsGetABigReceiveBuffer) {
             "udpm://239.255.76.67:7667?recv_buf_size=1000");
   EXPECT_EQ(WithReceiveBuffer("memq://"), "memq://");
   EXPECT_THROW(LcmLink("nonsense://"), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace sandbox::bridge
+
+namespace sandbox::bridge {
+namespace {
+
+TEST(RejectLogTest, OncePerCausePerSecond) {
+  std::ostringstream out;
+  RejectLog log(&out);
+  for (int i = 0; i < 5; ++i) log.Note("ELAHA/POSE", "non-finite pose");
+  log.Note("ELAHA/POSE", "non-unit quaternion");
+  log.Note("ELAHA/BONES", "non-finite pose");
+  EXPECT_EQ(out.str(),
+            "sandbox: ELAHA/POSE: rejected (non-finite pose)\n"
+            "sandbox: ELAHA/POSE: rejected (non-unit quaternion)\n"
+            "sandbox: ELAHA/BONES: rejected (non-finite pose)\n");
 }
 
 }  // namespace
