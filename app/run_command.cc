@@ -216,6 +216,15 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
             << (input->rejected() > 0 ? " (last: " + input->last_reject_reason() + ")" : "")
             << "\n";
       }
+      for (const bridge::UdpLatest* socket :
+           {robot.net_fdm ? &robot.net_fdm->socket() : nullptr,
+            robot.doubles ? &robot.doubles->socket() : nullptr}) {
+        if (socket == nullptr) continue;
+        out << "  " << socket->name() << ": " << socket->received() << " received, "
+            << socket->superseded() << " superseded, " << socket->rejected() << " rejected"
+            << (socket->rejected() > 0 ? " (last: " + socket->last_reject_reason() + ")" : "")
+            << "\n";
+      }
     }
     return 0;
   } catch (const scene::LevelError& error) {
