@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Record and replay a session with LCM's own tools, inside a private network
+# namespace (scripts/netns-run): lcm-logger records the example model's
+# flight; lcm-logplayer replays the log into a running sandbox, whose scan
+# faces face_check compares with one-shot scans at the replayed poses.
+#
+#   log_replay.sh SANDBOX FLY_WING FACE_CHECK LEVEL
+set -euo pipefail
+sandbox=$1 fly_wing=$2 face_check=$3 level=$4
+log=$(mktemp /tmp/sandbox-flight-XXXXXX.lcmlog)
+trap 'rm -f "$log"' EXIT
+lcm-logger --force --channel='ELAHA/(POSE|BONES)' "$log" > /dev/null &
+logger_pid=$!
+sleep 0.3
+published=$("$fly_wing" --duration 2 --rate 100 | sed -n 's/fly_wing: published \([0-9]*\) poses/\1/p')
+sleep 0.3
+kill -INT "$logger_pid"
+wait "$logger_pid" || true
+echo "recorded $(stat -c %s "$log") bytes"
+"$sandbox" run "$level" --duration 4 > /tmp/sandbox-replay-run.log &
+run_pid=$!
+sleep 0.3
+lcm-logplayer "$log" &
+player_pid=$!
+"$face_check" "$level" --faces 12 --seconds 3
+status=$?
+wait "$player_pid" "$run_pid"
+cat /tmp/sandbox-replay-run.log
+# Every pose recorded reached the sandbox (the log plays at recorded speed).
+grep -q "ELAHA/POSE: $published received" /tmp/sandbox-replay-run.log ||
+  { echo "not all $published logged poses arrived"; status=1; }
+exit "$status"
