@@ -2,14 +2,10 @@
 
 #include <stdexcept>
 
-#include <lcm/lcm-cpp.hpp>
+#include "bridge/lcm_link_impl.h"
 
 namespace sandbox::bridge {
 
-struct LcmLink::Impl {
-  explicit Impl(const std::string& url) : lcm(url) {}
-  lcm::LCM lcm;
-};
 
 std::string WithReceiveBuffer(const std::string& url) {
   const bool multicast = url.empty() || url.rfind("udpm://", 0) == 0;

@@ -1,0 +1,76 @@
+#include "bridge/topics.h"
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+
+#include "bridge/lcm_link_impl.h"
+
+#include "sandbox_msgs/actor_placements_t.hpp"
+#include "sandbox_msgs/bone_values_t.hpp"
+#include "sandbox_msgs/camera_command_t.hpp"
+#include "sandbox_msgs/ground_map_t.hpp"
+#include "sandbox_msgs/lidar_scan_t.hpp"
+#include "sandbox_msgs/robot_pose_t.hpp"
+#include "sandbox_msgs/robot_state_t.hpp"
+#include "sandbox_msgs/scan_face_t.hpp"
+#include "sandbox_msgs/status_t.hpp"
+#include "sandbox_msgs/wrench_t.hpp"
+
+namespace sandbox::bridge {
+namespace {
+
+// The type whose fingerprint leads a message (the first 8 bytes, big-endian).
+std::string TypeOf(const std::uint8_t* data, std::uint32_t size) {
+  if (size < 8) return "?";
+  std::int64_t hash = 0;
+  for (int i = 0; i < 8; ++i) hash = (hash << 8) | data[i];
+  using namespace sandbox_msgs;
+  const std::pair<std::int64_t, const char*> known[] = {
+      {robot_pose_t::getHash(), "robot_pose_t"},   {bone_values_t::getHash(), "bone_values_t"},
+      {actor_placements_t::getHash(), "actor_placements_t"},
+      {camera_command_t::getHash(), "camera_command_t"},
+      {scan_face_t::getHash(), "scan_face_t"},     {ground_map_t::getHash(), "ground_map_t"},
+      {lidar_scan_t::getHash(), "lidar_scan_t"},   {robot_state_t::getHash(), "robot_state_t"},
+      {wrench_t::getHash(), "wrench_t"},           {status_t::getHash(), "status_t"}};
+  for (const auto& [known_hash, name] : known) {
+    if (known_hash == hash) return name;
+  }
+  char text[24];
+  std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(hash));
+  return text;
+}
+
+struct Collector {
+  std::map<std::string, ChannelStats>* stats;
+  void On(const lcm::ReceiveBuffer* buffer, const std::string& channel) {
+    ChannelStats& s = (*stats)[channel];
+    if (s.messages == 0) {
+      s.first_utime = buffer->recv_utime;
+      s.type = TypeOf(static_cast<const std::uint8_t*>(buffer->data), buffer->data_size);
+    }
+    ++s.messages;
+    s.bytes += buffer->data_size;
+    s.last_utime = buffer->recv_utime;
+  }
+};
+
+}  // namespace
+
+double ChannelStats::rate_hz() const {
+  return messages > 1 && last_utime > first_utime
+             ? double(messages - 1) / (double(last_utime - first_utime) * 1e-6)
+             : 0.0;
+}
+
+std::map<std::string, ChannelStats> ListenToAll(LcmLink& link, double seconds) {
+  std::map<std::string, ChannelStats> stats;
+  Collector collector{&stats};
+  lcm::Subscription* subscription = link.impl().lcm.subscribe(".*", &Collector::On, &collector);
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < end) link.impl().lcm.handleTimeout(20);
+  link.impl().lcm.unsubscribe(subscription);
+  return stats;
+}
+
+}  // namespace sandbox::bridge
