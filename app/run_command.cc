@@ -2,8 +2,8 @@
 
 #include <atomic>
 #include <chrono>
-#include <csignal>
 #include <cmath>
+#include <csignal>
 #include <iomanip>
 #include <memory>
 #include <thread>
@@ -61,15 +61,17 @@ struct SensorRun {
 }  // namespace
 
 int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  const auto parsed = ParseArgs(args, "run", {"--rate", "--duration", "--lcm-url"}, {}, kUsage, err);
+  const auto parsed =
+      ParseArgs(args, "run", {"--rate", "--duration", "--lcm-url"}, {}, kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
     out << kUsage;
     return 0;
   }
   try {
-    const double rate_hz =
-        parsed->values.count("--rate") ? ParseNumbers(parsed->Value("--rate"), "--rate").at(0) : 100.0;
+    const double rate_hz = parsed->values.count("--rate")
+                               ? ParseNumbers(parsed->Value("--rate"), "--rate").at(0)
+                               : 100.0;
     const double duration_s = parsed->values.count("--duration")
                                   ? ParseNumbers(parsed->Value("--duration"), "--duration").at(0)
                                   : -1.0;
@@ -88,8 +90,10 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       robots[r].state = std::make_unique<scene::RobotState>(level.robots[r]);
       robots[r].inputs =
           std::make_unique<bridge::RobotInputs>(link, level, int(r), robots[r].config);
-      robots[r].outputs =
-          std::make_unique<bridge::RobotOutputs>(link, robots[r].config.channel_prefix);
+      robots[r].outputs = std::make_unique<bridge::RobotOutputs>(
+          link, robots[r].config.channel_prefix,
+          robots[r].config.state_in_pose_convention ? robots[r].config.pose
+                                                    : bridge::Translation{});
       robots[r].inputs->set_log(&reject_log);
       if (robots[r].config.net_fdm_port > 0) {
         robots[r].net_fdm = std::make_unique<bridge::NetFdmInput>(robots[r].config);
@@ -155,7 +159,8 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
           const sensors::FaceScanner scanner(*face);
           scanner.Scan(world, caster, filter, X_WS, tick, &run.face_scan);
           robot.outputs->PublishFaces(run.face_scan, tick, robot.input, now);
-        } else if (const auto* ground = std::get_if<sensors::GroundScannerConfig>(&run.mounted->config)) {
+        } else if (const auto* ground =
+                       std::get_if<sensors::GroundScannerConfig>(&run.mounted->config)) {
           sensors::HeightMap map;
           sensors::GroundScanner(*ground).Scan(world, caster, filter, X_WS.translation(), &map);
           robot.outputs->PublishGround(map, robot.input, now);
@@ -216,9 +221,8 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
             << (input->rejected() > 0 ? " (last: " + input->last_reject_reason() + ")" : "")
             << "\n";
       }
-      for (const bridge::UdpLatest* socket :
-           {robot.net_fdm ? &robot.net_fdm->socket() : nullptr,
-            robot.doubles ? &robot.doubles->socket() : nullptr}) {
+      for (const bridge::UdpLatest* socket : {robot.net_fdm ? &robot.net_fdm->socket() : nullptr,
+                                              robot.doubles ? &robot.doubles->socket() : nullptr}) {
         if (socket == nullptr) continue;
         out << "  " << socket->name() << ": " << socket->received() << " received, "
             << socket->superseded() << " superseded, " << socket->rejected() << " rejected"

@@ -23,13 +23,15 @@ int RunTopics(const std::vector<std::string>& args, std::ostream& out, std::ostr
     return parsed->help ? 0 : 2;
   }
   try {
-    const double seconds =
-        parsed->values.count("--seconds") ? ParseNumbers(parsed->Value("--seconds"), "--seconds").at(0) : 2.0;
+    const double seconds = parsed->values.count("--seconds")
+                               ? ParseNumbers(parsed->Value("--seconds"), "--seconds").at(0)
+                               : 2.0;
     bridge::LcmLink link(parsed->Value("--lcm-url"));
     const auto stats = bridge::ListenToAll(link, seconds);
     out << std::left << std::setw(24) << "channel" << std::setw(20) << "type" << std::right
         << std::setw(10) << "messages" << std::setw(10) << "rate Hz" << std::setw(12)
-        << "mean bytes" << "\n";
+        << "mean bytes"
+        << "\n";
     for (const auto& [channel, s] : stats) {
       out << std::left << std::setw(24) << channel << std::setw(20) << s.type << std::right
           << std::setw(10) << s.messages << std::setw(10) << std::fixed << std::setprecision(1)

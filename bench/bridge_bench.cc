@@ -15,10 +15,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <lcm/lcm-cpp.hpp>
 #include <thread>
 #include <vector>
-
-#include <lcm/lcm-cpp.hpp>
 
 #include "bridge/lcm_link.h"
 #include "bridge/outputs.h"
@@ -42,7 +41,8 @@ std::int64_t NowUtime() {
 
 // A full scan of the sample level from above the valley.
 sensors::FaceScan FullScan() {
-  const scene::Level level = scene::LoadLevel(std::string(SANDBOX_SOURCE_DIR) + "/assets/sample/level.toml");
+  const scene::Level level =
+      scene::LoadLevel(std::string(SANDBOX_SOURCE_DIR) + "/assets/sample/level.toml");
   const scene::CollisionWorld world(level);
   sensors::FaceScannerConfig config;
   config.refresh = sensors::Refresh::kFull;
@@ -88,8 +88,9 @@ std::int64_t Received(const std::string& url, const sensors::FaceScan& scan, int
 
 int main(int argc, char** argv) {
   if (std::getenv("SANDBOX_IN_NETNS") == nullptr) {
-    std::fprintf(stderr, "bench_bridge: run it in a private network namespace: "
-                         "scripts/netns-run build/bench/bench_bridge\n");
+    std::fprintf(stderr,
+                 "bench_bridge: run it in a private network namespace: "
+                 "scripts/netns-run build/bench/bench_bridge\n");
     return 2;
   }
   double seconds = 60.0;
@@ -106,7 +107,8 @@ int main(int argc, char** argv) {
     const int rounds = 200;
     const auto start = Clock::now();
     for (int i = 0; i < rounds; ++i) outputs.PublishFaces(scan, 0, {i, 0}, NowUtime());
-    const double publish_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count() / rounds;
+    const double publish_ms =
+        std::chrono::duration<double, std::milli>(Clock::now() - start).count() / rounds;
     // One face encoded, decoded many times.
     sandbox_msgs::scan_face_t face{};
     face.n = scan.n;
@@ -123,19 +125,21 @@ int main(int argc, char** argv) {
     }
     const double decode_ms =
         std::chrono::duration<double, std::milli>(Clock::now() - decode_start).count() / rounds;
-    std::printf("full scan (6 faces, %d points, %.0f KB): encode + publish %.3f ms, decode %.3f ms\n",
-                6 * face.num_points, 6.0 * double(bytes.size()) / 1024.0, publish_ms, decode_ms);
+    std::printf(
+        "full scan (6 faces, %d points, %.0f KB): encode + publish %.3f ms, decode %.3f ms\n",
+        6 * face.num_points, 6.0 * double(bytes.size()) / 1024.0, publish_ms, decode_ms);
   }
 
   // 2. Loss at 100 Hz.
   const int scans = int(seconds * 100.0);
   const std::int64_t with_buffer = Received(bridge::WithReceiveBuffer(kGroup), scan, scans);
   const std::int64_t reference = Received(kGroup, scan, std::min(scans, 500));
-  std::printf("loss, %d full scans at 100 Hz (%.0f s): %lld of %d face messages received with "
-              "recv_buf_size=4194304 (%lld lost); reference, default buffer, %d scans: %lld of %d\n",
-              scans, seconds, static_cast<long long>(with_buffer), 6 * scans,
-              static_cast<long long>(6 * scans - with_buffer), std::min(scans, 500),
-              static_cast<long long>(reference), 6 * std::min(scans, 500));
+  std::printf(
+      "loss, %d full scans at 100 Hz (%.0f s): %lld of %d face messages received with "
+      "recv_buf_size=4194304 (%lld lost); reference, default buffer, %d scans: %lld of %d\n",
+      scans, seconds, static_cast<long long>(with_buffer), 6 * scans,
+      static_cast<long long>(6 * scans - with_buffer), std::min(scans, 500),
+      static_cast<long long>(reference), 6 * std::min(scans, 500));
 
   // 3. Pose latency: model at 1 kHz, loop at 100 Hz.
   {
@@ -170,12 +174,13 @@ int main(int argc, char** argv) {
     done = true;
     model.join();
     std::sort(ages_ms.begin(), ages_ms.end());
-    std::printf("pose latency, model 1 kHz, loop 100 Hz, %zu ticks: age of the applied pose median "
-                "%.3f ms, p99 %.3f ms, max %.3f ms (bound: one loop period + 1 ms = 11 ms); "
-                "superseded %lld of %lld\n",
-                ages_ms.size(), ages_ms[ages_ms.size() / 2], ages_ms[ages_ms.size() * 99 / 100],
-                ages_ms.back(), static_cast<long long>(input.superseded()),
-                static_cast<long long>(input.received()));
+    std::printf(
+        "pose latency, model 1 kHz, loop 100 Hz, %zu ticks: age of the applied pose median "
+        "%.3f ms, p99 %.3f ms, max %.3f ms (bound: one loop period + 1 ms = 11 ms); "
+        "superseded %lld of %lld\n",
+        ages_ms.size(), ages_ms[ages_ms.size() / 2], ages_ms[ages_ms.size() * 99 / 100],
+        ages_ms.back(), static_cast<long long>(input.superseded()),
+        static_cast<long long>(input.received()));
   }
   return 0;
 }

@@ -6,7 +6,6 @@
 
 namespace sandbox::bridge {
 
-
 std::string WithReceiveBuffer(const std::string& url) {
   const bool multicast = url.empty() || url.rfind("udpm://", 0) == 0;
   if (!multicast || url.find("recv_buf_size=") != std::string::npos) return url;

@@ -59,15 +59,15 @@ std::string DecodeNetFdm(const std::uint8_t* bytes, std::size_t size, NetFdm* fd
   out.latitude_rad = F64(bytes + kLatitude);
   out.altitude_m = F64(bytes + kAltitude);
   const std::uint8_t* f = bytes + kFloats;
-  out.agl_m = F32(f), out.phi_rad = F32(f + 4), out.theta_rad = F32(f + 8), out.psi_rad = F32(f + 12);
+  out.agl_m = F32(f), out.phi_rad = F32(f + 4), out.theta_rad = F32(f + 8),
+  out.psi_rad = F32(f + 12);
   out.alpha_rad = F32(f + 16), out.beta_rad = F32(f + 20);
   out.v_north_fps = F32(f + 44), out.v_east_fps = F32(f + 48), out.v_down_fps = F32(f + 52);
   out.cur_time = U32(bytes + kCurTime);
   const std::uint8_t* s = bytes + kSurfaces;
-  float* surfaces[10] = {&out.elevator,     &out.elevator_trim_tab, &out.left_flap,
-                         &out.right_flap,   &out.left_aileron,      &out.right_aileron,
-                         &out.rudder,       &out.nose_wheel,        &out.speedbrake,
-                         &out.spoilers};
+  float* surfaces[10] = {&out.elevator,     &out.elevator_trim_tab, &out.left_flap, &out.right_flap,
+                         &out.left_aileron, &out.right_aileron,     &out.rudder,    &out.nose_wheel,
+                         &out.speedbrake,   &out.spoilers};
   for (int i = 0; i < 10; ++i) *surfaces[i] = F32(s + 4 * i);
   if (!std::isfinite(out.longitude_rad) || !std::isfinite(out.latitude_rad) ||
       !std::isfinite(out.altitude_m)) {
@@ -91,9 +91,9 @@ std::vector<std::uint8_t> EncodeNetFdm(const NetFdm& fdm) {
   PutF32(fdm.psi_rad, f + 12), PutF32(fdm.alpha_rad, f + 16), PutF32(fdm.beta_rad, f + 20);
   PutF32(fdm.v_north_fps, f + 44), PutF32(fdm.v_east_fps, f + 48), PutF32(fdm.v_down_fps, f + 52);
   PutU32(fdm.cur_time, &bytes[kCurTime]);
-  const float surfaces[10] = {fdm.elevator,     fdm.elevator_trim_tab, fdm.left_flap,
-                              fdm.right_flap,   fdm.left_aileron,      fdm.right_aileron,
-                              fdm.rudder,       fdm.nose_wheel,        fdm.speedbrake,
+  const float surfaces[10] = {fdm.elevator,   fdm.elevator_trim_tab, fdm.left_flap,
+                              fdm.right_flap, fdm.left_aileron,      fdm.right_aileron,
+                              fdm.rudder,     fdm.nose_wheel,        fdm.speedbrake,
                               fdm.spoilers};
   for (int i = 0; i < 10; ++i) PutF32(surfaces[i], &bytes[kSurfaces + 4 * std::size_t(i)]);
   return bytes;

@@ -8,8 +8,11 @@
 
 namespace sandbox::bridge {
 
-RobotOutputs::RobotOutputs(LcmLink& link, std::string robot_name)
-    : link_(link), prefix_(std::move(robot_name) + "/") {}
+RobotOutputs::RobotOutputs(LcmLink& link, std::string channel_prefix,
+                           const Translation& state_translation)
+    : link_(link),
+      prefix_(std::move(channel_prefix) + "/"),
+      state_translation_(state_translation) {}
 
 template <typename Message>
 void RobotOutputs::Send(const std::string& topic, const Message& message) {
@@ -98,8 +101,9 @@ void RobotOutputs::PublishState(const scene::RobotState& state,
   message.seq = seq_++;
   message.input_seq = input.seq;
   message.input_utime = input.utime;
-  const Eigen::Vector3d p = state.pose().translation();
-  const Eigen::Quaterniond q(state.pose().linear());
+  Eigen::Vector3d p;
+  Eigen::Quaterniond q;
+  state_translation_.FromWorld(state.pose(), &p, &q);
   for (int k = 0; k < 3; ++k) message.position[k] = p[k];
   message.orientation[0] = q.w(), message.orientation[1] = q.x();
   message.orientation[2] = q.y(), message.orientation[3] = q.z();

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "bridge/lcm_link.h"
+#include "bridge/translation.h"
 #include "scene/robot_state.h"
 #include "sensors/face_scanner.h"
 #include "sensors/ground_scanner.h"
@@ -31,7 +32,10 @@ struct ChannelStatus {
 
 class RobotOutputs {
  public:
-  RobotOutputs(LcmLink& link, std::string robot_name);
+  // Publishes on <channel_prefix>/...; STATE's pose in `state_translation`'s
+  // convention (the world's own, ENU, by default).
+  RobotOutputs(LcmLink& link, std::string channel_prefix,
+               const Translation& state_translation = {});
 
   // Publishes the faces of `scan` scanned at `tick` (the ones this tick refreshed).
   void PublishFaces(const sensors::FaceScan& scan, std::int64_t tick, const InputTag& input,
@@ -54,6 +58,7 @@ class RobotOutputs {
 
   LcmLink& link_;
   std::string prefix_;
+  Translation state_translation_;
   std::int64_t seq_{0};
   std::int64_t published_{0};
   std::vector<std::uint8_t> buffer_;

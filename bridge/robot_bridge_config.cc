@@ -13,23 +13,26 @@ RobotBridgeConfig RobotBridgeConfig::FromModel(const scene::RobotModel& model) {
   scene::SettingsReader read(model.bridge);
   RobotBridgeConfig config;
   config.channel_prefix = read.Text("channel_prefix", model.name);
-  if (config.channel_prefix.empty()) read.Fail("channel_prefix", "'channel_prefix' must not be empty");
+  if (config.channel_prefix.empty())
+    read.Fail("channel_prefix", "'channel_prefix' must not be empty");
   const std::string convention = read.Text("pose_convention", "enu");
   const auto parsed = ParseConvention(convention);
   if (!parsed) {
-    read.Fail("pose_convention", "'pose_convention' must be enu, ned, unreal or geodetic, got '" +
-                                     convention + "'");
+    read.Fail("pose_convention",
+              "'pose_convention' must be enu, ned, unreal or geodetic, got '" + convention + "'");
   }
   config.pose.convention = *parsed;
   const std::vector<double> origin = read.Numbers("geodetic_origin");
   if (!origin.empty()) {
     if (origin.size() != 3 || std::abs(origin[0]) > 90.0) {
-      read.Fail("geodetic_origin", "'geodetic_origin' must be [latitude_deg, longitude_deg, altitude_m]");
+      read.Fail("geodetic_origin",
+                "'geodetic_origin' must be [latitude_deg, longitude_deg, altitude_m]");
     }
     config.pose.origin = {origin[0], origin[1], origin[2]};
   }
   config.stale_after_s = read.Number("stale_after_s", config.stale_after_s);
   if (!(config.stale_after_s > 0.0)) read.Fail("stale_after_s", "'stale_after_s' must be positive");
+  config.state_in_pose_convention = read.Flag("state_in_pose_convention", false);
   config.bind_address = read.Text("bind_address", config.bind_address);
   auto port = [&](const std::string& key) {
     const int value = read.Whole(key, 0);
@@ -44,7 +47,8 @@ RobotBridgeConfig RobotBridgeConfig::FromModel(const scene::RobotModel& model) {
     const std::string key = std::string("net_fdm_") + surface;
     for (const std::string& bone : read.Texts(key)) {
       const int index = model.FindBone(bone);
-      if (index < 0) read.Fail(key, "'" + key + "' names bone '" + bone + "', which is not in the bone map");
+      if (index < 0)
+        read.Fail(key, "'" + key + "' names bone '" + bone + "', which is not in the bone map");
       if (model.bones[std::size_t(index)].rotation != scene::BoneRotation::kAngles) {
         read.Fail(key, "bone '" + bone + "' must take angles to follow a control surface");
       }
@@ -56,7 +60,8 @@ RobotBridgeConfig RobotBridgeConfig::FromModel(const scene::RobotModel& model) {
     for (const std::string& item : config.udp_doubles_layout) {
       if (item != "position" && item != "quaternion" && item != "rpy" && item != "bones") {
         read.Fail("udp_doubles_layout",
-                  "'udp_doubles_layout' items are position, quaternion, rpy and bones, got '" + item + "'");
+                  "'udp_doubles_layout' items are position, quaternion, rpy and bones, got '" +
+                      item + "'");
       }
     }
   }

@@ -8,6 +8,7 @@
 //   pose_convention = "enu"           # enu, ned, unreal, geodetic
 //   geodetic_origin = [47.0, 8.0, 500.0]   # lat, lon (deg), alt (m) of the world origin
 //   stale_after_s = 0.5
+//   state_in_pose_convention = false  # STATE's pose in pose_convention instead of world ENU
 //   bind_address = "127.0.0.1"        # for the UDP adapters
 //   net_fdm_port = 5505               # FlightGear net_fdm v24 (0: off); pose is geodetic
 //   net_fdm_elevator = ["E1", "E2", "E3"]   # bones driven by a control surface
@@ -29,6 +30,7 @@ struct RobotBridgeConfig {
   std::string channel_prefix;
   Translation pose;
   double stale_after_s{0.5};
+  bool state_in_pose_convention{false};
   std::string bind_address{"127.0.0.1"};
   int net_fdm_port{0};
   // net_fdm surface field ("elevator", "left_aileron", ...) -> bone-map indices.

@@ -21,8 +21,7 @@ class RobotInputs {
   // Subscribes the robot's channels (<prefix>/POSE, /BONES, /ACTORS) on
   // `link`; the config also says the convention its pose publisher speaks.
   // `level` must outlive this.
-  RobotInputs(LcmLink& link, const scene::Level& level, int robot,
-              const RobotBridgeConfig& config);
+  RobotInputs(LcmLink& link, const scene::Level& level, int robot, const RobotBridgeConfig& config);
   // With the robot's own [robot.bridge] settings.
   RobotInputs(LcmLink& link, const scene::Level& level, int robot);
 
@@ -41,9 +40,7 @@ class RobotInputs {
   const LatestInput& bones() const { return bones_; }
   const LatestInput& actors() const { return actors_; }
   // Logs rejections of all three inputs to `log`.
-  void set_log(RejectLog* log) {
-    pose_.set_log(log), bones_.set_log(log), actors_.set_log(log);
-  }
+  void set_log(RejectLog* log) { pose_.set_log(log), bones_.set_log(log), actors_.set_log(log); }
 
  private:
   const scene::Level& level_;

@@ -5,7 +5,6 @@
 #include <cstring>
 
 #include "bridge/lcm_link_impl.h"
-
 #include "sandbox_msgs/actor_placements_t.hpp"
 #include "sandbox_msgs/bone_values_t.hpp"
 #include "sandbox_msgs/camera_command_t.hpp"
@@ -27,12 +26,16 @@ std::string TypeOf(const std::uint8_t* data, std::uint32_t size) {
   for (int i = 0; i < 8; ++i) hash = (hash << 8) | data[i];
   using namespace sandbox_msgs;
   const std::pair<std::int64_t, const char*> known[] = {
-      {robot_pose_t::getHash(), "robot_pose_t"},   {bone_values_t::getHash(), "bone_values_t"},
+      {robot_pose_t::getHash(), "robot_pose_t"},
+      {bone_values_t::getHash(), "bone_values_t"},
       {actor_placements_t::getHash(), "actor_placements_t"},
       {camera_command_t::getHash(), "camera_command_t"},
-      {scan_face_t::getHash(), "scan_face_t"},     {ground_map_t::getHash(), "ground_map_t"},
-      {lidar_scan_t::getHash(), "lidar_scan_t"},   {robot_state_t::getHash(), "robot_state_t"},
-      {wrench_t::getHash(), "wrench_t"},           {status_t::getHash(), "status_t"}};
+      {scan_face_t::getHash(), "scan_face_t"},
+      {ground_map_t::getHash(), "ground_map_t"},
+      {lidar_scan_t::getHash(), "lidar_scan_t"},
+      {robot_state_t::getHash(), "robot_state_t"},
+      {wrench_t::getHash(), "wrench_t"},
+      {status_t::getHash(), "status_t"}};
   for (const auto& [known_hash, name] : known) {
     if (known_hash == hash) return name;
   }

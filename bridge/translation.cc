@@ -118,7 +118,8 @@ void Translation::FromWorld(const Eigen::Isometry3d& X_WB, Eigen::Vector3d* posi
           GeodeticToEcef(origin.latitude_deg, origin.longitude_deg, origin.altitude_m);
       *position = EcefToGeodetic(o_ecef + R_EcefWorld * X_WB.translation());
       const Eigen::Matrix3d R_EcefLocal = EcefFromEnu(position->x(), position->y());
-      *q = Eigen::Quaterniond(kEnuFromNed * R_EcefLocal.transpose() * R_EcefWorld * R * kFluFromFrd);
+      *q =
+          Eigen::Quaterniond(kEnuFromNed * R_EcefLocal.transpose() * R_EcefWorld * R * kFluFromFrd);
       break;
     }
   }

@@ -3,10 +3,9 @@
 // speak their own conventions, the sandbox's world is right-handed ENU, metres,
 // with robot bodies x forward, y left, z up (../shared/DESIGN.md).
 
+#include <Eigen/Geometry>
 #include <optional>
 #include <string>
-
-#include <Eigen/Geometry>
 
 namespace sandbox::bridge {
 

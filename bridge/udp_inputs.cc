@@ -66,27 +66,32 @@ bool NetFdmInput::Apply(scene::RobotState* state) {
   // Geodetic position, NED attitude, relative to the configured origin.
   Translation geodetic = config_.pose;
   geodetic.convention = Convention::kGeodetic;
-  const Eigen::Isometry3d X_WB = geodetic.ToWorld(
-      Eigen::Vector3d(fdm.latitude_rad * 180.0 / M_PI, fdm.longitude_rad * 180.0 / M_PI,
-                      fdm.altitude_m),
-      NedAttitude(fdm.phi_rad, fdm.theta_rad, fdm.psi_rad));
+  const Eigen::Isometry3d X_WB =
+      geodetic.ToWorld(Eigen::Vector3d(fdm.latitude_rad * 180.0 / M_PI,
+                                       fdm.longitude_rad * 180.0 / M_PI, fdm.altitude_m),
+                       NedAttitude(fdm.phi_rad, fdm.theta_rad, fdm.psi_rad));
   if (!state->SetPose(X_WB)) {
     socket_.Reject(state->last_rejection());
     return false;
   }
   // Control surfaces: each named bone's first angle.
-  const std::map<std::string, float> surfaces = {
-      {"elevator", fdm.elevator},         {"elevator_trim_tab", fdm.elevator_trim_tab},
-      {"left_flap", fdm.left_flap},       {"right_flap", fdm.right_flap},
-      {"left_aileron", fdm.left_aileron}, {"right_aileron", fdm.right_aileron},
-      {"rudder", fdm.rudder},             {"nose_wheel", fdm.nose_wheel},
-      {"speedbrake", fdm.speedbrake},     {"spoilers", fdm.spoilers}};
+  const std::map<std::string, float> surfaces = {{"elevator", fdm.elevator},
+                                                 {"elevator_trim_tab", fdm.elevator_trim_tab},
+                                                 {"left_flap", fdm.left_flap},
+                                                 {"right_flap", fdm.right_flap},
+                                                 {"left_aileron", fdm.left_aileron},
+                                                 {"right_aileron", fdm.right_aileron},
+                                                 {"rudder", fdm.rudder},
+                                                 {"nose_wheel", fdm.nose_wheel},
+                                                 {"speedbrake", fdm.speedbrake},
+                                                 {"spoilers", fdm.spoilers}};
   for (const auto& [surface, bones] : config_.net_fdm_surfaces) {
     for (const int bone : bones) {
       const scene::Bone& b = state->model().bones[std::size_t(bone)];
       std::vector<double> values(std::size_t(b.num_values), 0.0);
       values[0] = double(surfaces.at(surface)) * config_.net_fdm_max_deflection_rad;
-      if (!state->SetBone(bone, values.data(), b.num_values)) socket_.Reject(state->last_rejection());
+      if (!state->SetBone(bone, values.data(), b.num_values))
+        socket_.Reject(state->last_rejection());
     }
   }
   last_ = fdm;
@@ -98,8 +103,10 @@ DoublesInput::DoublesInput(const RobotBridgeConfig& config, const scene::RobotMo
       socket_(config.bind_address, config.udp_doubles_port),
       num_values_(model.num_values) {
   for (const std::string& item : config_.udp_doubles_layout) {
-    expected_ += item == "position" ? 3 : item == "quaternion" ? 4 : item == "rpy" ? 3
-                                                                              : std::size_t(num_values_);
+    expected_ += item == "position"     ? 3
+                 : item == "quaternion" ? 4
+                 : item == "rpy"        ? 3
+                                        : std::size_t(num_values_);
   }
 }
 
@@ -108,8 +115,8 @@ bool DoublesInput::Apply(scene::RobotState* state) {
   if (packet == nullptr) return false;
   if (packet->size() != 8 * expected_) {
     socket_.Reject("expected " + std::to_string(expected_) + " doubles (" +
-                   std::to_string(8 * expected_) + " bytes), got " + std::to_string(packet->size()) +
-                   " bytes");
+                   std::to_string(8 * expected_) + " bytes), got " +
+                   std::to_string(packet->size()) + " bytes");
     return false;
   }
   std::vector<double> v(expected_);
@@ -138,7 +145,8 @@ bool DoublesInput::Apply(scene::RobotState* state) {
       }
     } else if (item == "rpy") {
       // In the convention's own frame: aerospace attitude for ned and geodetic.
-      q = config_.pose.convention == Convention::kNed || config_.pose.convention == Convention::kGeodetic
+      q = config_.pose.convention == Convention::kNed ||
+                  config_.pose.convention == Convention::kGeodetic
               ? NedAttitude(v[at], v[at + 1], v[at + 2])
               : Eigen::Quaterniond(Eigen::AngleAxisd(v[at + 2], Eigen::Vector3d::UnitZ()) *
                                    Eigen::AngleAxisd(v[at + 1], Eigen::Vector3d::UnitY()) *

@@ -9,9 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "bridge/reject_log.h"
-
 #include "bridge/net_fdm.h"
+#include "bridge/reject_log.h"
 #include "bridge/robot_bridge_config.h"
 #include "scene/robot_state.h"
 

@@ -9,11 +9,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <lcm/lcm-cpp.hpp>
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <lcm/lcm-cpp.hpp>
 
 #include "sandbox_msgs/bone_values_t.hpp"
 #include "sandbox_msgs/robot_pose_t.hpp"
@@ -22,12 +21,17 @@ int main(int argc, char** argv) {
   double rate_hz = 100.0, duration_s = 10.0;
   std::string url, robot = "ELAHA";
   for (int i = 1; i + 1 < argc; i += 2) {
-    if (!std::strcmp(argv[i], "--rate")) rate_hz = std::atof(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--duration")) duration_s = std::atof(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--lcm-url")) url = argv[i + 1];
-    else if (!std::strcmp(argv[i], "--robot")) robot = argv[i + 1];
+    if (!std::strcmp(argv[i], "--rate"))
+      rate_hz = std::atof(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--duration"))
+      duration_s = std::atof(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--lcm-url"))
+      url = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--robot"))
+      robot = argv[i + 1];
     else {
-      std::fprintf(stderr, "usage: fly_wing [--rate HZ] [--duration S] [--lcm-url URL] [--robot NAME]\n");
+      std::fprintf(stderr,
+                   "usage: fly_wing [--rate HZ] [--duration S] [--lcm-url URL] [--robot NAME]\n");
       return 2;
     }
   }

@@ -24,15 +24,20 @@ int main(int argc, char** argv) {
   double rate_hz = 100.0, duration_s = 10.0, lat0 = 47.0, lon0 = 8.0, alt0 = 500.0;
   bool hover = false;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--hover")) hover = true;
-    else if (i + 1 < argc && !std::strcmp(argv[i], "--port")) port = std::atoi(argv[++i]);
-    else if (i + 1 < argc && !std::strcmp(argv[i], "--rate")) rate_hz = std::atof(argv[++i]);
-    else if (i + 1 < argc && !std::strcmp(argv[i], "--duration")) duration_s = std::atof(argv[++i]);
+    if (!std::strcmp(argv[i], "--hover"))
+      hover = true;
+    else if (i + 1 < argc && !std::strcmp(argv[i], "--port"))
+      port = std::atoi(argv[++i]);
+    else if (i + 1 < argc && !std::strcmp(argv[i], "--rate"))
+      rate_hz = std::atof(argv[++i]);
+    else if (i + 1 < argc && !std::strcmp(argv[i], "--duration"))
+      duration_s = std::atof(argv[++i]);
     else if (i + 1 < argc && !std::strcmp(argv[i], "--origin")) {
       std::sscanf(argv[++i], "%lf,%lf,%lf", &lat0, &lon0, &alt0);
     } else {
-      std::fprintf(stderr, "usage: send_net_fdm [--port P] [--rate HZ] [--duration S] "
-                           "[--origin LAT,LON,ALT] [--hover]\n");
+      std::fprintf(stderr,
+                   "usage: send_net_fdm [--port P] [--rate HZ] [--duration S] "
+                   "[--origin LAT,LON,ALT] [--hover]\n");
       return 2;
     }
   }
@@ -54,7 +59,8 @@ int main(int argc, char** argv) {
     double north = 0.0, east = 0.0, heading = M_PI / 2;
     if (!hover) {
       const double a = 15.0 / 120.0 * t;
-      north = 120.0 * std::sin(a), east = 120.0 * std::cos(a), heading = -a;  // clockwise from above
+      north = 120.0 * std::sin(a), east = 120.0 * std::cos(a),
+      heading = -a;  // clockwise from above
     }
     fdm.latitude_rad = (lat0 + (hover ? 1.0 / 3600.0 : north / earth / deg)) * deg;
     fdm.longitude_rad = (lon0 + east / (earth * std::cos(lat0 * deg)) / deg) * deg;
@@ -64,7 +70,8 @@ int main(int argc, char** argv) {
     const auto bytes = sandbox::bridge::EncodeNetFdm(fdm);
     ::sendto(s, bytes.data(), bytes.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof(to));
     ++sent;
-    next += std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / rate_hz));
+    next +=
+        std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / rate_hz));
     std::this_thread::sleep_until(next);
   }
   ::close(s);

@@ -217,8 +217,9 @@ SettingsTable ReadSettings(const fs::path& file, const toml::table& table, Table
       settings.values[key] = read.Number(&value, key);
     } else if (value.is_string()) {
       settings.values[key] = *value.value<std::string>();
-    } else if (const toml::array* array = value.as_array(); array != nullptr && !array->empty() &&
-                                                            array->is_homogeneous(toml::node_type::string)) {
+    } else if (const toml::array* array = value.as_array();
+               array != nullptr && !array->empty() &&
+               array->is_homogeneous(toml::node_type::string)) {
       std::vector<std::string> texts;
       for (const toml::node& item : *array) texts.push_back(*item.value<std::string>());
       settings.values[key] = texts;

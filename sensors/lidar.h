@@ -34,10 +34,10 @@ struct LidarConfig {
 struct LidarScan {
   int channels{0};
   int azimuth_steps{0};
-  std::vector<float> range_m;             // the hit distance, or range_m when nothing
-  std::vector<std::uint8_t> hit;          // 1 when the beam hit something
-  std::vector<Eigen::Vector3d> points_W;  // the hit, or the beam's end
-  std::vector<double> time_s;             // per azimuth step, from the sweep's start
+  std::vector<float> range_m;                         // the hit distance, or range_m when nothing
+  std::vector<std::uint8_t> hit;                      // 1 when the beam hit something
+  std::vector<Eigen::Vector3d> points_W;              // the hit, or the beam's end
+  std::vector<double> time_s;                         // per azimuth step, from the sweep's start
   Eigen::Vector3d origin_W{Eigen::Vector3d::Zero()};  // the sensor at the sweep's start
 };
 

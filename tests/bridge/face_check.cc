@@ -8,9 +8,8 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
-#include <string>
-
 #include <lcm/lcm-cpp.hpp>
+#include <string>
 
 #include "sandbox_msgs/scan_face_t.hpp"
 #include "scene/collision_world.h"
@@ -36,9 +35,10 @@ struct Checker {
     Eigen::Isometry3d X_WS = Eigen::Isometry3d::Identity();
     X_WS.translation() = Eigen::Vector3d(message->sensor_position[0], message->sensor_position[1],
                                          message->sensor_position[2]);
-    X_WS.linear() = Eigen::Quaterniond(message->sensor_orientation[0], message->sensor_orientation[1],
-                                       message->sensor_orientation[2], message->sensor_orientation[3])
-                        .toRotationMatrix();
+    X_WS.linear() =
+        Eigen::Quaterniond(message->sensor_orientation[0], message->sensor_orientation[1],
+                           message->sensor_orientation[2], message->sensor_orientation[3])
+            .toRotationMatrix();
     sensors::RayFilter filter;
     filter.ignore_robot = robot;
     sensors::FaceScan scan = scanner->EmptyScan();
@@ -65,17 +65,23 @@ struct Checker {
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: face_check LEVEL [--robot NAME] [--faces N] [--seconds S] [--lcm-url URL]\n");
+    std::fprintf(
+        stderr,
+        "usage: face_check LEVEL [--robot NAME] [--faces N] [--seconds S] [--lcm-url URL]\n");
     return 2;
   }
   std::string robot_name = "ELAHA", url;
   int want = 12;
   double seconds = 5.0;
   for (int i = 2; i + 1 < argc; i += 2) {
-    if (!std::strcmp(argv[i], "--robot")) robot_name = argv[i + 1];
-    else if (!std::strcmp(argv[i], "--faces")) want = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--seconds")) seconds = std::atof(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--lcm-url")) url = argv[i + 1];
+    if (!std::strcmp(argv[i], "--robot"))
+      robot_name = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--faces"))
+      want = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--seconds"))
+      seconds = std::atof(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--lcm-url"))
+      url = argv[i + 1];
   }
   const scene::Level level = scene::LoadLevel(argv[1]);
   const scene::CollisionWorld world(level);
@@ -97,7 +103,8 @@ int main(int argc, char** argv) {
   lcm.subscribe(robot_name + "/SCAN_FACE", &Checker::OnFace, &checker);
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   while (checker.faces < want && std::chrono::steady_clock::now() < end) lcm.handleTimeout(100);
-  std::printf("face_check: %d faces (%d from an external pose), %d mismatched points, worst %.2e m\n",
-              checker.faces, checker.inputs_seen, checker.mismatched_points, checker.worst_m);
+  std::printf(
+      "face_check: %d faces (%d from an external pose), %d mismatched points, worst %.2e m\n",
+      checker.faces, checker.inputs_seen, checker.mismatched_points, checker.worst_m);
   return checker.faces >= want && checker.mismatched_points == 0 && checker.inputs_seen > 0 ? 0 : 1;
 }

@@ -8,9 +8,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <string>
-
 #include <lcm/lcm-cpp.hpp>
+#include <string>
 
 #include "sandbox_msgs/robot_state_t.hpp"
 
@@ -37,8 +36,10 @@ int main(int argc, char** argv) {
   lcm.subscribe(std::string(argv[1]) + "/STATE", &Last::On, &last);
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   while (std::chrono::steady_clock::now() < end) lcm.handleTimeout(50);
-  const double error = std::hypot(last.p[0] - expected[0], last.p[1] - expected[1], last.p[2] - expected[2]);
-  std::printf("state_check: robot at (%.3f, %.3f, %.3f), expected (%.3f, %.3f, %.3f), off by %.4f m\n",
-              last.p[0], last.p[1], last.p[2], expected[0], expected[1], expected[2], error);
+  const double error =
+      std::hypot(last.p[0] - expected[0], last.p[1] - expected[1], last.p[2] - expected[2]);
+  std::printf(
+      "state_check: robot at (%.3f, %.3f, %.3f), expected (%.3f, %.3f, %.3f), off by %.4f m\n",
+      last.p[0], last.p[1], last.p[2], expected[0], expected[1], expected[2], error);
   return last.any && error <= tolerance ? 0 : 1;
 }

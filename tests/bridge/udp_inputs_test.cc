@@ -35,12 +35,14 @@ void Send(int port, const void* data, std::size_t size) {
 
 scene::Level WingLevel(const testing::TempDir& dir, const std::string& bridge) {
   const std::string wing =
-      (std::filesystem::path(SANDBOX_SOURCE_DIR) / "assets/robots/generated/flying_wing.gltf").string();
+      (std::filesystem::path(SANDBOX_SOURCE_DIR) / "assets/robots/generated/flying_wing.gltf")
+          .string();
   return scene::LoadLevel(dir.Write(
       "level.toml",
       "[[robot]]\nname = \"W\"\nfile = \"" + wing +
           "\"\nbones = [\"root\", \"R1\", \"E1\"]\nrotation = \"angles\"\nangle_axes = [\"y\"]\n"
-          "\n[robot.bridge]\n" + bridge));
+          "\n[robot.bridge]\n" +
+          bridge));
 }
 
 TEST(UdpInputsTest, NetFdmDrivesPoseAndControlSurfaces) {
@@ -55,7 +57,7 @@ TEST(UdpInputsTest, NetFdmDrivesPoseAndControlSurfaces) {
   NetFdm fdm;
   fdm.latitude_rad = (47.0 + 1.0 / 3600.0) * M_PI / 180.0;  // 30.87 m north
   fdm.longitude_rad = 8.0 * M_PI / 180.0;
-  fdm.altitude_m = 600.0;  // 100 m up
+  fdm.altitude_m = 600.0;         // 100 m up
   fdm.psi_rad = float(M_PI / 2);  // heading east
   fdm.elevator = 0.5f;
   for (const float lat_offset : {0.0f, 1.0f}) {  // two packets: the newest wins
@@ -100,9 +102,9 @@ TEST(UdpInputsTest, NetFdmDrivesPoseAndControlSurfaces) {
 TEST(UdpInputsTest, DoublesInTheConfiguredLayout) {
   testing::TempDir dir;
   const int port = TestPort(1);
-  const scene::Level level = WingLevel(
-      dir, "udp_doubles_port = " + std::to_string(port) +
-               "\nudp_doubles_layout = [\"position\", \"rpy\", \"bones\"]\nudp_doubles_big_endian = true\n");
+  const scene::Level level = WingLevel(dir, "udp_doubles_port = " + std::to_string(port) +
+                                                "\nudp_doubles_layout = [\"position\", \"rpy\", "
+                                                "\"bones\"]\nudp_doubles_big_endian = true\n");
   const RobotBridgeConfig config = RobotBridgeConfig::FromModel(level.robots[0]);
   DoublesInput input(config, level.robots[0]);
   ASSERT_EQ(input.expected_doubles(), 3u + 3u + 3u);
