@@ -8,6 +8,30 @@
 
 namespace sandbox::bridge {
 
+namespace {
+
+// The header every output carries: when, its sequence number, and the input
+// it was computed from.
+template <typename Message>
+void Stamp(std::int64_t now_utime, std::int64_t seq, const InputTag& input, Message* message) {
+  message->utime = now_utime;
+  message->seq = seq;
+  message->input_seq = input.seq;
+  message->input_utime = input.utime;
+}
+
+// World points as float offsets from a double origin, flat.
+void Offsets(const std::vector<Eigen::Vector3d>& points_W, const Eigen::Vector3d& origin,
+             std::vector<float>* xyz) {
+  xyz->resize(3 * points_W.size());
+  for (std::size_t i = 0; i < points_W.size(); ++i) {
+    const Eigen::Vector3d offset = points_W[i] - origin;
+    for (int k = 0; k < 3; ++k) (*xyz)[3 * i + std::size_t(k)] = float(offset[k]);
+  }
+}
+
+}  // namespace
+
 RobotOutputs::RobotOutputs(LcmLink& link, std::string channel_prefix,
                            const Translation& state_translation)
     : link_(link),
@@ -27,10 +51,7 @@ void RobotOutputs::PublishFaces(const sensors::FaceScan& scan, std::int64_t tick
     const sensors::ScanFace& face = scan.faces[std::size_t(f)];
     if (face.tick != tick) continue;
     sandbox_msgs::scan_face_t message{};
-    message.utime = now_utime;
-    message.seq = seq_++;
-    message.input_seq = input.seq;
-    message.input_utime = input.utime;
+    Stamp(now_utime, seq_++, input, &message);
     message.tick = tick;
     message.face = std::int8_t(f);
     message.n = scan.n;
@@ -43,11 +64,7 @@ void RobotOutputs::PublishFaces(const sensors::FaceScan& scan, std::int64_t tick
     message.num_points = int(n);
     message.occupancy = face.occupancy;
     message.num_xyz = int(3 * n);
-    message.xyz.resize(3 * n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const Eigen::Vector3d offset = face.points_W[i] - p;
-      for (int k = 0; k < 3; ++k) message.xyz[3 * i + std::size_t(k)] = float(offset[k]);
-    }
+    Offsets(face.points_W, p, &message.xyz);
     Send("SCAN_FACE", message);
   }
 }
@@ -55,10 +72,7 @@ void RobotOutputs::PublishFaces(const sensors::FaceScan& scan, std::int64_t tick
 void RobotOutputs::PublishGround(const sensors::HeightMap& map, const InputTag& input,
                                  std::int64_t now_utime) {
   sandbox_msgs::ground_map_t message{};
-  message.utime = now_utime;
-  message.seq = seq_++;
-  message.input_seq = input.seq;
-  message.input_utime = input.utime;
+  Stamp(now_utime, seq_++, input, &message);
   message.n = map.n;
   message.resolution_m = map.resolution_m;
   message.corner[0] = map.corner_W.x(), message.corner[1] = map.corner_W.y();
@@ -71,10 +85,7 @@ void RobotOutputs::PublishGround(const sensors::HeightMap& map, const InputTag& 
 void RobotOutputs::PublishLidar(const sensors::LidarScan& scan, const InputTag& input,
                                 std::int64_t now_utime) {
   sandbox_msgs::lidar_scan_t message{};
-  message.utime = now_utime;
-  message.seq = seq_++;
-  message.input_seq = input.seq;
-  message.input_utime = input.utime;
+  Stamp(now_utime, seq_++, input, &message);
   message.channels = scan.channels;
   message.steps = scan.azimuth_steps;
   const Eigen::Vector3d& origin = scan.origin_W;
@@ -84,11 +95,7 @@ void RobotOutputs::PublishLidar(const sensors::LidarScan& scan, const InputTag& 
   message.range_m = scan.range_m;
   message.hit.assign(scan.hit.begin(), scan.hit.end());
   message.num_xyz = int(3 * n);
-  message.xyz.resize(3 * n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d offset = scan.points_W[i] - origin;
-    for (int k = 0; k < 3; ++k) message.xyz[3 * i + std::size_t(k)] = float(offset[k]);
-  }
+  Offsets(scan.points_W, origin, &message.xyz);
   message.time_s.assign(scan.time_s.begin(), scan.time_s.end());
   Send("LIDAR", message);
 }
@@ -97,10 +104,7 @@ void RobotOutputs::PublishState(const scene::RobotState& state,
                                 const std::vector<double>& bone_values, const InputTag& input,
                                 std::int64_t now_utime) {
   sandbox_msgs::robot_state_t message{};
-  message.utime = now_utime;
-  message.seq = seq_++;
-  message.input_seq = input.seq;
-  message.input_utime = input.utime;
+  Stamp(now_utime, seq_++, input, &message);
   Eigen::Vector3d p;
   Eigen::Quaterniond q;
   state_translation_.FromWorld(state.pose(), &p, &q);
