@@ -23,11 +23,16 @@ namespace sandbox::app {
 namespace {
 
 const char* kUsage =
-    "usage: sandbox run [LEVEL] [--rate HZ] [--duration S] [--lcm-url URL]\n"
+    "usage: sandbox run [LEVEL] [--rate HZ] [--duration S] [--lcm-url URL] [--lockstep]\n"
+    "                   [--replay LOG] [--record LOG]\n"
     "  LEVEL        a level (default: the bundled sample level)\n"
     "  --rate       loop rate in Hz (default 100)\n"
     "  --duration   stop after this many seconds (default: run until Ctrl-C)\n"
     "  --lcm-url    LCM URL (default: LCM's own; multicast URLs get a 4 MB receive buffer)\n"
+    "  --lockstep   each tick consumes exactly one pose message (waits for it); outputs are\n"
+    "               a function of the inputs alone\n"
+    "  --replay     read the inputs from an LCM log file (no network), lock-step, full speed\n"
+    "  --record     write every output message to an LCM log file\n"
     "Inputs per robot: <ROBOT>/POSE, /BONES, /ACTORS. Outputs: <ROBOT>/SCAN_FACE, /GROUND,\n"
     "/LIDAR, /STATE, /STATUS (docs/bridge.md).\n";
 
@@ -62,7 +67,8 @@ struct SensorRun {
 
 int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   const auto parsed =
-      ParseArgs(args, "run", {"--rate", "--duration", "--lcm-url"}, {}, kUsage, err);
+      ParseArgs(args, "run", {"--rate", "--duration", "--lcm-url", "--replay", "--record"},
+                {"--lockstep"}, kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
     out << kUsage;
@@ -80,7 +86,14 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     const scene::Level level = scene::LoadLevel(parsed->level.value_or(kDefaultLevel));
     const std::vector<sensors::MountedSensor> mounted = sensors::MakeRobotSensors(level);
     scene::CollisionWorld world(level);
-    bridge::LcmLink link(parsed->Value("--lcm-url"));
+    const std::string replay_file = parsed->Value("--replay");
+    const bool replay = !replay_file.empty();
+    const bool lockstep = replay || parsed->flags.count("--lockstep") > 0;
+    // A replay feeds its inputs through an in-process link: nothing on the network.
+    bridge::LcmLink link(replay ? "memq://" : parsed->Value("--lcm-url"));
+    if (!parsed->Value("--record").empty()) link.RecordTo(parsed->Value("--record"));
+    std::unique_ptr<bridge::LogReader> log;
+    if (replay) log = std::make_unique<bridge::LogReader>(replay_file);
     sensors::RayCaster caster;
 
     bridge::RejectLog reject_log(&err);
@@ -95,6 +108,7 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
           robots[r].config.state_in_pose_convention ? robots[r].config.pose
                                                     : bridge::Translation{});
       robots[r].inputs->set_log(&reject_log);
+      robots[r].inputs->set_lockstep(lockstep);
       if (robots[r].config.net_fdm_port > 0) {
         robots[r].net_fdm = std::make_unique<bridge::NetFdmInput>(robots[r].config);
         robots[r].net_fdm->set_log(&reject_log);
@@ -110,7 +124,11 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     for (const sensors::MountedSensor& m : mounted) sensor_runs.push_back({&m, 0.0, {}});
 
     out << "sandbox run: " << level.name << ", " << level.robots.size() << " robots, "
-        << mounted.size() << " sensors, " << rate_hz << " Hz, LCM " << link.url() << "\n"
+        << mounted.size() << " sensors, "
+        << (replay ? "replaying " + replay_file
+                   : (lockstep ? std::string("lock-step") : std::to_string(rate_hz) + " Hz") +
+                         ", LCM " + link.url())
+        << "\n"
         << std::flush;
     stop_requested = false;
     std::signal(SIGINT, OnSignal);
@@ -120,17 +138,55 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     const auto period = std::chrono::duration<double>(1.0 / rate_hz);
     const auto start = Clock::now();
     auto deadline = start;
-    std::int64_t tick = 0, overruns = 0;
-    double next_status_s = 0.0, busy_s = 0.0;
+    std::int64_t tick = 0, overruns = 0, first_input_utime = -1;
+    double next_status_s = 0.0, busy_s = 0.0, next_progress_s = 0.0;
+    auto has_pose = [&] {
+      for (const RobotRun& robot : robots) {
+        if (robot.inputs->HasPose()) return true;
+      }
+      return false;
+    };
     while (!stop_requested) {
-      const double t = std::chrono::duration<double>(Clock::now() - start).count();
-      if (duration_s >= 0.0 && t >= duration_s) break;
+      const double wall_s = std::chrono::duration<double>(Clock::now() - start).count();
+      if (duration_s >= 0.0 && wall_s >= duration_s) break;
+      // Lock-step: wait for (or, replaying, read up to) the next pose message.
+      if (replay) {
+        std::string channel;
+        std::vector<std::uint8_t> data;
+        std::int64_t utime = 0;
+        while (!has_pose() && log->Next(&channel, &data, &utime)) {
+          link.Inject(channel, data.data(), unsigned(data.size()));
+          link.Drain();
+        }
+        if (!has_pose()) break;  // the log has ended
+        if (wall_s >= next_progress_s) {
+          next_progress_s = wall_s + 0.25;
+          const double done = log->fraction_read();
+          err << "\rreplay: " << std::setw(3) << int(100 * done) << "% | " << tick << " ticks | "
+              << std::setprecision(0) << std::fixed << (wall_s > 0 ? tick / wall_s : 0.0)
+              << " ticks/s | " << (done > 0 ? wall_s * (1 - done) / done : 0.0) << " s left  "
+              << std::flush;
+        }
+      } else if (lockstep) {
+        link.Drain();
+        if (!has_pose()) {
+          link.Wait(100);
+          continue;
+        }
+      }
       const auto tick_start = Clock::now();
-      const std::int64_t now = NowUtime();
-      // 1-2. Inputs: the newest message per channel, applied.
-      link.Drain();
+      std::int64_t now = NowUtime();
+      // 1-2. Inputs: the newest message per channel (lock-step: the next pose), applied.
+      if (!lockstep) link.Drain();
       for (RobotRun& robot : robots) {
-        const bridge::RobotInputs::Applied applied = robot.inputs->Apply(robot.state.get(), &world);
+        const bridge::RobotInputs::Applied applied =
+            lockstep ? robot.inputs->ApplyNext(robot.state.get(), &world)
+                     : robot.inputs->Apply(robot.state.get(), &world);
+        if (lockstep && applied.pose) {
+          // Lock-step time is input time: the outputs depend on the inputs alone.
+          if (first_input_utime < 0) first_input_utime = applied.pose_utime;
+          now = applied.pose_utime;
+        }
         if (applied.pose) robot.input = {applied.pose_seq, applied.pose_utime};
         bool moved = applied.pose || applied.bones;
         if (robot.net_fdm && robot.net_fdm->Apply(robot.state.get())) {
@@ -146,6 +202,9 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
           world.UpdateRobot(int(&robot - robots.data()), *robot.state);
         }
       }
+      const double t =
+          lockstep ? double(now - std::max<std::int64_t>(first_input_utime, 0)) * 1e-6 : wall_s;
+      link.set_record_utime(now);
       // 3-4. Sensors that are due, and their outputs.
       for (SensorRun& run : sensor_runs) {
         if (t < run.next_due_s) continue;
@@ -197,6 +256,7 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       ++tick;
       busy_s += std::chrono::duration<double>(Clock::now() - tick_start).count();
       // 6. Wait for the next tick; a late tick starts the next at once, no catching up.
+      if (lockstep) continue;  // paced by its inputs
       deadline += std::chrono::duration_cast<Clock::duration>(period);
       const auto after = Clock::now();
       if (after > deadline) {
@@ -208,6 +268,7 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     }
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
+    if (replay) err << "\rreplay: 100% | " << tick << " ticks" << std::string(30, ' ') << "\n";
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     out << "sandbox run: " << tick << " ticks in " << std::fixed << std::setprecision(2) << elapsed
         << " s (" << (elapsed > 0 ? tick / elapsed : 0.0) << " Hz), mean tick "

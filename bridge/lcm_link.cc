@@ -1,5 +1,7 @@
 #include "bridge/lcm_link.h"
 
+#include <algorithm>
+#include <cstdio>
 #include <stdexcept>
 
 #include "bridge/lcm_link_impl.h"
@@ -27,7 +29,62 @@ int LcmLink::Drain() {
 }
 
 bool LcmLink::Publish(const std::string& channel, const void* data, unsigned size) {
+  if (impl_->record) {
+    lcm::LogEvent event;
+    event.eventnum = 0;
+    event.timestamp = record_utime_;
+    event.channel = channel;
+    event.datalen = static_cast<std::int32_t>(size);
+    event.data = const_cast<void*>(data);
+    impl_->record->writeEvent(&event);
+  }
   return impl_->lcm.publish(channel, data, size) == 0;
+}
+
+bool LcmLink::Inject(const std::string& channel, const void* data, unsigned size) {
+  return impl_->lcm.publish(channel, data, size) == 0;
+}
+
+bool LcmLink::Wait(int timeout_ms) { return impl_->lcm.handleTimeout(timeout_ms) > 0; }
+
+void LcmLink::RecordTo(const std::string& path) {
+  impl_->record = std::make_unique<lcm::LogFile>(path, "w");
+  if (!impl_->record->good()) {
+    impl_->record.reset();
+    throw std::runtime_error("LcmLink: cannot write the log file '" + path + "'");
+  }
+}
+
+struct LogReader::Impl {
+  explicit Impl(const std::string& path) : log(path, "r") {}
+  lcm::LogFile log;
+  long size{1};
+};
+
+LogReader::LogReader(const std::string& path) : impl_(std::make_unique<Impl>(path)) {
+  if (!impl_->log.good())
+    throw std::runtime_error("LogReader: cannot read the LCM log '" + path + "'");
+  std::FILE* file = impl_->log.getFilePtr();
+  const long at = std::ftell(file);
+  std::fseek(file, 0, SEEK_END);
+  impl_->size = std::max(1L, std::ftell(file));
+  std::fseek(file, at, SEEK_SET);
+}
+
+LogReader::~LogReader() = default;
+
+bool LogReader::Next(std::string* channel, std::vector<std::uint8_t>* data, std::int64_t* utime) {
+  const lcm::LogEvent* event = impl_->log.readNextEvent();
+  if (event == nullptr) return false;
+  *channel = event->channel;
+  const auto* bytes = static_cast<const std::uint8_t*>(event->data);
+  data->assign(bytes, bytes + event->datalen);
+  *utime = event->timestamp;
+  return true;
+}
+
+double LogReader::fraction_read() const {
+  return double(std::ftell(impl_->log.getFilePtr())) / double(impl_->size);
 }
 
 namespace {
@@ -49,11 +106,25 @@ LatestInput::~LatestInput() {
 
 void LatestInput::OnMessage(const void* data, unsigned size, std::int64_t receive_utime) {
   ++received_;
+  last_receive_utime_ = receive_utime;
+  if (queue_) {
+    const auto* bytes = static_cast<const std::uint8_t*>(data);
+    queue_messages_.emplace_back(bytes, bytes + size);
+    return;
+  }
   if (fresh_) ++superseded_;  // the one waiting was never taken
   const auto* bytes = static_cast<const std::uint8_t*>(data);
   newest_.assign(bytes, bytes + size);
   fresh_ = true;
   last_receive_utime_ = receive_utime;
+}
+
+const std::vector<std::uint8_t>* LatestInput::Peek() const {
+  return queue_messages_.empty() ? nullptr : &queue_messages_.front();
+}
+
+void LatestInput::Pop() {
+  if (!queue_messages_.empty()) queue_messages_.pop_front();
 }
 
 const std::vector<std::uint8_t>* LatestInput::TakeNewest() {

@@ -3,6 +3,7 @@
 // Threads: everything here belongs to the loop thread.
 
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <memory>
 #include <string>
@@ -32,12 +33,38 @@ class LcmLink {
   int Drain();
   // Publishes raw bytes (an encoded LCM message). Returns false on failure.
   bool Publish(const std::string& channel, const void* data, unsigned size);
+  // Publishes without recording (a replay feeding its inputs through memq://).
+  bool Inject(const std::string& channel, const void* data, unsigned size);
+  // Waits up to `timeout_ms` for one message and handles it; false on timeout.
+  bool Wait(int timeout_ms);
+
+  // Also writes every message this link publishes to an LCM log file, stamped
+  // with the time set by set_record_utime() (deterministic in lock-step runs).
+  // Throws std::runtime_error naming the file when it cannot be opened.
+  void RecordTo(const std::string& path);
+  void set_record_utime(std::int64_t utime) { record_utime_ = utime; }
 
   struct Impl;
   Impl& impl() { return *impl_; }
 
  private:
   std::string url_;
+  std::unique_ptr<Impl> impl_;
+  std::int64_t record_utime_{0};
+};
+
+// Reads an LCM log file event by event (no network), for replays.
+class LogReader {
+ public:
+  // Throws std::runtime_error naming the file when it cannot be read.
+  explicit LogReader(const std::string& path);
+  ~LogReader();
+  // The next event, or false at the end.
+  bool Next(std::string* channel, std::vector<std::uint8_t>* data, std::int64_t* utime);
+  double fraction_read() const;  // 0 .. 1
+
+ private:
+  struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 
@@ -55,6 +82,13 @@ class LatestInput {
 
   // The newest message that arrived since the last call, or nullptr.
   const std::vector<std::uint8_t>* TakeNewest();
+
+  // Lock-step mode: keep every message in arrival order instead of the newest.
+  void set_queue(bool queue) { queue_ = queue; }
+  std::size_t queued() const { return queue_messages_.size(); }
+  // The oldest queued message (nullptr when none), and dropping it.
+  const std::vector<std::uint8_t>* Peek() const;
+  void Pop();
   // Counts a taken message as rejected, by reason; the user keeps its last good value.
   void Reject(const std::string& reason);
   // Where rejections are also logged, once per cause per second (nullptr: nowhere).
@@ -80,6 +114,8 @@ class LatestInput {
   std::string channel_;
   void* subscription_{nullptr};
   std::vector<std::uint8_t> newest_, taken_;
+  bool queue_{false};
+  std::deque<std::vector<std::uint8_t>> queue_messages_;
   bool fresh_{false};
   std::int64_t received_{0}, superseded_{0}, rejected_{0};
   std::int64_t last_receive_utime_{0}, last_accept_utime_{-1};

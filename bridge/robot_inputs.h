@@ -36,6 +36,13 @@ class RobotInputs {
   // or bones changed.
   Applied Apply(scene::RobotState* state, scene::CollisionWorld* world);
 
+  // Lock-step (for replays and deterministic runs): the inputs queue every
+  // message, and ApplyNext() consumes exactly the oldest pose message, after
+  // the bone and placement messages whose seq is not above its seq.
+  void set_lockstep(bool lockstep);
+  bool HasPose() const { return pose_.queued() > 0; }
+  Applied ApplyNext(scene::RobotState* state, scene::CollisionWorld* world);
+
   const LatestInput& pose() const { return pose_; }
   const LatestInput& bones() const { return bones_; }
   const LatestInput& actors() const { return actors_; }
@@ -43,6 +50,13 @@ class RobotInputs {
   void set_log(RejectLog* log) { pose_.set_log(log), bones_.set_log(log), actors_.set_log(log); }
 
  private:
+  void ApplyPose(const std::vector<std::uint8_t>& bytes, scene::RobotState* state,
+                 Applied* applied);
+  void ApplyBones(const std::vector<std::uint8_t>& bytes, scene::RobotState* state,
+                  Applied* applied);
+  void ApplyActors(const std::vector<std::uint8_t>& bytes, scene::CollisionWorld* world,
+                   Applied* applied);
+
   const scene::Level& level_;
   Translation translation_;
   LatestInput pose_, bones_, actors_;

@@ -1,14 +1,18 @@
 #!/usr/bin/env bash
-# Record and replay a session with LCM's own tools, inside a private network
-# namespace (scripts/netns-run): lcm-logger records the example model's
-# flight; lcm-logplayer replays the log into a running sandbox, whose scan
-# faces face_check compares with one-shot scans at the replayed poses.
+# Record and replay a session, inside a private network namespace
+# (scripts/netns-run): lcm-logger records the example model's flight;
+# lcm-logplayer replays the log into a running sandbox, whose scan faces
+# face_check compares with one-shot scans at the replayed poses; and
+# `sandbox run --replay` reads the log twice in lock-step, giving
+# byte-identical output logs with one tick per recorded pose.
 #
 #   log_replay.sh SANDBOX FLY_WING FACE_CHECK LEVEL
 set -euo pipefail
 sandbox=$1 fly_wing=$2 face_check=$3 level=$4
 log=$(mktemp /tmp/sandbox-flight-XXXXXX.lcmlog)
-trap 'rm -f "$log"' EXIT
+out1=$(mktemp /tmp/sandbox-replay1-XXXXXX.lcmlog)
+out2=$(mktemp /tmp/sandbox-replay2-XXXXXX.lcmlog)
+trap 'rm -f "$log" "$out1" "$out2"' EXIT
 lcm-logger --force --channel='ELAHA/(POSE|BONES)' "$log" > /dev/null &
 logger_pid=$!
 sleep 0.3
@@ -29,4 +33,11 @@ cat /tmp/sandbox-replay-run.log
 # Every pose recorded reached the sandbox (the log plays at recorded speed).
 grep -q "ELAHA/POSE: $published received" /tmp/sandbox-replay-run.log ||
   { echo "not all $published logged poses arrived"; status=1; }
+# Lock-step replays of the log: one tick per pose, the same bytes every time.
+"$sandbox" run "$level" --replay "$log" --record "$out1" 2> /dev/null > /tmp/sandbox-replay1.log
+"$sandbox" run "$level" --replay "$log" --record "$out2" 2> /dev/null > /dev/null
+grep -q "sandbox run: $published ticks" /tmp/sandbox-replay1.log ||
+  { echo "the replay did not run one tick per pose:"; cat /tmp/sandbox-replay1.log; status=1; }
+cmp "$out1" "$out2" || { echo "two replays of one log differ"; status=1; }
+echo "replayed twice: $(stat -c %s "$out1") bytes of outputs, identical"
 exit "$status"
