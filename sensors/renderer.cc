@@ -1,0 +1,353 @@
+#include "sensors/renderer.h"
+
+#define GL_GLEXT_PROTOTYPES
+#include <GL/osmesa.h>
+#include <GL/gl.h>
+#include <GL/glext.h>
+
+#include <cmath>
+#include <limits>
+#include <map>
+#include <stdexcept>
+
+namespace sandbox::sensors {
+namespace {
+
+const char* kVertexShader = R"(#version 450 core
+layout(location = 0) in vec3 position;
+layout(location = 1) in vec3 normal;
+layout(location = 2) in vec2 uv;
+uniform mat4 model;       // object to camera-centred world (world axes, origin at the camera)
+uniform mat4 view_proj;   // camera-centred world to clip
+out vec3 world_normal;
+out vec2 tex_uv;
+out float distance_m;
+void main() {
+  vec4 p = model * vec4(position, 1.0);
+  world_normal = mat3(model) * normal;
+  tex_uv = uv;
+  distance_m = length(p.xyz);
+  gl_Position = view_proj * p;
+}
+)";
+
+const char* kFragmentShader = R"(#version 450 core
+in vec3 world_normal;
+in vec2 tex_uv;
+in float distance_m;
+uniform vec4 base_color;
+uniform bool has_texture;
+uniform sampler2D base_texture;
+uniform vec3 sun;
+uniform vec3 sky;
+uniform vec2 fog;  // start, end
+out vec4 color;
+void main() {
+  vec4 albedo = base_color;
+  if (has_texture) albedo *= texture(base_texture, tex_uv);
+  vec3 n = normalize(world_normal);
+  float light = 0.35 + 0.65 * abs(dot(n, sun));  // two-sided: thin surfaces lit from both sides
+  vec3 lit = albedo.rgb * light;
+  float f = clamp((distance_m - fog.x) / max(fog.y - fog.x, 1e-3), 0.0, 1.0);
+  color = vec4(mix(lit, sky, f), albedo.a);
+}
+)";
+
+GLuint Compile(GLenum type, const char* source) {
+  const GLuint shader = glCreateShader(type);
+  glShaderSource(shader, 1, &source, nullptr);
+  glCompileShader(shader);
+  GLint ok = 0;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[2048];
+    glGetShaderInfoLog(shader, sizeof(log), nullptr, log);
+    throw std::runtime_error(std::string("Renderer: shader does not compile: ") + log);
+  }
+  return shader;
+}
+
+// A mesh on the GPU.
+struct GpuMesh {
+  GLuint vao{0}, positions{0}, normals{0}, uvs{0}, indices{0};
+  GLsizei index_count{0};
+  int material{-1};
+};
+
+GpuMesh Upload(const std::vector<Eigen::Vector3f>& positions,
+               const std::vector<Eigen::Vector3f>& normals, const std::vector<Eigen::Vector2f>& uvs,
+               const std::vector<std::uint32_t>& indices, int material, GLenum usage) {
+  GpuMesh mesh;
+  mesh.material = material;
+  mesh.index_count = GLsizei(indices.size());
+  glGenVertexArrays(1, &mesh.vao);
+  glBindVertexArray(mesh.vao);
+  auto attribute = [&](GLuint* buffer, GLuint location, int size, const void* data, std::size_t bytes) {
+    glGenBuffers(1, buffer);
+    glBindBuffer(GL_ARRAY_BUFFER, *buffer);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(bytes), data, usage);
+    glEnableVertexAttribArray(location);
+    glVertexAttribPointer(location, size, GL_FLOAT, GL_FALSE, 0, nullptr);
+  };
+  attribute(&mesh.positions, 0, 3, positions.data(), positions.size() * 12);
+  attribute(&mesh.normals, 1, 3, normals.data(), normals.size() * 12);
+  if (uvs.size() == positions.size()) {
+    attribute(&mesh.uvs, 2, 2, uvs.data(), uvs.size() * 8);
+  } else {
+    glDisableVertexAttribArray(2);
+    glVertexAttrib2f(2, 0.f, 0.f);
+  }
+  glGenBuffers(1, &mesh.indices);
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, mesh.indices);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * 4), indices.data(), GL_STATIC_DRAW);
+  glBindVertexArray(0);
+  return mesh;
+}
+
+// Column-major float matrix of X relative to the camera position (double).
+Eigen::Matrix4f Relative(const Eigen::Affine3d& X, const Eigen::Vector3d& camera) {
+  Eigen::Affine3d rel = X;
+  rel.translation() -= camera;
+  return rel.matrix().cast<float>();
+}
+
+class OsMesaRenderer : public Renderer {
+ public:
+  OsMesaRenderer() {
+    const int attributes[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 24, OSMESA_PROFILE,
+                              OSMESA_CORE_PROFILE, OSMESA_CONTEXT_MAJOR_VERSION, 4,
+                              OSMESA_CONTEXT_MINOR_VERSION, 5, 0};
+    context_ = OSMesaCreateContextAttribs(attributes, nullptr);
+    if (context_ == nullptr) throw std::runtime_error("Renderer: cannot create an OSMesa GL 4.5 context");
+    backing_.resize(4);
+    if (!OSMesaMakeCurrent(context_, backing_.data(), GL_UNSIGNED_BYTE, 1, 1)) {
+      throw std::runtime_error("Renderer: cannot make the OSMesa context current");
+    }
+    description_ = std::string("OpenGL ") + reinterpret_cast<const char*>(glGetString(GL_VERSION)) +
+                   ", " + reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    program_ = glCreateProgram();
+    glAttachShader(program_, Compile(GL_VERTEX_SHADER, kVertexShader));
+    glAttachShader(program_, Compile(GL_FRAGMENT_SHADER, kFragmentShader));
+    glLinkProgram(program_);
+    GLint ok = 0;
+    glGetProgramiv(program_, GL_LINK_STATUS, &ok);
+    if (!ok) throw std::runtime_error("Renderer: shaders do not link");
+  }
+  ~OsMesaRenderer() override { OSMesaDestroyContext(context_); }
+
+  void SetLevel(const scene::Level& level, const TextureDecoder& decoder) override {
+    level_ = &level;
+    for (std::size_t a = 0; a < level.actors.size(); ++a) {
+      for (const scene::Mesh& mesh : level.actors[a].meshes) {
+        actor_meshes_.push_back({int(a), Upload(mesh.positions_A, mesh.normals_A, mesh.uvs,
+                                                mesh.indices, mesh.material, GL_STATIC_DRAW)});
+      }
+    }
+    // Textures: decoded once, by the decoder the app gives.
+    for (std::size_t m = 0; m < level.materials.size(); ++m) {
+      const scene::Material& material = level.materials[m];
+      const bool embedded = material.base_color_texture_embedded >= 0 &&
+                            material.base_color_texture_embedded < int(level.textures.size());
+      if (!embedded && material.base_color_texture_path.empty()) continue;
+      RgbaImage image;
+      const scene::EmbeddedTexture* texture =
+          embedded ? &level.textures[std::size_t(material.base_color_texture_embedded)] : nullptr;
+      if (!decoder || !decoder(texture, material.base_color_texture_path, &image) ||
+          image.width <= 0 || image.height <= 0) {
+        warnings_.push_back("material '" + material.name + "': texture " +
+                            (embedded ? "(embedded)" : material.base_color_texture_path) +
+                            " cannot be read; drawn with its base colour");
+        continue;
+      }
+      GLuint id = 0;
+      glGenTextures(1, &id);
+      glBindTexture(GL_TEXTURE_2D, id);
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, image.width, image.height, 0, GL_RGBA,
+                   GL_UNSIGNED_BYTE, image.rgba.data());
+      glGenerateMipmap(GL_TEXTURE_2D);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+      textures_[int(m)] = id;
+    }
+  }
+
+  void Render(const CameraView& view, const std::vector<Eigen::Isometry3d>& actor_poses,
+              const std::vector<const scene::RobotState*>& robots, const RenderSettings& settings,
+              Frame* frame) override {
+    view.ValidateOrThrow();
+    Resize(view.width, view.height);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glViewport(0, 0, view.width, view.height);
+    glClearColor(settings.sky_rgb.x(), settings.sky_rgb.y(), settings.sky_rgb.z(), 1.f);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    glUseProgram(program_);
+
+    // Camera-centred world: rotation only in the view; positions relative to the camera.
+    const Eigen::Vector3d camera = view.X_WC.translation();
+    Eigen::Matrix3d R_EyeCam;
+    R_EyeCam << 0, -1, 0, 0, 0, 1, -1, 0, 0;  // camera x forward, y left, z up -> GL eye
+    Eigen::Matrix4d view_rotation = Eigen::Matrix4d::Identity();
+    view_rotation.topLeftCorner<3, 3>() = R_EyeCam * view.X_WC.linear().transpose();
+    const double f = 1.0 / std::tan(0.5 * view.fov_y_rad), aspect = double(view.width) / view.height;
+    const double n = view.near_m, fa = view.far_m;
+    Eigen::Matrix4d projection = Eigen::Matrix4d::Zero();
+    projection(0, 0) = f / aspect;
+    projection(1, 1) = f;
+    projection(2, 2) = (fa + n) / (n - fa);
+    projection(2, 3) = 2.0 * fa * n / (n - fa);
+    projection(3, 2) = -1.0;
+    const Eigen::Matrix4f view_proj = (projection * view_rotation).cast<float>();
+    glUniformMatrix4fv(Location("view_proj"), 1, GL_FALSE, view_proj.data());
+    const Eigen::Vector3f sun = settings.sun_direction_W.normalized();
+    glUniform3f(Location("sun"), sun.x(), sun.y(), sun.z());
+    glUniform3f(Location("sky"), settings.sky_rgb.x(), settings.sky_rgb.y(), settings.sky_rgb.z());
+    glUniform2f(Location("fog"), settings.fog_start_m, settings.fog_end_m);
+    glUniform1i(Location("base_texture"), 0);
+
+    // Opaque first, then the translucent (water) on top.
+    for (const bool translucent : {false, true}) {
+      for (const auto& [actor, mesh] : actor_meshes_) {
+        if (IsTranslucent(mesh.material) != translucent) continue;
+        const Eigen::Isometry3d& X_WA = actor_poses.size() == level_->actors.size()
+                                            ? actor_poses[std::size_t(actor)]
+                                            : level_->actors[std::size_t(actor)].X_WA;
+        Draw(mesh, Relative(Eigen::Affine3d(X_WA.matrix()), camera));
+      }
+    }
+    // Robots: their posed meshes, uploaded afresh.
+    for (std::size_t r = 0; r < robots.size(); ++r) {
+      const scene::RobotState& state = *robots[r];
+      std::vector<GpuMesh>& meshes = robot_meshes_[&state.model()];
+      const auto& model = state.model();
+      for (std::size_t m = 0; m < model.meshes.size(); ++m) {
+        if (meshes.size() <= m) {
+          meshes.push_back(Upload(state.positions_B(int(m)), state.normals_B(int(m)),
+                                  model.meshes[m].bind.uvs, model.meshes[m].bind.indices,
+                                  model.meshes[m].bind.material, GL_DYNAMIC_DRAW));
+        } else {
+          glBindBuffer(GL_ARRAY_BUFFER, meshes[m].positions);
+          glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(state.positions_B(int(m)).size() * 12),
+                          state.positions_B(int(m)).data());
+          glBindBuffer(GL_ARRAY_BUFFER, meshes[m].normals);
+          glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(state.normals_B(int(m)).size() * 12),
+                          state.normals_B(int(m)).data());
+        }
+        Draw(meshes[m], Relative(Eigen::Affine3d(state.pose().matrix()), camera));
+      }
+    }
+    glFinish();
+
+    // Read back, bottom row first in GL; flip to top first.
+    const int w = view.width, h = view.height;
+    pixels_.resize(std::size_t(w) * h * 4);
+    depth_.resize(std::size_t(w) * h);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, pixels_.data());
+    glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, depth_.data());
+    frame->width = w;
+    frame->height = h;
+    frame->rgb.resize(std::size_t(w) * h * 3);
+    frame->depth_m.resize(std::size_t(w) * h);
+    for (int y = 0; y < h; ++y) {
+      const std::size_t src = std::size_t(h - 1 - y) * std::size_t(w), dst = std::size_t(y) * std::size_t(w);
+      for (int x = 0; x < w; ++x) {
+        for (int c = 0; c < 3; ++c) frame->rgb[3 * (dst + std::size_t(x)) + std::size_t(c)] =
+            pixels_[4 * (src + std::size_t(x)) + std::size_t(c)];
+        const double d = depth_[src + std::size_t(x)];
+        frame->depth_m[dst + std::size_t(x)] =
+            d >= 1.0 ? std::numeric_limits<float>::infinity()
+                     : float(2.0 * n * fa / (fa + n - (2.0 * d - 1.0) * (fa - n)));
+      }
+    }
+  }
+
+  const std::vector<std::string>& warnings() const override { return warnings_; }
+  std::string description() const override { return description_; }
+
+ private:
+  GLint Location(const char* name) { return glGetUniformLocation(program_, name); }
+
+  bool IsTranslucent(int material) const {
+    return material >= 0 && material < int(level_->materials.size()) &&
+           level_->materials[std::size_t(material)].base_color.w() < 0.999f;
+  }
+
+  void Draw(const GpuMesh& mesh, const Eigen::Matrix4f& model) {
+    glUniformMatrix4fv(Location("model"), 1, GL_FALSE, model.data());
+    Eigen::Vector4f color(0.8f, 0.8f, 0.8f, 1.f);
+    if (mesh.material >= 0 && mesh.material < int(level_->materials.size())) {
+      color = level_->materials[std::size_t(mesh.material)].base_color;
+    }
+    glUniform4f(Location("base_color"), color.x(), color.y(), color.z(), color.w());
+    const auto texture = textures_.find(mesh.material);
+    glUniform1i(Location("has_texture"), texture != textures_.end() && mesh.uvs != 0);
+    if (texture != textures_.end()) {
+      glActiveTexture(GL_TEXTURE0);
+      glBindTexture(GL_TEXTURE_2D, texture->second);
+    }
+    glBindVertexArray(mesh.vao);
+    glDrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
+  }
+
+  void Resize(int width, int height) {
+    if (width == width_ && height == height_) return;
+    if (fbo_ == 0) {
+      glGenFramebuffers(1, &fbo_);
+      glGenRenderbuffers(2, buffers_);
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glBindRenderbuffer(GL_RENDERBUFFER, buffers_[0]);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, buffers_[0]);
+    glBindRenderbuffer(GL_RENDERBUFFER, buffers_[1]);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, width, height);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, buffers_[1]);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+      throw std::runtime_error("Renderer: framebuffer of " + std::to_string(width) + " x " +
+                               std::to_string(height) + " is incomplete");
+    }
+    width_ = width, height_ = height;
+  }
+
+  OSMesaContext context_{nullptr};
+  std::vector<std::uint8_t> backing_;
+  std::string description_;
+  GLuint program_{0}, fbo_{0}, buffers_[2]{0, 0};
+  int width_{0}, height_{0};
+  const scene::Level* level_{nullptr};
+  std::vector<std::pair<int, GpuMesh>> actor_meshes_;
+  std::map<const scene::RobotModel*, std::vector<GpuMesh>> robot_meshes_;
+  std::map<int, GLuint> textures_;
+  std::vector<std::string> warnings_;
+  std::vector<std::uint8_t> pixels_;
+  std::vector<float> depth_;
+};
+
+}  // namespace
+
+void CameraView::ValidateOrThrow() const {
+  if (width < 1 || width > 8192 || height < 1 || height > 8192) {
+    throw std::invalid_argument("resolution must be 1 to 8192 pixels a side, got " +
+                                std::to_string(width) + " x " + std::to_string(height));
+  }
+  if (!(fov_y_rad > 0.0 && fov_y_rad < M_PI)) {
+    throw std::invalid_argument("field of view must be between 0 and 180 degrees");
+  }
+  if (!(near_m > 0.0 && far_m > near_m)) throw std::invalid_argument("need 0 < near_m < far_m");
+  if (!X_WC.matrix().allFinite()) throw std::invalid_argument("non-finite camera pose");
+}
+
+std::unique_ptr<Renderer> MakeRenderer(RendererBackend backend) {
+  switch (backend) {
+    case RendererBackend::kOsMesa:
+      return std::make_unique<OsMesaRenderer>();
+  }
+  return nullptr;
+}
+
+}  // namespace sandbox::sensors
