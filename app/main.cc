@@ -6,6 +6,7 @@
 
 #include "app/info_command.h"
 #include "app/pose_command.h"
+#include "app/render_command.h"
 #include "app/run_command.h"
 #include "app/scan_command.h"
 #include "app/topics_command.h"
@@ -19,6 +20,7 @@ const char* kUsage =
     "  pose [LEVEL] --out M.ply  a robot posed from the command line, as a mesh and bone frames\n"
     "  scan [LEVEL] --at X,Y,Z --out F  one sensor once at a pose, as CSV or PLY\n"
     "  run [LEVEL]             the loop: LCM inputs, sensors, outputs at a fixed rate\n"
+    "  render [LEVEL] --camera C --at X,Y,Z --out F  one camera frame (OSMesa)\n"
     "  topics                  the LCM channels heard: type, count, rate, size\n"
     "run 'sandbox COMMAND --help' for a command's options\n";
 
@@ -36,6 +38,7 @@ int main(int argc, char** argv) {
     if (args[0] == "pose") return sandbox::app::RunPose(rest, std::cout, std::cerr);
     if (args[0] == "scan") return sandbox::app::RunScan(rest, std::cout, std::cerr);
     if (args[0] == "run") return sandbox::app::RunLoop(rest, std::cout, std::cerr);
+    if (args[0] == "render") return sandbox::app::RunRender(rest, std::cout, std::cerr);
     if (args[0] == "topics") return sandbox::app::RunTopics(rest, std::cout, std::cerr);
   } catch (const std::exception& error) {
     std::cerr << "sandbox " << args[0] << ": " << error.what() << "\n";

@@ -1,0 +1,70 @@
+#include "app/images.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace sandbox::app {
+
+sensors::TextureDecoder OpenCvTextureDecoder() {
+  return [](const scene::EmbeddedTexture* embedded, const std::string& path,
+            sensors::RgbaImage* image) {
+    cv::Mat decoded;
+    if (embedded != nullptr && embedded->height > 0) {  // raw RGBA texels
+      image->width = embedded->width;
+      image->height = embedded->height;
+      image->rgba = embedded->bytes;
+      return true;
+    }
+    if (embedded != nullptr) {
+      const cv::Mat bytes(1, int(embedded->bytes.size()), CV_8U,
+                          const_cast<std::uint8_t*>(embedded->bytes.data()));
+      decoded = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
+    } else {
+      decoded = cv::imread(path, cv::IMREAD_UNCHANGED);
+    }
+    if (decoded.empty()) return false;
+    if (decoded.depth() != CV_8U) decoded.convertTo(decoded, CV_8U, 1.0 / 257.0);
+    const int code = decoded.channels() == 1   ? cv::COLOR_GRAY2RGBA
+                     : decoded.channels() == 3 ? cv::COLOR_BGR2RGBA
+                                               : cv::COLOR_BGRA2RGBA;
+    cv::cvtColor(decoded, decoded, code);
+    image->width = decoded.cols;
+    image->height = decoded.rows;
+    image->rgba.assign(decoded.data, decoded.data + decoded.total() * 4);
+    return true;
+  };
+}
+
+void WriteColor(const sensors::Frame& frame, const std::string& path) {
+  cv::Mat rgb(frame.height, frame.width, CV_8UC3, const_cast<std::uint8_t*>(frame.rgb.data()));
+  cv::Mat bgr;
+  cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+  bool written = false;
+  try {
+    written = cv::imwrite(path, bgr);
+  } catch (const cv::Exception&) {
+    written = false;
+  }
+  if (!written) throw std::runtime_error("cannot write " + path);
+}
+
+void WriteDepthMillimetres(const sensors::Frame& frame, const std::string& path) {
+  cv::Mat depth(frame.height, frame.width, CV_16U);
+  for (int i = 0; i < frame.width * frame.height; ++i) {
+    const float d = frame.depth_m[std::size_t(i)];
+    depth.at<std::uint16_t>(i / frame.width, i % frame.width) =
+        std::isfinite(d) && d * 1000.f < 65535.f ? std::uint16_t(std::lround(d * 1000.f)) : 0;
+  }
+  bool written = false;
+  try {
+    written = cv::imwrite(path, depth);
+  } catch (const cv::Exception&) {
+    written = false;
+  }
+  if (!written) throw std::runtime_error("cannot write " + path);
+}
+
+}  // namespace sandbox::app

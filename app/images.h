@@ -1,0 +1,19 @@
+#pragma once
+// Images through OpenCV: texture decoding for the renderer, and frame writing.
+
+#include <string>
+
+#include "sensors/renderer.h"
+
+namespace sandbox::app {
+
+// Decodes embedded (PNG, JPEG, ...) or file textures to RGBA with OpenCV.
+sensors::TextureDecoder OpenCvTextureDecoder();
+
+// Writes a frame's colour; the format follows the file's extension (.jpg,
+// .png, ...). Throws std::runtime_error naming the file when it cannot.
+void WriteColor(const sensors::Frame& frame, const std::string& path);
+// Writes depth as a 16-bit PNG in millimetres (0: nothing within range).
+void WriteDepthMillimetres(const sensors::Frame& frame, const std::string& path);
+
+}  // namespace sandbox::app
