@@ -1,0 +1,214 @@
+// The OSMesa renderer and the cameras: colours, depth against the ray caster,
+// textures, the bent wing's silhouette, the chase camera's aim and lag.
+
+#include "sensors/renderer.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <opencv2/imgcodecs.hpp>
+
+#include "app/images.h"
+#include "scene/collision_world.h"
+#include "scene/level.h"
+#include "sensors/cameras.h"
+#include "sensors/ray_caster.h"
+#include "tests/test_util.h"
+
+namespace sandbox::sensors {
+namespace {
+
+using Eigen::Isometry3d;
+using Eigen::Vector3d;
+
+std::string Generated(const std::string& file) {
+  return std::string(SANDBOX_SOURCE_DIR) + "/assets/sample/generated/" + file;
+}
+
+// Pixel (column, row) of world point p seen by `view` (row 0 at the top).
+Eigen::Vector2d Project(const CameraView& view, const Vector3d& p_W) {
+  const Vector3d p_C = view.X_WC.inverse() * p_W;  // x forward, y left, z up
+  const double f = 0.5 * view.height / std::tan(0.5 * view.fov_y_rad);
+  return {0.5 * view.width - f * p_C.y() / p_C.x(), 0.5 * view.height - f * p_C.z() / p_C.x()};
+}
+
+const std::uint8_t* Pixel(const Frame& frame, int column, int row) {
+  return &frame.rgb[3 * (std::size_t(row) * std::size_t(frame.width) + std::size_t(column))];
+}
+
+class RendererTest : public ::testing::Test {
+ protected:
+  // The sample terrain and tower only (no water, no robot): what the rays see is drawn.
+  RendererTest()
+      : level_(scene::LoadLevel(dir_.Write(
+            "level.toml", "[[actor]]\nname = \"terrain\"\nfile = \"" + Generated("terrain.gltf") +
+                              "\"\n[[actor]]\nname = \"tower\"\nfile = \"" +
+                              Generated("tower.gltf") + "\"\nposition = [-30, 45, 7.76]\n"))),
+        renderer_(MakeRenderer()) {
+    renderer_->SetLevel(level_, app::OpenCvTextureDecoder());
+  }
+  testing::TempDir dir_;
+  scene::Level level_;
+  std::unique_ptr<Renderer> renderer_;
+};
+
+TEST_F(RendererTest, SkyAboveTerrainBelow) {
+  CameraView view;
+  view.X_WC = LookAt(Vector3d(0, -150, 40), Vector3d(0, 0, 40));  // level, looking north
+  Frame frame;
+  const RenderSettings settings;
+  renderer_->Render(view, {}, {}, settings, &frame);
+  const std::uint8_t* top = Pixel(frame, 320, 2);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(top[c], std::lround(255 * settings.sky_rgb[c]), 1) << c;
+  const std::uint8_t* bottom = Pixel(frame, 320, 470);
+  EXPECT_GT(bottom[1], bottom[0]);  // the terrain's green
+  EXPECT_GT(bottom[1], bottom[2]);
+  EXPECT_TRUE(std::isinf(frame.depth_m[2 * 640 + 320]));
+}
+
+TEST_F(RendererTest, DepthAgreesWithTheRayCaster) {
+  CameraView view;
+  view.X_WC = LookAt(Vector3d(10, -120, 45), Vector3d(-30, 45, 10));  // the tower, the hills
+  Frame frame;
+  renderer_->Render(view, {}, {}, {}, &frame);
+  const scene::CollisionWorld world(level_);
+  RayCaster caster(1);
+  RayBatch rays;
+  rays.origin_W = view.X_WC.translation();
+  std::vector<std::pair<int, int>> pixels;
+  const double f = 0.5 * view.height / std::tan(0.5 * view.fov_y_rad);
+  for (int row = 4; row < view.height; row += 37) {
+    for (int column = 4; column < view.width; column += 41) {
+      // The ray through the pixel centre, in the camera frame (x forward).
+      const Vector3d d_C(1.0, -(column + 0.5 - 0.5 * view.width) / f, -(row + 0.5 - 0.5 * view.height) / f);
+      rays.start.emplace_back(0.f, 0.f, 0.f);
+      rays.direction.push_back((view.X_WC.linear() * d_C.normalized()).cast<float>());
+      rays.length_m.push_back(2000.f);
+      pixels.emplace_back(column, row);
+    }
+  }
+  RayHits hits;
+  caster.Cast(world, rays, {}, &hits);
+  int compared = 0;
+  for (std::size_t i = 0; i < pixels.size(); ++i) {
+    const auto [column, row] = pixels[i];
+    const float depth = frame.depth_m[std::size_t(row) * std::size_t(view.width) + std::size_t(column)];
+    if (hits.body[i] == RayHits::kNoHit) {
+      EXPECT_TRUE(std::isinf(depth)) << column << ", " << row;
+      continue;
+    }
+    const Vector3d d_C(1.0, -(column + 0.5 - 0.5 * view.width) / f, -(row + 0.5 - 0.5 * view.height) / f);
+    const double expected = hits.distance_m[i] / d_C.norm();  // along the optical axis
+    EXPECT_NEAR(depth, expected, 0.02 + 1e-3 * expected) << column << ", " << row;
+    ++compared;
+  }
+  EXPECT_GT(compared, 60);
+}
+
+TEST(RendererTextureTest, TextureColoursShow) {
+  // A square with a two-colour texture: red on the left half, blue on the right.
+  testing::TempDir dir;
+  cv::Mat texture(8, 16, CV_8UC3, cv::Scalar(255, 0, 0));   // BGR blue
+  texture(cv::Rect(0, 0, 8, 8)).setTo(cv::Scalar(0, 0, 255));  // left half red
+  ASSERT_TRUE(cv::imwrite((dir.path() / "check.png").string(), texture));
+  dir.Write("square.mtl", "newmtl check\nKd 1 1 1\nmap_Kd check.png\n");
+  dir.Write("square.obj",
+            "mtllib square.mtl\no square\nv 0 -1 -1\nv 0 1 -1\nv 0 1 1\nv 0 -1 1\n"
+            "vt 1 0\nvt 0 0\nvt 0 1\nvt 1 1\nusemtl check\nf 1/1 2/2 3/3 4/4\n");
+  const scene::Level level = scene::LoadLevel(
+      dir.Write("level.toml", "[[actor]]\nname = \"square\"\nfile = \"square.obj\"\n"));
+  auto renderer = MakeRenderer();
+  renderer->SetLevel(level, app::OpenCvTextureDecoder());
+  EXPECT_TRUE(renderer->warnings().empty());
+  CameraView view;
+  view.X_WC = LookAt(Vector3d(-5, 0, 0), Vector3d::Zero());  // facing the square's -x side
+  Frame frame;
+  renderer->Render(view, {}, {}, {}, &frame);
+  // Seen from -x the square's +y edge (u = 0, the red half) is on the image's left.
+  const Eigen::Vector2d left = Project(view, Vector3d(0, 0.5, 0)), right = Project(view, Vector3d(0, -0.5, 0));
+  const std::uint8_t* l = Pixel(frame, int(left.x()), int(left.y()));
+  const std::uint8_t* r = Pixel(frame, int(right.x()), int(right.y()));
+  EXPECT_GT(l[0], 3 * l[2]) << int(l[0]) << " " << int(l[1]) << " " << int(l[2]);
+  EXPECT_GT(r[2], 3 * r[0]) << int(r[0]) << " " << int(r[1]) << " " << int(r[2]);
+  // A texture that cannot be read: one warning, the base colour.
+  dir.Write("square.mtl", "newmtl check\nKd 1 1 1\nmap_Kd missing.png\n");
+  const scene::Level missing = scene::LoadLevel(dir.path() / "level.toml");
+  auto plain = MakeRenderer();
+  plain->SetLevel(missing, app::OpenCvTextureDecoder());
+  ASSERT_EQ(plain->warnings().size(), 1u);
+  EXPECT_NE(plain->warnings()[0].find("missing.png cannot be read"), std::string::npos);
+}
+
+TEST(RendererWingTest, BendingMovesTheSilhouetteToTheAnalyticTip) {
+  const scene::Level level = scene::LoadLevel(testing::SampleLevel());
+  auto renderer = MakeRenderer();
+  renderer->SetLevel(level, {});
+  scene::RobotState straight(level.robots[0]), bent(level.robots[0]);
+  const double roll = 4.5 * M_PI / 180.0;
+  for (int b = 1; b <= 20; ++b) {
+    const double values[2] = {b <= 10 ? roll : -roll, 0.0};
+    ASSERT_TRUE(bent.SetBone(b, values, 2));
+  }
+  bent.Update();
+  // In front of the wing (spawned at (0, 0, 60)), looking back at it, sky behind.
+  CameraView view;
+  view.X_WC = LookAt(Vector3d(40, 0, 62), Vector3d(0, 0, 58));
+  Frame frame_straight, frame_bent;
+  renderer->Render(view, {}, {&straight}, {}, &frame_straight);
+  renderer->Render(view, {}, {&bent}, {}, &frame_bent);
+  // The analytic right tip: ten joints 0.6 then 1.2 m out along -y, each rolled 4.5 degrees.
+  Isometry3d X = Isometry3d(Eigen::Translation3d(0, 0, 60));
+  for (int k = 1; k <= 10; ++k) {
+    X = X * Eigen::Translation3d(0, k == 1 ? -0.6 : -1.2, 0) * Eigen::AngleAxisd(roll, Vector3d::UnitX());
+  }
+  const Vector3d tip = X * Vector3d(-0.15, -0.6, 0.0);  // half an element inside the tip
+  const Eigen::Vector2d px = Project(view, tip);
+  const RenderSettings sky;
+  auto is_sky = [&](const Frame& frame) {
+    const std::uint8_t* p = Pixel(frame, int(px.x()), int(px.y()));
+    return std::abs(p[0] - 255 * sky.sky_rgb[0]) < 3 && std::abs(p[2] - 255 * sky.sky_rgb[2]) < 3;
+  };
+  EXPECT_FALSE(is_sky(frame_bent)) << px.transpose();  // the bent tip is drawn there
+  EXPECT_TRUE(is_sky(frame_straight)) << px.transpose();  // the straight wing is not
+}
+
+TEST(CameraTest, ChaseCameraAimsAtTheRobotAndFollowsWithoutOvershoot) {
+  ChaseCamera chase({});
+  Isometry3d X_WB = Eigen::Translation3d(10, 20, 60) * Eigen::AngleAxisd(0.7, Vector3d::UnitZ());
+  CameraView view;
+  for (int i = 0; i < 100; ++i) view.X_WC = chase.Update(X_WB, 0.05);
+  const Eigen::Vector2d centre = Project(view, X_WB.translation());
+  EXPECT_NEAR(centre.x(), 320.0, 0.5);
+  EXPECT_NEAR(centre.y(), 240.0, 0.5);
+  // A 50 m step: the camera closes on its new place monotonically.
+  X_WB.translation() += Vector3d(50, 0, 0);
+  ChaseCamera settled({});
+  const Vector3d goal = settled.Update(X_WB, 0.0).translation();
+  double last = 1e9;
+  for (int i = 0; i < 60; ++i) {
+    const double distance = (chase.Update(X_WB, 0.05).translation() - goal).norm();
+    EXPECT_LT(distance, last);
+    last = distance;
+  }
+  EXPECT_LT(last, 0.01);
+  // Trailing: pan turns the camera about the robot; tilt raises it.
+  const Isometry3d straight = TrailingPose(X_WB, 25, 8, {});
+  const Isometry3d panned = TrailingPose(X_WB, 25, 8, {M_PI / 2, 0.0, 1.0});
+  EXPECT_NEAR((straight.translation() - X_WB.translation()).norm(),
+              (panned.translation() - X_WB.translation()).norm(), 1e-9);
+  EXPECT_GT(TrailingPose(X_WB, 25, 8, {0.0, 0.3, 1.0}).translation().z(), straight.translation().z());
+}
+
+TEST(CameraTest, BadViewsAreRefused) {
+  CameraView view;
+  view.width = 0;
+  EXPECT_THROW(view.ValidateOrThrow(), std::invalid_argument);
+  view.width = 100000;
+  EXPECT_THROW(view.ValidateOrThrow(), std::invalid_argument);
+  view.width = 640;
+  view.fov_y_rad = 4.0;
+  EXPECT_THROW(view.ValidateOrThrow(), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace sandbox::sensors
