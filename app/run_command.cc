@@ -1,6 +1,8 @@
 #include "app/run_command.h"
 
+#include <algorithm>
 #include <atomic>
+#include <sstream>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -11,6 +13,7 @@
 
 #include "app/command_line.h"
 #include "app/defaults.h"
+#include "app/frame_pipeline.h"
 #include "bridge/lcm_link.h"
 #include "bridge/outputs.h"
 #include "bridge/robot_inputs.h"
@@ -33,10 +36,19 @@ const char* kUsage =
     "               a function of the inputs alone\n"
     "  --replay     read the inputs from an LCM log file (no network), lock-step, full speed\n"
     "  --record     write every output message to an LCM log file\n"
+    "  --out DIR    render the robots' cameras ([[robot.camera]]) into DIR (render and\n"
+    "               encoder threads; the loop never waits for them)\n"
+    "  --frames     jpg (default), png, mp4 or avi\n"
     "Inputs per robot: <ROBOT>/POSE, /BONES, /ACTORS. Outputs: <ROBOT>/SCAN_FACE, /GROUND,\n"
     "/LIDAR, /STATE, /STATUS (docs/bridge.md).\n";
 
 std::atomic<bool> stop_requested{false};
+
+std::string Format(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
 void OnSignal(int) { stop_requested = true; }
 
 std::int64_t NowUtime() {
@@ -67,7 +79,7 @@ struct SensorRun {
 
 int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   const auto parsed =
-      ParseArgs(args, "run", {"--rate", "--duration", "--lcm-url", "--replay", "--record"},
+      ParseArgs(args, "run", {"--rate", "--duration", "--lcm-url", "--replay", "--record", "--out", "--frames"},
                 {"--lockstep"}, kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
@@ -120,13 +132,35 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       }
       robots[r].bone_values.assign(std::size_t(level.robots[r].num_values), 0.0);
     }
+    // Cameras: rendered off the loop when --out is given.
+    const std::vector<sensors::MountedCamera> cameras = sensors::MakeRobotCameras(level);
+    std::unique_ptr<FramePipeline> frames;
+    if (!parsed->Value("--out").empty()) {
+      FramePipelineConfig frame_config;
+      frame_config.out_dir = parsed->Value("--out");
+      frame_config.format = parsed->Value("--frames", "jpg");
+      if (frame_config.format != "jpg" && frame_config.format != "png" &&
+          frame_config.format != "mp4" && frame_config.format != "avi") {
+        throw CommandError("--frames must be jpg, png, mp4 or avi, got '" + frame_config.format + "'");
+      }
+      frames = std::make_unique<FramePipeline>(level, frame_config);
+    }
+    struct CameraRun {
+      const sensors::MountedCamera* camera;
+      sensors::ChaseCamera chase;
+      double next_due_s{0.0}, last_s{-1.0};
+    };
+    std::vector<CameraRun> camera_runs;
+    for (const sensors::MountedCamera& camera : cameras) {
+      camera_runs.push_back({&camera, sensors::ChaseCamera(camera.chase)});
+    }
     std::vector<SensorRun> sensor_runs;
     for (const sensors::MountedSensor& m : mounted) sensor_runs.push_back({&m, 0.0, {}});
 
     out << "sandbox run: " << level.name << ", " << level.robots.size() << " robots, "
         << mounted.size() << " sensors, "
         << (replay ? "replaying " + replay_file
-                   : (lockstep ? std::string("lock-step") : std::to_string(rate_hz) + " Hz") +
+                   : (lockstep ? std::string("lock-step") : Format(rate_hz) + " Hz") +
                          ", LCM " + link.url())
         << "\n"
         << std::flush;
@@ -139,6 +173,7 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     const auto start = Clock::now();
     auto deadline = start;
     std::int64_t tick = 0, overruns = 0, first_input_utime = -1;
+    std::vector<double> lateness_ms;  // tick start after its deadline (free running)
     double next_status_s = 0.0, busy_s = 0.0, next_progress_s = 0.0;
     auto has_pose = [&] {
       for (const RobotRun& robot : robots) {
@@ -175,6 +210,7 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
         }
       }
       const auto tick_start = Clock::now();
+      if (!lockstep) lateness_ms.push_back(std::chrono::duration<double, std::milli>(tick_start - deadline).count());
       std::int64_t now = NowUtime();
       // 1-2. Inputs: the newest message per channel (lock-step: the next pose), applied.
       if (!lockstep) link.Drain();
@@ -232,6 +268,27 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       for (RobotRun& robot : robots) {
         robot.outputs->PublishState(*robot.state, robot.bone_values, robot.input, now);
       }
+      // 5. Cameras that are due: a job for the render thread (copies, no waiting).
+      for (CameraRun& run : camera_runs) {
+        const double dt = run.last_s < 0.0 ? 0.0 : t - run.last_s;
+        run.last_s = t;
+        const RobotRun& robot = robots[std::size_t(run.camera->robot)];
+        sensors::CameraView view = run.camera->view;
+        view.X_WC = run.camera->Pose(*robot.state, &run.chase, {}, dt);  // chase lag advances every tick
+        if (!frames || t < run.next_due_s) continue;
+        const double rate = run.camera->spec.rate_hz > 0.0 ? run.camera->spec.rate_hz : 30.0;
+        run.next_due_s = std::max(run.next_due_s + 1.0 / rate, t);
+        RenderJob job;
+        job.camera = run.camera->spec.name;
+        job.tick = tick;
+        job.time_s = t;
+        job.view = view;
+        job.depth = run.camera->depth;
+        for (const RobotRun& r : robots) job.robots.push_back(*r.state);
+        for (std::size_t a = 0; a < level.actors.size(); ++a) job.actor_poses.push_back(world.actor_pose(int(a)));
+        job.robot_pose = robot.state->pose();
+        frames->Submit(std::move(job));
+      }
       if (t >= next_status_s) {
         next_status_s = t + 1.0;
         for (RobotRun& robot : robots) {
@@ -268,12 +325,25 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     }
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
+    if (frames) frames->Finish();  // queues drained, videos and indexes closed
     if (replay) err << "\rreplay: 100% | " << tick << " ticks" << std::string(30, ' ') << "\n";
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     out << "sandbox run: " << tick << " ticks in " << std::fixed << std::setprecision(2) << elapsed
         << " s (" << (elapsed > 0 ? tick / elapsed : 0.0) << " Hz), mean tick "
         << std::setprecision(3) << (tick > 0 ? 1e3 * busy_s / double(tick) : 0.0) << " ms, "
         << overruns << " overruns\n";
+    if (!lateness_ms.empty()) {
+      std::sort(lateness_ms.begin(), lateness_ms.end());
+      out << "  tick lateness: p50 " << lateness_ms[lateness_ms.size() / 2] << " ms, p99 "
+          << lateness_ms[lateness_ms.size() * 99 / 100] << " ms, max " << lateness_ms.back()
+          << " ms\n";
+    }
+    if (frames) {
+      out << "  frames: " << frames->rendered() << " rendered, " << frames->written() << " written, "
+          << frames->dropped() << " dropped, " << frames->failed() << " failed"
+          << (frames->failed() > 0 ? " (" + frames->error() + ")" : "") << " -> "
+          << parsed->Value("--out") << "\n";
+    }
     for (const RobotRun& robot : robots) {
       for (const bridge::LatestInput* input :
            {&robot.inputs->pose(), &robot.inputs->bones(), &robot.inputs->actors()}) {

@@ -236,15 +236,20 @@ SettingsTable ReadSettings(const fs::path& file, const toml::table& table, Table
 
 // A [[robot.sensor]] table: name, type, mount, placement and rate here; every
 // other key is the sensor's own setting, checked by sensors/.
-SensorSpec ParseSensor(const fs::path& file, const toml::table& table, int index) {
+SensorSpec ParseSensor(const fs::path& file, const toml::table& table, int index,
+                       const std::string& kind, const std::vector<std::string>& types) {
+  std::string type_list;
+  for (std::size_t i = 0; i < types.size(); ++i) {
+    type_list += (i == 0 ? "" : i + 1 == types.size() ? " or " : ", ") + types[i];
+  }
   SensorSpec sensor;
-  sensor.name = ParseName(file, table, "sensor", index);
-  TableReader read(file, table, "sensor '" + sensor.name + "': ");
+  sensor.name = ParseName(file, table, kind, index);
+  TableReader read(file, table, kind + " '" + sensor.name + "': ");
   read.Find("name");
   const std::optional<std::string> type = read.String("type");
-  if (!type) read.Fail(nullptr, "'type' is required: face, ground, lidar or ray");
-  if (*type != "face" && *type != "ground" && *type != "lidar" && *type != "ray") {
-    read.Fail(read.Find("type"), "'type' must be face, ground, lidar or ray, got '" + *type + "'");
+  if (!type) read.Fail(nullptr, "'type' is required: " + type_list);
+  if (std::find(types.begin(), types.end(), *type) == types.end()) {
+    read.Fail(read.Find("type"), "'type' must be " + type_list + ", got '" + *type + "'");
   }
   sensor.type = *type;
   sensor.mount = read.String("mount").value_or("");
@@ -261,7 +266,7 @@ SensorSpec ParseSensor(const fs::path& file, const toml::table& table, int index
   sensor.settings = ReadSettings(file, table, read,
                                  {"name", "type", "mount", "position", "rpy_deg", "rate_hz",
                                   "quaternion_wxyz", "scale", "up", "unit_scale"},
-                                 "sensor '" + sensor.name + "'");
+                                 kind + " '" + sensor.name + "'");
   return sensor;
 }
 
@@ -317,20 +322,24 @@ RobotSpec ParseRobot(const fs::path& file, const toml::table& table, int index) 
       robot.bone_axes[bone] = ParseAxes(read, &value, "bone_axes." + bone);
     }
   }
-  if (const toml::node* sensors = read.Find("sensor")) {
-    const toml::array* array = sensors->as_array();
+  // Sensors and cameras: mounted, named, typed; their own settings as given.
+  for (const auto& [key, types] :
+       {std::pair<std::string, std::vector<std::string>>{"sensor", {"face", "ground", "lidar", "ray"}},
+        {"camera", {"chase", "trailing", "payload", "fixed"}}}) {
+    const toml::node* tables = read.Find(key);
+    if (tables == nullptr) continue;
+    const toml::array* array = tables->as_array();
     if (array == nullptr || !array->is_array_of_tables()) {
-      read.Fail(sensors, "'sensor' must be an array of tables: [[robot.sensor]]");
+      read.Fail(tables, "'" + key + "' must be an array of tables: [[robot." + key + "]]");
     }
     std::set<std::string> names;
-    int sensor_index = 0;
+    int table_index = 0;
     for (const toml::node& item : *array) {
-      SensorSpec sensor = ParseSensor(file, *item.as_table(), ++sensor_index);
-      if (!names.insert(sensor.name).second) {
-        TableReader(file, *item.as_table(), "")
-            .Fail(nullptr, "duplicate sensor name '" + sensor.name + "'");
+      SensorSpec spec = ParseSensor(file, *item.as_table(), ++table_index, key, types);
+      if (!names.insert(spec.name).second) {
+        TableReader(file, *item.as_table(), "").Fail(nullptr, "duplicate " + key + " name '" + spec.name + "'");
       }
-      robot.sensors.push_back(std::move(sensor));
+      (key == "sensor" ? robot.sensors : robot.cameras).push_back(std::move(spec));
     }
   }
   if (const toml::node* bridge = read.Find("bridge")) {

@@ -301,16 +301,18 @@ RobotModel LoadRobotModel(const RobotSpec& spec, const fs::path& manifest, Level
     throw LevelError(where + spec.file.string() + ": has no triangle meshes");
   }
 
-  // Sensor mounts: a node of the robot, or its body frame.
-  for (SensorSpec sensor : spec.sensors) {
-    if (!sensor.mount.empty() && sensor.mount != "body") {
-      sensor.mount_node = model.FindNode(sensor.mount);
-      if (sensor.mount_node < 0) {
-        throw LevelError(sensor.Where() + "mount '" + sensor.mount + "' is not a node of " +
-                         spec.file.filename().string() + " (nodes: " + NodeList(model) + ")");
+  // Sensor and camera mounts: a node of the robot, or its body frame.
+  for (const auto* list : {&spec.sensors, &spec.cameras}) {
+    for (SensorSpec sensor : *list) {
+      if (!sensor.mount.empty() && sensor.mount != "body") {
+        sensor.mount_node = model.FindNode(sensor.mount);
+        if (sensor.mount_node < 0) {
+          throw LevelError(sensor.Where() + "mount '" + sensor.mount + "' is not a node of " +
+                           spec.file.filename().string() + " (nodes: " + NodeList(model) + ")");
+        }
       }
+      (list == &spec.sensors ? model.sensors : model.cameras).push_back(std::move(sensor));
     }
-    model.sensors.push_back(std::move(sensor));
   }
   return model;
 }

@@ -53,6 +53,7 @@ struct RobotSpec {
   std::vector<Eigen::Vector3d> angle_axes;                        // kAngles: the default axes
   std::map<std::string, std::vector<Eigen::Vector3d>> bone_axes;  // per-bone overrides
   std::vector<SensorSpec> sensors;
+  std::vector<SensorSpec> cameras;  // [[robot.camera]]: chase, trailing, payload, fixed
   SettingsTable bridge;  // [robot.bridge]: how the bridge connects it (bridge/ reads it)
   int line{0};
 };
@@ -120,6 +121,7 @@ struct RobotModel {
   Eigen::Isometry3d X_WB_spawn{Eigen::Isometry3d::Identity()};
   bool collision{true};
   std::vector<SensorSpec> sensors;  // mounts resolved
+  std::vector<SensorSpec> cameras;  // mounts resolved
   SettingsTable bridge;
 
   int FindNode(const std::string& node_name) const;  // -1 when absent

@@ -85,6 +85,52 @@ Eigen::Isometry3d MountedSensor::Pose(const scene::RobotState& state) const {
   return state.pose() * X_BM * spec.X_MS;
 }
 
+Eigen::Isometry3d MountedCamera::Pose(const scene::RobotState& state, ChaseCamera* chase_state,
+                                      const TrailingCommand& command, double dt_s) const {
+  if (spec.type == "chase") return chase_state->Update(state.pose(), dt_s);
+  if (spec.type == "trailing") {
+    return TrailingPose(state.pose(), trailing_distance_m, trailing_height_m, command);
+  }
+  if (spec.type == "fixed") return spec.X_MS;
+  const Eigen::Isometry3d X_BM =
+      spec.mount_node < 0
+          ? Eigen::Isometry3d::Identity()
+          : scene::RigidPart(state.node_poses_B()[static_cast<std::size_t>(spec.mount_node)]);
+  return state.pose() * X_BM * spec.X_MS;
+}
+
+std::vector<MountedCamera> MakeRobotCameras(const scene::Level& level) {
+  std::vector<MountedCamera> cameras;
+  for (std::size_t r = 0; r < level.robots.size(); ++r) {
+    for (const scene::SensorSpec& spec : level.robots[r].cameras) {
+      scene::SettingsReader read(spec.settings);
+      MountedCamera camera;
+      camera.spec = spec;
+      camera.robot = static_cast<int>(r);
+      camera.view.width = read.Whole("width", 640);
+      camera.view.height = read.Whole("height", 480);
+      camera.view.fov_y_rad = read.Number("fov_deg", 60.0) * M_PI / 180.0;
+      camera.view.near_m = read.Number("near_m", 0.1);
+      camera.view.far_m = read.Number("far_m", 2000.0);
+      camera.chase.arm_length_m = read.Number("arm_length_m", camera.chase.arm_length_m);
+      camera.chase.arm_height_m = read.Number("arm_height_m", camera.chase.arm_height_m);
+      camera.chase.position_lag_s = read.Number("position_lag_s", camera.chase.position_lag_s);
+      camera.chase.rotation_lag_s = read.Number("rotation_lag_s", camera.chase.rotation_lag_s);
+      camera.trailing_distance_m = read.Number("distance_m", camera.trailing_distance_m);
+      camera.trailing_height_m = read.Number("height_m", camera.trailing_height_m);
+      camera.depth = read.Flag("depth", spec.type == "payload");
+      read.RejectUnknownKeys(spec.type + " camera");
+      try {
+        camera.view.ValidateOrThrow();
+      } catch (const std::invalid_argument& error) {
+        throw LevelError(spec.Where() + error.what());
+      }
+      cameras.push_back(std::move(camera));
+    }
+  }
+  return cameras;
+}
+
 std::vector<MountedSensor> MakeRobotSensors(const scene::Level& level) {
   std::vector<MountedSensor> sensors;
   for (std::size_t r = 0; r < level.robots.size(); ++r) {

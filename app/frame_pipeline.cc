@@ -1,0 +1,161 @@
+#include "app/frame_pipeline.h"
+
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "app/images.h"
+
+namespace sandbox::app {
+
+struct FramePipeline::Video {
+  cv::VideoWriter writer;
+};
+
+FramePipeline::FramePipeline(const scene::Level& level, const FramePipelineConfig& config)
+    : level_(level), config_(config) {
+  std::error_code error;
+  std::filesystem::create_directories(config_.out_dir, error);
+  if (error || !std::filesystem::is_directory(config_.out_dir)) {
+    throw std::runtime_error("cannot create the output folder '" + config_.out_dir + "'");
+  }
+  render_thread_ = std::thread([this] { RenderLoop(); });
+  write_thread_ = std::thread([this] { WriteLoop(); });
+}
+
+FramePipeline::~FramePipeline() { Finish(); }
+
+void FramePipeline::Finish() {
+  if (!render_thread_.joinable()) return;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+  }
+  render_wake_.notify_all();
+  render_thread_.join();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    render_done_ = true;
+  }
+  write_wake_.notify_all();
+  write_thread_.join();
+}
+
+void FramePipeline::Submit(RenderJob job) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (render_queue_.size() >= config_.queue_capacity) {
+      render_queue_.pop_front();
+      ++dropped_render_;
+    }
+    render_queue_.push_back(std::move(job));
+  }
+  render_wake_.notify_one();
+}
+
+std::string FramePipeline::error() const { return first_error_; }
+
+void FramePipeline::RenderLoop() {
+  std::unique_ptr<sensors::Renderer> renderer;
+  try {
+    renderer = sensors::MakeRenderer();
+    renderer->SetLevel(level_, OpenCvTextureDecoder());
+    for (const std::string& warning : renderer->warnings()) std::cerr << "sandbox: warning: " << warning << "\n";
+  } catch (const std::exception& e) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    first_error_ = e.what();
+  }
+  for (;;) {
+    RenderJob job;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      render_wake_.wait(lock, [&] { return stopping_ || !render_queue_.empty(); });
+      if (render_queue_.empty()) break;  // stopping and drained
+      job = std::move(render_queue_.front());
+      render_queue_.pop_front();
+    }
+    if (!renderer) continue;
+    Encoded item{job.camera, job.tick, job.time_s, job.depth, {}, job.robot_pose};
+    std::vector<const scene::RobotState*> robots;
+    for (const scene::RobotState& state : job.robots) robots.push_back(&state);
+    renderer->Render(job.view, job.actor_poses, robots, {}, &item.frame);
+    ++rendered_;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (write_queue_.size() >= config_.queue_capacity) {
+        write_queue_.pop_front();
+        ++dropped_write_;
+      }
+      write_queue_.push_back(std::move(item));
+    }
+    write_wake_.notify_one();
+  }
+}
+
+void FramePipeline::WriteLoop() {
+  for (;;) {
+    Encoded item;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      write_wake_.wait(lock, [&] { return !write_queue_.empty() || render_done_; });
+      if (write_queue_.empty()) break;  // the render thread is done and all is written
+      item = std::move(write_queue_.front());
+      write_queue_.pop_front();
+    }
+    Write(item);
+  }
+  for (auto& [camera, video] : videos_) video->writer.release();
+}
+
+void FramePipeline::Write(const Encoded& item) {
+  const std::filesystem::path dir = config_.out_dir;
+  std::ostringstream name;
+  name << item.camera << "_" << std::setw(6) << std::setfill('0') << item.tick;
+  std::string file;
+  try {
+    if (config_.format == "mp4" || config_.format == "avi") {
+      std::unique_ptr<Video>& video = videos_[item.camera];
+      if (!video) {
+        video = std::make_unique<Video>();
+        file = (dir / (item.camera + "." + config_.format)).string();
+        const int fourcc = config_.format == "mp4" ? cv::VideoWriter::fourcc('m', 'p', '4', 'v')
+                                                   : cv::VideoWriter::fourcc('M', 'J', 'P', 'G');
+        video->writer.open(file, cv::CAP_FFMPEG, fourcc, config_.video_fps,
+                           cv::Size(item.frame.width, item.frame.height));
+        if (!video->writer.isOpened()) throw std::runtime_error("cannot open the video " + file);
+      }
+      cv::Mat rgb(item.frame.height, item.frame.width, CV_8UC3,
+                  const_cast<std::uint8_t*>(item.frame.rgb.data()));
+      cv::Mat bgr;
+      cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+      video->writer.write(bgr);
+      file = item.camera + "." + config_.format;
+    } else {
+      file = name.str() + "." + config_.format;
+      WriteColor(item.frame, (dir / file).string());
+    }
+    if (item.depth) WriteDepthMillimetres(item.frame, (dir / (name.str() + "_depth.png")).string());
+    std::unique_ptr<std::ofstream>& index = indexes_[item.camera];
+    if (!index) {
+      index = std::make_unique<std::ofstream>(dir / (item.camera + ".csv"));
+      *index << "tick,time_s,file,x,y,z,qw,qx,qy,qz\n" << std::setprecision(10);
+    }
+    const Eigen::Vector3d p = item.robot_pose.translation();
+    const Eigen::Quaterniond q(item.robot_pose.linear());
+    *index << item.tick << "," << item.time_s << "," << file << "," << p.x() << "," << p.y() << ","
+           << p.z() << "," << q.w() << "," << q.x() << "," << q.y() << "," << q.z() << "\n";
+    ++written_;
+  } catch (const std::exception& e) {
+    if (failed_++ == 0) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      first_error_ = e.what();
+      std::cerr << "sandbox: frames: " << e.what() << " (further failures are only counted)\n";
+    }
+  }
+}
+
+}  // namespace sandbox::app

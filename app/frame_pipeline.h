@@ -1,0 +1,98 @@
+#pragma once
+// Camera frames off the loop thread: a render thread that owns the GL context
+// renders the jobs the loop submits, and an encoder thread writes them with
+// OpenCV. Both queues are small and bounded: when a stage is behind, the
+// oldest waiting job is dropped and counted, so the loop never waits.
+//
+// Files: DIR/<camera>_<tick>.jpg (or .png), DIR/<camera>_<tick>_depth.png
+// (16-bit millimetres), or one DIR/<camera>.mp4 / .avi for video, and
+// DIR/<camera>.csv indexing every frame: tick, time_s, file, robot pose.
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "scene/level.h"
+#include "scene/robot_state.h"
+#include "sensors/renderer.h"
+
+namespace sandbox::app {
+
+struct FramePipelineConfig {
+  std::string out_dir;
+  std::string format{"jpg"};  // jpg, png, mp4 (mp4v) or avi (MJPG)
+  double video_fps{30.0};
+  std::size_t queue_capacity{4};
+};
+
+// What the loop hands over: a camera view and copies of the robot states.
+struct RenderJob {
+  std::string camera;
+  std::int64_t tick{0};
+  double time_s{0.0};
+  sensors::CameraView view;
+  bool depth{false};
+  std::vector<scene::RobotState> robots;
+  std::vector<Eigen::Isometry3d> actor_poses;
+  Eigen::Isometry3d robot_pose{Eigen::Isometry3d::Identity()};  // for the index
+};
+
+class FramePipeline {
+ public:
+  // Starts both threads; the renderer is made on the render thread. Throws
+  // std::runtime_error when DIR cannot be created.
+  FramePipeline(const scene::Level& level, const FramePipelineConfig& config);
+  // Finishes what is queued, closes videos and indexes (also done by the destructor).
+  void Finish();
+  ~FramePipeline();
+  FramePipeline(const FramePipeline&) = delete;
+  FramePipeline& operator=(const FramePipeline&) = delete;
+
+  // Loop thread: never blocks.
+  void Submit(RenderJob job);
+
+  std::int64_t rendered() const { return rendered_; }
+  std::int64_t written() const { return written_; }
+  std::int64_t dropped() const { return dropped_render_ + dropped_write_; }
+  std::int64_t failed() const { return failed_; }
+  std::string error() const;  // the first failure, reported once
+
+ private:
+  struct Encoded {
+    std::string camera;
+    std::int64_t tick;
+    double time_s;
+    bool depth;
+    sensors::Frame frame;
+    Eigen::Isometry3d robot_pose;
+  };
+  void RenderLoop();
+  void WriteLoop();
+  void Write(const Encoded& item);
+
+  const scene::Level& level_;
+  FramePipelineConfig config_;
+  std::mutex mutex_;
+  std::condition_variable render_wake_, write_wake_;
+  std::deque<RenderJob> render_queue_;
+  std::deque<Encoded> write_queue_;
+  bool stopping_{false};
+  bool render_done_{false};  // the render thread has finished: the writer may stop
+  std::atomic<std::int64_t> rendered_{0}, written_{0}, dropped_render_{0}, dropped_write_{0},
+      failed_{0};
+  std::string first_error_;
+  struct Video;
+  std::map<std::string, std::unique_ptr<Video>> videos_;  // write thread only
+  std::map<std::string, std::unique_ptr<std::ofstream>> indexes_;  // write thread only
+  std::thread render_thread_, write_thread_;
+};
+
+}  // namespace sandbox::app
