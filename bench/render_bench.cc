@@ -1,0 +1,173 @@
+// Rendering figures with OSMesa (llvmpipe):
+//  1. A chase camera 640 x 480 on the sample level with the flying wing
+//     flexing, rendered on its own thread and JPEG-encoded on another, free
+//     running: frames per second, against the same render without encoding.
+//  2. Render time against triangle count (generated terrains of 10k, 100k and
+//     1M triangles), against an empty level as the reference.
+//
+//   bench_render [--seconds S]
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <cstring>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <thread>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "assets/generators/gltf_writer.h"
+#include "scene/level.h"
+#include "sensors/cameras.h"
+#include "sensors/renderer.h"
+
+namespace {
+
+using namespace sandbox;
+using Clock = std::chrono::steady_clock;
+namespace fs = std::filesystem;
+
+// A square terrain of about `triangles` triangles, 1 m cells.
+fs::path Terrain(const fs::path& dir, int triangles) {
+  const int side = int(std::sqrt(triangles / 2.0));
+  assets::GeneratedMesh mesh{"terrain", {0.4f, 0.5f, 0.3f, 1.0f}};
+  for (int r = 0; r <= side; ++r) {
+    for (int c = 0; c <= side; ++c) {
+      mesh.AddVertex(float(c - side / 2), float(r - side / 2),
+                     float(3.0 * std::sin(c / 17.0) * std::cos(r / 13.0)));
+    }
+  }
+  for (int r = 0; r < side; ++r) {
+    for (int c = 0; c < side; ++c) {
+      const auto a = std::uint32_t(r * (side + 1) + c), b = a + 1, d = a + std::uint32_t(side + 1), e = d + 1;
+      mesh.AddTriangle(a, b, e);
+      mesh.AddTriangle(a, e, d);
+    }
+  }
+  const std::string name = "terrain" + std::to_string(triangles);
+  assets::WriteGltf(dir / (name + ".gltf"), {mesh});
+  std::ofstream(dir / (name + ".toml")) << "[[actor]]\nname = \"t\"\nfile = \"" << name << ".gltf\"\n";
+  return dir / (name + ".toml");
+}
+
+double MedianMs(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  double seconds = 5.0;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    if (!std::strcmp(argv[i], "--seconds")) seconds = std::atof(argv[i + 1]);
+  }
+  // 1. Chase camera, render thread + encoder thread.
+  {
+    const scene::Level level = scene::LoadLevel(std::string(SANDBOX_SOURCE_DIR) + "/assets/sample/level.toml");
+    std::mutex mutex;
+    std::condition_variable wake;
+    std::deque<sensors::Frame> queue;
+    std::atomic<bool> done{false};
+    std::atomic<long> rendered{0}, encoded{0};
+    std::size_t bytes = 0;
+    std::thread encoder([&] {
+      std::vector<std::uint8_t> jpeg;
+      for (;;) {
+        sensors::Frame frame;
+        {
+          std::unique_lock<std::mutex> lock(mutex);
+          wake.wait(lock, [&] { return done || !queue.empty(); });
+          if (queue.empty()) break;
+          frame = std::move(queue.front());
+          queue.pop_front();
+        }
+        cv::Mat rgb(frame.height, frame.width, CV_8UC3, frame.rgb.data()), bgr;
+        cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+        cv::imencode(".jpg", bgr, jpeg);
+        bytes = jpeg.size();
+        ++encoded;
+      }
+    });
+    auto renderer = sensors::MakeRenderer();
+    renderer->SetLevel(level, {});
+    scene::RobotState wing(level.robots[0]);
+    sensors::ChaseCamera chase({});
+    sensors::CameraView view;
+    const auto start = Clock::now();
+    double render_only_s = 0.0;
+    for (int i = 0;; ++i) {
+      const double t = std::chrono::duration<double>(Clock::now() - start).count();
+      if (t >= seconds) break;
+      // The wing circles and flexes, as the example model flies it.
+      const double a = 0.125 * i * 0.033;
+      Eigen::Isometry3d X = Eigen::Translation3d(120 * std::cos(a), 120 * std::sin(a), 60) *
+                            Eigen::AngleAxisd(a + M_PI / 2, Eigen::Vector3d::UnitZ());
+      wing.SetPose(X);
+      for (int b = 1; b <= 20; ++b) {
+        const double values[2] = {(b <= 10 ? 1 : -1) * 0.06 * std::sin(0.05 * i), 0.0};
+        wing.SetBone(b, values, 2);
+      }
+      wing.Update();
+      view.X_WC = chase.Update(X, 0.033);
+      sensors::Frame frame;
+      const auto render_start = Clock::now();
+      renderer->Render(view, {}, {&wing}, {}, &frame);
+      render_only_s += std::chrono::duration<double>(Clock::now() - render_start).count();
+      ++rendered;
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (queue.size() >= 2) queue.pop_front();  // drop the oldest, as the writer does
+        queue.push_back(std::move(frame));
+      }
+      wake.notify_one();
+    }
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    done = true;
+    wake.notify_one();
+    encoder.join();
+    std::printf("chase 640x480, sample level + flying wing: %.1f frames/s rendered and JPEG-encoded "
+                "(%.1f rendered/s; render alone %.2f ms a frame = %.0f fps), %zu KB a JPEG; target 80\n",
+                encoded / elapsed, rendered / elapsed, 1e3 * render_only_s / double(rendered.load()),
+                double(rendered.load()) / render_only_s, bytes / 1024);
+  }
+  // 2. Render time against triangles.
+  {
+    const fs::path dir = fs::temp_directory_path() / "sandbox-bench-render";
+    fs::create_directories(dir);
+    std::printf("\n%-12s %12s %14s %8s\n", "triangles", "render ms", "empty-level ms", "ratio");
+    double empty_ms = 0.0;
+    for (const int triangles : {0, 10000, 100000, 1000000}) {
+      std::unique_ptr<sensors::Renderer> renderer = sensors::MakeRenderer();
+      scene::Level level;
+      if (triangles > 0) {
+        level = scene::LoadLevel(Terrain(dir, triangles));
+        renderer->SetLevel(level, {});
+      } else {
+        renderer->SetLevel(level, {});
+      }
+      sensors::CameraView view;
+      view.X_WC = sensors::LookAt(Eigen::Vector3d(-200, -200, 150), Eigen::Vector3d(0, 0, 0));
+      std::vector<double> ms;
+      sensors::Frame frame;
+      for (int i = 0; i < 21; ++i) {
+        const auto start = Clock::now();
+        renderer->Render(view, {}, {}, {}, &frame);
+        if (i > 0) ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+      }
+      const double median = MedianMs(ms);
+      if (triangles == 0) empty_ms = median;
+      std::printf("%-12d %12.2f %14.2f %7.1fx\n", int(level.num_triangles()), median, empty_ms,
+                  median / empty_ms);
+    }
+    fs::remove_all(dir);
+  }
+  return 0;
+}
