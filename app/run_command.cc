@@ -20,6 +20,7 @@
 #include "bridge/udp_inputs.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
+#include "sensors/range_sensor.h"
 #include "sensors/robot_sensors.h"
 
 namespace sandbox::app {
@@ -40,7 +41,7 @@ const char* kUsage =
     "               encoder threads; the loop never waits for them)\n"
     "  --frames     jpg (default), png, mp4 or avi\n"
     "Inputs per robot: <ROBOT>/POSE, /BONES, /ACTORS. Outputs: <ROBOT>/SCAN_FACE, /GROUND,\n"
-    "/LIDAR, /STATE, /STATUS (docs/bridge.md).\n";
+    "/LIDAR, /RANGE, /STATE, /STATUS (docs/bridge.md).\n";
 
 std::atomic<bool> stop_requested{false};
 
@@ -263,6 +264,10 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
           sensors::LidarScan scan;
           sensors::Lidar(*lidar).Sweep(world, caster, filter, X_WS, X_WS, &scan);
           robot.outputs->PublishLidar(scan, robot.input, now);
+        } else if (const auto* ray = std::get_if<sensors::RangeSensorConfig>(&run.mounted->config)) {
+          robot.outputs->PublishRange(run.mounted->spec.name,
+                                      sensors::MeasureRange(*ray, world, caster, filter, X_WS),
+                                      robot.input, now);
         }
       }
       for (RobotRun& robot : robots) {

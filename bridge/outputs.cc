@@ -2,6 +2,7 @@
 
 #include "sandbox_msgs/ground_map_t.hpp"
 #include "sandbox_msgs/lidar_scan_t.hpp"
+#include "sandbox_msgs/range_t.hpp"
 #include "sandbox_msgs/robot_state_t.hpp"
 #include "sandbox_msgs/scan_face_t.hpp"
 #include "sandbox_msgs/status_t.hpp"
@@ -98,6 +99,23 @@ void RobotOutputs::PublishLidar(const sensors::LidarScan& scan, const InputTag& 
   Offsets(scan.points_W, origin, &message.xyz);
   message.time_s.assign(scan.time_s.begin(), scan.time_s.end());
   Send("LIDAR", message);
+}
+
+void RobotOutputs::PublishRange(const std::string& sensor, const sensors::RangeReading& reading,
+                                const InputTag& input, std::int64_t now_utime) {
+  sandbox_msgs::range_t message{};
+  Stamp(now_utime, seq_++, input, &message);
+  message.sensor = sensor;
+  for (int k = 0; k < 3; ++k) {
+    message.origin[k] = reading.origin_W[k];
+    message.direction[k] = reading.direction_W[k];
+    message.point[k] = reading.point_W[k];
+    message.normal[k] = reading.normal_W[k];
+  }
+  message.hit = reading.hit ? 1 : 0;
+  message.range_m = reading.range_m;
+  message.body = reading.body;
+  Send("RANGE", message);
 }
 
 void RobotOutputs::PublishState(const scene::RobotState& state,

@@ -1,5 +1,5 @@
 #pragma once
-// What the sandbox publishes for a robot: <ROBOT>/SCAN_FACE, /GROUND, /LIDAR,
+// What the sandbox publishes for a robot: <ROBOT>/SCAN_FACE, /GROUND, /LIDAR, /RANGE,
 // /STATE and /STATUS, each tagged with the sequence number and time of the
 // pose input it was computed from. Threads: the loop thread.
 
@@ -13,6 +13,7 @@
 #include "sensors/face_scanner.h"
 #include "sensors/ground_scanner.h"
 #include "sensors/lidar.h"
+#include "sensors/range_sensor.h"
 
 namespace sandbox::bridge {
 
@@ -42,6 +43,9 @@ class RobotOutputs {
                     std::int64_t now_utime);
   void PublishGround(const sensors::HeightMap& map, const InputTag& input, std::int64_t now_utime);
   void PublishLidar(const sensors::LidarScan& scan, const InputTag& input, std::int64_t now_utime);
+  // One single-ray sensor's reading; `sensor` tells several on one robot apart.
+  void PublishRange(const std::string& sensor, const sensors::RangeReading& reading,
+                    const InputTag& input, std::int64_t now_utime);
   // The robot pose and bones in use, and the face scanner's face frames in
   // the robot frame (identity rotations for a body-aligned box at the origin).
   void PublishState(const scene::RobotState& state, const std::vector<double>& bone_values,

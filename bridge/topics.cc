@@ -10,6 +10,7 @@
 #include "sandbox_msgs/camera_command_t.hpp"
 #include "sandbox_msgs/ground_map_t.hpp"
 #include "sandbox_msgs/lidar_scan_t.hpp"
+#include "sandbox_msgs/range_t.hpp"
 #include "sandbox_msgs/robot_pose_t.hpp"
 #include "sandbox_msgs/robot_state_t.hpp"
 #include "sandbox_msgs/scan_face_t.hpp"
@@ -33,6 +34,7 @@ std::string TypeOf(const std::uint8_t* data, std::uint32_t size) {
       {scan_face_t::getHash(), "scan_face_t"},
       {ground_map_t::getHash(), "ground_map_t"},
       {lidar_scan_t::getHash(), "lidar_scan_t"},
+      {range_t::getHash(), "range_t"},
       {robot_state_t::getHash(), "robot_state_t"},
       {wrench_t::getHash(), "wrench_t"},
       {status_t::getHash(), "status_t"}};

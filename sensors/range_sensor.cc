@@ -27,6 +27,8 @@ RangeReading MeasureRange(const RangeSensorConfig& config, const scene::Collisio
   RayHits hits;
   caster.Cast(world, ray, filter, &hits);
   RangeReading reading;
+  reading.origin_W = ray.origin_W;
+  reading.direction_W = X_WS.linear() * config.direction_S;
   reading.hit = hits.body[0] != RayHits::kNoHit;
   reading.range_m = hits.distance_m[0];
   reading.point_W = ray.origin_W + double(hits.distance_m[0]) * ray.direction[0].cast<double>();

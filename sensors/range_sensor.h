@@ -14,6 +14,8 @@ struct RangeSensorConfig {
 };
 
 struct RangeReading {
+  Eigen::Vector3d origin_W{Eigen::Vector3d::Zero()};     // the ray, in the world frame
+  Eigen::Vector3d direction_W{Eigen::Vector3d::UnitZ()};  // unit
   bool hit{false};
   double range_m{0.0};  // to the hit, or range_m when nothing
   Eigen::Vector3d point_W{Eigen::Vector3d::Zero()};

@@ -97,6 +97,8 @@ TEST_F(PlaneTest, GroundScannerAndAltimeter) {
   EXPECT_TRUE(down.hit);
   EXPECT_NEAR(down.range_m, 7.5, 1e-4);
   EXPECT_NEAR(down.normal_W.z(), 1.0, 1e-6);
+  EXPECT_TRUE(down.origin_W.isApprox(Vector3d(0, 0, 7.5)));
+  EXPECT_TRUE(down.direction_W.isApprox(Vector3d(0, 0, -1)));
   RangeSensorConfig forward;
   forward.direction_S = Vector3d::UnitX();
   EXPECT_FALSE(
