@@ -2,12 +2,12 @@
 
 #include <algorithm>
 #include <atomic>
-#include <sstream>
 #include <chrono>
 #include <cmath>
 #include <csignal>
 #include <iomanip>
 #include <memory>
+#include <sstream>
 #include <thread>
 #include <variant>
 
@@ -68,6 +68,22 @@ struct RobotRun {
   std::unique_ptr<bridge::RobotOutputs> outputs;
   bridge::InputTag input;
   std::vector<double> bone_values;
+
+  // Every input's counters: the LCM channels, then the UDP sockets.
+  std::vector<bridge::ChannelStatus> Channels(std::int64_t now_utime) const {
+    std::vector<bridge::ChannelStatus> channels;
+    for (const bridge::LatestInput* in : {&inputs->pose(), &inputs->bones(), &inputs->actors()}) {
+      channels.push_back({in->channel(), in->received(), in->superseded(), in->rejected(),
+                          in->Stale(now_utime, config.stale_after_s), in->last_reject_reason()});
+    }
+    for (const bridge::UdpLatest* socket : {net_fdm ? &net_fdm->socket() : nullptr,
+                                            doubles ? &doubles->socket() : nullptr}) {
+      if (socket == nullptr) continue;
+      channels.push_back({socket->name(), socket->received(), socket->superseded(),
+                          socket->rejected(), false, socket->last_reject_reason()});
+    }
+    return channels;
+  }
 };
 
 struct SensorRun {
@@ -297,22 +313,8 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       if (t >= next_status_s) {
         next_status_s = t + 1.0;
         for (RobotRun& robot : robots) {
-          std::vector<bridge::ChannelStatus> channels;
-          for (const bridge::LatestInput* input :
-               {&robot.inputs->pose(), &robot.inputs->bones(), &robot.inputs->actors()}) {
-            channels.push_back({input->channel(), input->received(), input->superseded(),
-                                input->rejected(), input->Stale(now, robot.config.stale_after_s),
-                                input->last_reject_reason()});
-          }
-          for (const bridge::UdpLatest* socket :
-               {robot.net_fdm ? &robot.net_fdm->socket() : nullptr,
-                robot.doubles ? &robot.doubles->socket() : nullptr}) {
-            if (socket == nullptr) continue;
-            channels.push_back({socket->name(), socket->received(), socket->superseded(),
-                                socket->rejected(), false, socket->last_reject_reason()});
-          }
           const double rate_now = t > 0.0 ? double(tick) / t : 0.0;
-          robot.outputs->PublishStatus(rate_now, tick, overruns, channels, now);
+          robot.outputs->PublishStatus(rate_now, tick, overruns, robot.Channels(now), now);
         }
       }
       ++tick;
@@ -350,19 +352,10 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
           << parsed->Value("--out") << "\n";
     }
     for (const RobotRun& robot : robots) {
-      for (const bridge::LatestInput* input :
-           {&robot.inputs->pose(), &robot.inputs->bones(), &robot.inputs->actors()}) {
-        out << "  " << input->channel() << ": " << input->received() << " received, "
-            << input->superseded() << " superseded, " << input->rejected() << " rejected"
-            << (input->rejected() > 0 ? " (last: " + input->last_reject_reason() + ")" : "")
-            << "\n";
-      }
-      for (const bridge::UdpLatest* socket : {robot.net_fdm ? &robot.net_fdm->socket() : nullptr,
-                                              robot.doubles ? &robot.doubles->socket() : nullptr}) {
-        if (socket == nullptr) continue;
-        out << "  " << socket->name() << ": " << socket->received() << " received, "
-            << socket->superseded() << " superseded, " << socket->rejected() << " rejected"
-            << (socket->rejected() > 0 ? " (last: " + socket->last_reject_reason() + ")" : "")
+      for (const bridge::ChannelStatus& channel : robot.Channels(NowUtime())) {
+        out << "  " << channel.channel << ": " << channel.received << " received, "
+            << channel.superseded << " superseded, " << channel.rejected << " rejected"
+            << (channel.rejected > 0 ? " (last: " + channel.last_reject_reason + ")" : "")
             << "\n";
       }
     }
