@@ -57,7 +57,10 @@ void FramePipeline::Submit(RenderJob job) {
   render_wake_.notify_one();
 }
 
-std::string FramePipeline::error() const { return first_error_; }
+std::string FramePipeline::error() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return first_error_;
+}
 
 void FramePipeline::RenderLoop() {
   std::unique_ptr<sensors::Renderer> renderer;
@@ -66,8 +69,7 @@ void FramePipeline::RenderLoop() {
     renderer->SetLevel(level_, OpenCvTextureDecoder());
     for (const std::string& warning : renderer->warnings()) std::cerr << "sandbox: warning: " << warning << "\n";
   } catch (const std::exception& e) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    first_error_ = e.what();
+    Fail(std::string("cannot render: ") + e.what());
   }
   for (;;) {
     RenderJob job;
@@ -78,11 +80,19 @@ void FramePipeline::RenderLoop() {
       job = std::move(render_queue_.front());
       render_queue_.pop_front();
     }
-    if (!renderer) continue;
+    if (!renderer) {  // every frame fails alike: counted, reported once
+      ++failed_;
+      continue;
+    }
     Encoded item{job.camera, job.tick, job.time_s, job.depth, {}, job.robot_pose};
     std::vector<const scene::RobotState*> robots;
     for (const scene::RobotState& state : job.robots) robots.push_back(&state);
-    renderer->Render(job.view, job.actor_poses, robots, {}, &item.frame);
+    try {
+      renderer->Render(job.view, job.actor_poses, robots, {}, &item.frame);
+    } catch (const std::exception& e) {
+      Fail("camera " + job.camera + ": " + e.what());
+      continue;
+    }
     ++rendered_;
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -150,12 +160,15 @@ void FramePipeline::Write(const Encoded& item) {
            << p.z() << "," << q.w() << "," << q.x() << "," << q.y() << "," << q.z() << "\n";
     ++written_;
   } catch (const std::exception& e) {
-    if (failed_++ == 0) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      first_error_ = e.what();
-      std::cerr << "sandbox: frames: " << e.what() << " (further failures are only counted)\n";
-    }
+    Fail(e.what());
   }
+}
+
+void FramePipeline::Fail(const std::string& what) {
+  if (failed_++ > 0) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  first_error_ = what;
+  std::cerr << "sandbox: frames: " << what << " (further failures are only counted)\n";
 }
 
 }  // namespace sandbox::app

@@ -77,10 +77,11 @@ class FramePipeline {
   void RenderLoop();
   void WriteLoop();
   void Write(const Encoded& item);
+  void Fail(const std::string& what);  // counts; the first one is kept and printed
 
   const scene::Level& level_;
   FramePipelineConfig config_;
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   std::condition_variable render_wake_, write_wake_;
   std::deque<RenderJob> render_queue_;
   std::deque<Encoded> write_queue_;
