@@ -132,6 +132,10 @@ class OsMesaRenderer : public Renderer {
     GLint ok = 0;
     glGetProgramiv(program_, GL_LINK_STATUS, &ok);
     if (!ok) throw std::runtime_error("Renderer: shaders do not link");
+    auto location = [&](const char* name) { return glGetUniformLocation(program_, name); };
+    uniforms_ = {location("model"), location("view_proj"), location("base_color"),
+                 location("has_texture"), location("base_texture"), location("sun"),
+                 location("sky"), location("fog")};
   }
   ~OsMesaRenderer() override { OSMesaDestroyContext(context_); }
 
@@ -203,12 +207,12 @@ class OsMesaRenderer : public Renderer {
     projection(2, 3) = 2.0 * fa * n / (n - fa);
     projection(3, 2) = -1.0;
     const Eigen::Matrix4f view_proj = (projection * view_rotation).cast<float>();
-    glUniformMatrix4fv(Location("view_proj"), 1, GL_FALSE, view_proj.data());
+    glUniformMatrix4fv(uniforms_.view_proj, 1, GL_FALSE, view_proj.data());
     const Eigen::Vector3f sun = settings.sun_direction_W.normalized();
-    glUniform3f(Location("sun"), sun.x(), sun.y(), sun.z());
-    glUniform3f(Location("sky"), settings.sky_rgb.x(), settings.sky_rgb.y(), settings.sky_rgb.z());
-    glUniform2f(Location("fog"), settings.fog_start_m, settings.fog_end_m);
-    glUniform1i(Location("base_texture"), 0);
+    glUniform3f(uniforms_.sun, sun.x(), sun.y(), sun.z());
+    glUniform3f(uniforms_.sky, settings.sky_rgb.x(), settings.sky_rgb.y(), settings.sky_rgb.z());
+    glUniform2f(uniforms_.fog, settings.fog_start_m, settings.fog_end_m);
+    glUniform1i(uniforms_.base_texture, 0);
 
     // Opaque first, then the translucent (water) on top.
     for (const bool translucent : {false, true}) {
@@ -270,22 +274,20 @@ class OsMesaRenderer : public Renderer {
   std::string description() const override { return description_; }
 
  private:
-  GLint Location(const char* name) { return glGetUniformLocation(program_, name); }
-
   bool IsTranslucent(int material) const {
     return material >= 0 && material < int(level_->materials.size()) &&
            level_->materials[std::size_t(material)].base_color.w() < 0.999f;
   }
 
   void Draw(const GpuMesh& mesh, const Eigen::Matrix4f& model) {
-    glUniformMatrix4fv(Location("model"), 1, GL_FALSE, model.data());
+    glUniformMatrix4fv(uniforms_.model, 1, GL_FALSE, model.data());
     Eigen::Vector4f color(0.8f, 0.8f, 0.8f, 1.f);
     if (mesh.material >= 0 && mesh.material < int(level_->materials.size())) {
       color = level_->materials[std::size_t(mesh.material)].base_color;
     }
-    glUniform4f(Location("base_color"), color.x(), color.y(), color.z(), color.w());
+    glUniform4f(uniforms_.base_color, color.x(), color.y(), color.z(), color.w());
     const auto texture = textures_.find(mesh.material);
-    glUniform1i(Location("has_texture"), texture != textures_.end() && mesh.uvs != 0);
+    glUniform1i(uniforms_.has_texture, texture != textures_.end() && mesh.uvs != 0);
     if (texture != textures_.end()) {
       glActiveTexture(GL_TEXTURE0);
       glBindTexture(GL_TEXTURE_2D, texture->second);
@@ -318,6 +320,9 @@ class OsMesaRenderer : public Renderer {
   std::vector<std::uint8_t> backing_;
   std::string description_;
   GLuint program_{0}, fbo_{0}, buffers_[2]{0, 0};
+  struct {
+    GLint model, view_proj, base_color, has_texture, base_texture, sun, sky, fog;
+  } uniforms_{};
   int width_{0}, height_{0};
   const scene::Level* level_{nullptr};
   std::vector<std::pair<int, GpuMesh>> actor_meshes_;
