@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "bench/million_level.h"
+#include "bench/bench_levels.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
 #include "scene/manifest.h"
@@ -92,11 +92,6 @@ Figures AssimpReadOnly(const fs::path& level_file) {
   return {std::chrono::duration<double>(Clock::now() - start).count(), PeakMiB(), triangles};
 }
 
-double Median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -135,6 +130,7 @@ int main(int argc, char** argv) {
       load_s.push_back(full.seconds), peak.push_back(full.peak_mib), triangles = full.triangles;
       ref_s.push_back(ref.seconds), ref_peak.push_back(ref.peak_mib);
     }
+    using sandbox::bench::Median;
     std::printf("%-12s %10.0f %9.3f %9.1f %12.3f %11.1f %6.2fx\n", name, triangles, Median(load_s),
                 Median(peak), Median(ref_s), Median(ref_peak), Median(load_s) / Median(ref_s));
   }

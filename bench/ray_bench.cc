@@ -20,7 +20,7 @@
 #include <thread>
 #include <vector>
 
-#include "bench/million_level.h"
+#include "bench/bench_levels.h"
 #include "scene/collision_world_internal.h"
 #include "scene/level.h"
 #include "sensors/face_scanner.h"

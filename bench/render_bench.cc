@@ -16,14 +16,13 @@
 #include <cstring>
 #include <deque>
 #include <filesystem>
-#include <fstream>
 #include <mutex>
 #include <thread>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "assets/generators/gltf_writer.h"
+#include "bench/bench_levels.h"
 #include "scene/level.h"
 #include "sensors/cameras.h"
 #include "sensors/renderer.h"
@@ -33,34 +32,6 @@ namespace {
 using namespace sandbox;
 using Clock = std::chrono::steady_clock;
 namespace fs = std::filesystem;
-
-// A square terrain of about `triangles` triangles, 1 m cells.
-fs::path Terrain(const fs::path& dir, int triangles) {
-  const int side = int(std::sqrt(triangles / 2.0));
-  assets::GeneratedMesh mesh{"terrain", {0.4f, 0.5f, 0.3f, 1.0f}};
-  for (int r = 0; r <= side; ++r) {
-    for (int c = 0; c <= side; ++c) {
-      mesh.AddVertex(float(c - side / 2), float(r - side / 2),
-                     float(3.0 * std::sin(c / 17.0) * std::cos(r / 13.0)));
-    }
-  }
-  for (int r = 0; r < side; ++r) {
-    for (int c = 0; c < side; ++c) {
-      const auto a = std::uint32_t(r * (side + 1) + c), b = a + 1, d = a + std::uint32_t(side + 1), e = d + 1;
-      mesh.AddTriangle(a, b, e);
-      mesh.AddTriangle(a, e, d);
-    }
-  }
-  const std::string name = "terrain" + std::to_string(triangles);
-  assets::WriteGltf(dir / (name + ".gltf"), {mesh});
-  std::ofstream(dir / (name + ".toml")) << "[[actor]]\nname = \"t\"\nfile = \"" << name << ".gltf\"\n";
-  return dir / (name + ".toml");
-}
-
-double MedianMs(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
 
 }  // namespace
 
@@ -148,7 +119,9 @@ int main(int argc, char** argv) {
       std::unique_ptr<sensors::Renderer> renderer = sensors::MakeRenderer();
       scene::Level level;
       if (triangles > 0) {
-        level = scene::LoadLevel(Terrain(dir, triangles));
+        const int side = int(std::sqrt(triangles / 2.0));  // a square about the origin
+        level = scene::LoadLevel(bench::WriteTerrainLevel(dir, "terrain" + std::to_string(triangles),
+                                                          side, side, -side / 2, -side / 2));
         renderer->SetLevel(level, {});
       } else {
         renderer->SetLevel(level, {});
@@ -162,7 +135,7 @@ int main(int argc, char** argv) {
         renderer->Render(view, {}, {}, {}, &frame);
         if (i > 0) ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
       }
-      const double median = MedianMs(ms);
+      const double median = bench::Median(ms);
       if (triangles == 0) empty_ms = median;
       std::printf("%-12d %12.2f %14.2f %7.1fx\n", int(level.num_triangles()), median, empty_ms,
                   median / empty_ms);
