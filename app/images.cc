@@ -38,17 +38,26 @@ sensors::TextureDecoder OpenCvTextureDecoder() {
   };
 }
 
-void WriteColor(const sensors::Frame& frame, const std::string& path) {
-  cv::Mat rgb(frame.height, frame.width, CV_8UC3, const_cast<std::uint8_t*>(frame.rgb.data()));
-  cv::Mat bgr;
-  cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+namespace {
+
+// cv::imwrite, failing with the path whether OpenCV returns false or throws.
+void Write(const cv::Mat& image, const std::string& path) {
   bool written = false;
   try {
-    written = cv::imwrite(path, bgr);
+    written = cv::imwrite(path, image);
   } catch (const cv::Exception&) {
     written = false;
   }
   if (!written) throw std::runtime_error("cannot write " + path);
+}
+
+}  // namespace
+
+void WriteColor(const sensors::Frame& frame, const std::string& path) {
+  cv::Mat rgb(frame.height, frame.width, CV_8UC3, const_cast<std::uint8_t*>(frame.rgb.data()));
+  cv::Mat bgr;
+  cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+  Write(bgr, path);
 }
 
 void WriteDepthMillimetres(const sensors::Frame& frame, const std::string& path) {
@@ -58,13 +67,7 @@ void WriteDepthMillimetres(const sensors::Frame& frame, const std::string& path)
     depth.at<std::uint16_t>(i / frame.width, i % frame.width) =
         std::isfinite(d) && d * 1000.f < 65535.f ? std::uint16_t(std::lround(d * 1000.f)) : 0;
   }
-  bool written = false;
-  try {
-    written = cv::imwrite(path, depth);
-  } catch (const cv::Exception&) {
-    written = false;
-  }
-  if (!written) throw std::runtime_error("cannot write " + path);
+  Write(depth, path);
 }
 
 }  // namespace sandbox::app
