@@ -40,8 +40,8 @@ const char* kUsage =
     "  --out DIR    render the robots' cameras ([[robot.camera]]) into DIR (render and\n"
     "               encoder threads; the loop never waits for them)\n"
     "  --frames     jpg (default), png, mp4 or avi\n"
-    "Inputs per robot: <ROBOT>/POSE, /BONES, /ACTORS. Outputs: <ROBOT>/SCAN_FACE, /GROUND,\n"
-    "/LIDAR, /RANGE, /STATE, /STATUS (docs/bridge.md).\n";
+    "Inputs per robot: <ROBOT>/POSE, /BONES, /ACTORS, /CAMERA (trailing pan, tilt, zoom).\n"
+    "Outputs: <ROBOT>/SCAN_FACE, /GROUND, /LIDAR, /RANGE, /STATE, /STATUS (docs/bridge.md).\n";
 
 std::atomic<bool> stop_requested{false};
 
@@ -72,9 +72,12 @@ struct RobotRun {
   // Every input's counters: the LCM channels, then the UDP sockets.
   std::vector<bridge::ChannelStatus> Channels(std::int64_t now_utime) const {
     std::vector<bridge::ChannelStatus> channels;
-    for (const bridge::LatestInput* in : {&inputs->pose(), &inputs->bones(), &inputs->actors()}) {
-      channels.push_back({in->channel(), in->received(), in->superseded(), in->rejected(),
-                          in->Stale(now_utime, config.stale_after_s), in->last_reject_reason()});
+    for (const bridge::LatestInput* in : {&inputs->pose(), &inputs->bones(), &inputs->actors(),
+                                          &inputs->camera()}) {
+      // Camera commands come when someone steers: never stale.
+      const bool stale = in != &inputs->camera() && in->Stale(now_utime, config.stale_after_s);
+      channels.push_back({in->channel(), in->received(), in->superseded(), in->rejected(), stale,
+                          in->last_reject_reason()});
     }
     for (const bridge::UdpLatest* socket : {net_fdm ? &net_fdm->socket() : nullptr,
                                             doubles ? &doubles->socket() : nullptr}) {
@@ -295,7 +298,11 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
         run.last_s = t;
         const RobotRun& robot = robots[std::size_t(run.camera->robot)];
         sensors::CameraView view = run.camera->view;
-        view.X_WC = run.camera->Pose(*robot.state, &run.chase, {}, dt);  // chase lag advances every tick
+        const sensors::TrailingCommand& steer = robot.inputs->trailing();  // from <ROBOT>/CAMERA
+        view.X_WC = run.camera->Pose(*robot.state, &run.chase, steer, dt);  // chase lag advances every tick
+        if (run.camera->spec.type == "trailing") {
+          view.fov_y_rad = sensors::ZoomedFov(view.fov_y_rad, steer.zoom);
+        }
         if (!frames || t < run.next_due_s) continue;
         const double rate = run.camera->spec.rate_hz > 0.0 ? run.camera->spec.rate_hz : 30.0;
         run.next_due_s = std::max(run.next_due_s + 1.0 / rate, t);
@@ -352,6 +359,10 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
           << parsed->Value("--out") << "\n";
     }
     for (const RobotRun& robot : robots) {
+      if (!robot.inputs->active_camera().empty()) {
+        out << "  " << robot.config.channel_prefix << " active camera: "
+            << robot.inputs->active_camera() << "\n";
+      }
       for (const bridge::ChannelStatus& channel : robot.Channels(NowUtime())) {
         out << "  " << channel.channel << ": " << channel.received << " received, "
             << channel.superseded << " superseded, " << channel.rejected << " rejected"

@@ -4,6 +4,7 @@
 
 #include "sandbox_msgs/actor_placements_t.hpp"
 #include "sandbox_msgs/bone_values_t.hpp"
+#include "sandbox_msgs/camera_command_t.hpp"
 #include "sandbox_msgs/robot_pose_t.hpp"
 
 namespace sandbox::bridge {
@@ -34,13 +35,15 @@ bool AllFinite(const double* values, std::size_t n) {
 
 }  // namespace
 
-RobotInputs::RobotInputs(LcmLink& link, const scene::Level& level, int /*robot*/,
+RobotInputs::RobotInputs(LcmLink& link, const scene::Level& level, int robot,
                          const RobotBridgeConfig& config)
     : level_(level),
+      robot_(robot),
       translation_(config.pose),
       pose_(link, config.channel_prefix + "/POSE"),
       bones_(link, config.channel_prefix + "/BONES"),
-      actors_(link, config.channel_prefix + "/ACTORS") {}
+      actors_(link, config.channel_prefix + "/ACTORS"),
+      camera_(link, config.channel_prefix + "/CAMERA") {}
 
 RobotInputs::RobotInputs(LcmLink& link, const scene::Level& level, int robot)
     : RobotInputs(link, level, robot,
@@ -51,6 +54,7 @@ RobotInputs::Applied RobotInputs::Apply(scene::RobotState* state, scene::Collisi
   if (const auto* bytes = pose_.TakeNewest()) ApplyPose(*bytes, state, &applied);
   if (const auto* bytes = bones_.TakeNewest()) ApplyBones(*bytes, state, &applied);
   if (const auto* bytes = actors_.TakeNewest()) ApplyActors(*bytes, world, &applied);
+  if (const auto* bytes = camera_.TakeNewest()) ApplyCamera(*bytes, &applied);
   return applied;
 }
 
@@ -77,6 +81,8 @@ RobotInputs::Applied RobotInputs::ApplyNext(scene::RobotState* state,
   }
   ApplyPose(*pose, state, &applied);
   pose_.Pop();
+  // Camera commands change no output: the newest wins, as in free running.
+  if (const auto* bytes = camera_.TakeNewest()) ApplyCamera(*bytes, &applied);
   return applied;
 }
 
@@ -147,6 +153,28 @@ void RobotInputs::ApplyActors(const std::vector<std::uint8_t>& bytes, scene::Col
   for (const auto& [actor, X_WA] : placements) world->SetActorPose(actor, X_WA);
   actors_.Accept(actors_.last_receive_utime());
   applied->actors = true;
+}
+
+void RobotInputs::ApplyCamera(const std::vector<std::uint8_t>& bytes, Applied* applied) {
+  sandbox_msgs::camera_command_t message{};
+  if (!Decode(bytes, &message)) return camera_.Reject("cannot decode as camera_command_t");
+  if (!std::isfinite(message.pan_rad) || !std::isfinite(message.tilt_rad)) {
+    return camera_.Reject("non-finite pan or tilt");
+  }
+  if (!(message.zoom > 0.0 && message.zoom <= 100.0)) {
+    return camera_.Reject("zoom must be in (0, 100], got " + std::to_string(message.zoom));
+  }
+  if (!message.active_camera.empty()) {
+    bool known = false;
+    for (const scene::SensorSpec& camera : level_.robots.at(std::size_t(robot_)).cameras) {
+      known = known || camera.name == message.active_camera;
+    }
+    if (!known) return camera_.Reject("unknown camera '" + message.active_camera + "'");
+    active_camera_ = message.active_camera;
+  }
+  trailing_ = {message.pan_rad, message.tilt_rad, message.zoom};
+  camera_.Accept(camera_.last_receive_utime());
+  applied->camera = true;
 }
 
 }  // namespace sandbox::bridge

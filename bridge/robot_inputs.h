@@ -1,8 +1,9 @@
 #pragma once
 // A robot's inputs from external models: <ROBOT>/POSE (robot_pose_t),
-// <ROBOT>/BONES (bone_values_t) and <ROBOT>/ACTORS (actor_placements_t), each
-// the newest message of its channel, checked, translated and applied; bad
-// messages are rejected, counted by reason, and the last good value stays.
+// <ROBOT>/BONES (bone_values_t), <ROBOT>/ACTORS (actor_placements_t) and
+// <ROBOT>/CAMERA (camera_command_t), each the newest message of its channel,
+// checked, translated and applied; bad messages are rejected, counted by
+// reason, and the last good value stays.
 
 #include <cstdint>
 #include <string>
@@ -13,6 +14,7 @@
 #include "scene/collision_world.h"
 #include "scene/level.h"
 #include "scene/robot_state.h"
+#include "sensors/cameras.h"
 
 namespace sandbox::bridge {
 
@@ -27,7 +29,7 @@ class RobotInputs {
 
   // What the last Apply() used.
   struct Applied {
-    bool pose{false}, bones{false}, actors{false};
+    bool pose{false}, bones{false}, actors{false}, camera{false};
     std::int64_t pose_seq{-1}, pose_utime{-1};  // of the pose message applied
   };
   // After LcmLink::Drain(): applies the newest good message of each channel to
@@ -46,8 +48,15 @@ class RobotInputs {
   const LatestInput& pose() const { return pose_; }
   const LatestInput& bones() const { return bones_; }
   const LatestInput& actors() const { return actors_; }
-  // Logs rejections of all three inputs to `log`.
-  void set_log(RejectLog* log) { pose_.set_log(log), bones_.set_log(log), actors_.set_log(log); }
+  const LatestInput& camera() const { return camera_; }
+  // The last good camera command: the trailing cameras' pan, tilt and zoom,
+  // and the active camera (one of the robot's, by name; empty until chosen).
+  const sensors::TrailingCommand& trailing() const { return trailing_; }
+  const std::string& active_camera() const { return active_camera_; }
+  // Logs rejections of every input to `log`.
+  void set_log(RejectLog* log) {
+    pose_.set_log(log), bones_.set_log(log), actors_.set_log(log), camera_.set_log(log);
+  }
 
  private:
   void ApplyPose(const std::vector<std::uint8_t>& bytes, scene::RobotState* state,
@@ -56,10 +65,14 @@ class RobotInputs {
                   Applied* applied);
   void ApplyActors(const std::vector<std::uint8_t>& bytes, scene::CollisionWorld* world,
                    Applied* applied);
+  void ApplyCamera(const std::vector<std::uint8_t>& bytes, Applied* applied);
 
   const scene::Level& level_;
+  int robot_;
   Translation translation_;
-  LatestInput pose_, bones_, actors_;
+  LatestInput pose_, bones_, actors_, camera_;
+  sensors::TrailingCommand trailing_;
+  std::string active_camera_;
 };
 
 }  // namespace sandbox::bridge

@@ -55,4 +55,8 @@ Eigen::Isometry3d TrailingPose(const Eigen::Isometry3d& X_WB, double distance_m,
   return LookAt(X_WB.translation() + offset, X_WB.translation());
 }
 
+double ZoomedFov(double fov_y_rad, double zoom) {
+  return 2.0 * std::atan(std::tan(0.5 * fov_y_rad) / zoom);
+}
+
 }  // namespace sandbox::sensors

@@ -46,8 +46,11 @@ struct TrailingCommand {
 };
 
 // A fixed offset behind and above the robot, turned by pan and tilt, looking
-// at the robot; zoom narrows the field of view.
+// at the robot (zoom is for the field of view: ZoomedFov).
 Eigen::Isometry3d TrailingPose(const Eigen::Isometry3d& X_WB, double distance_m, double height_m,
                                const TrailingCommand& command);
+
+// The vertical field of view `zoom` times magnified: tan(fov / 2) / zoom.
+double ZoomedFov(double fov_y_rad, double zoom);
 
 }  // namespace sandbox::sensors

@@ -11,6 +11,7 @@
 
 #include "sandbox_msgs/actor_placements_t.hpp"
 #include "sandbox_msgs/bone_values_t.hpp"
+#include "sandbox_msgs/camera_command_t.hpp"
 #include "sandbox_msgs/robot_pose_t.hpp"
 #include "tests/test_util.h"
 
@@ -146,6 +147,41 @@ TEST_F(RobotInputsTest, BonesAndActorPlacementsApply) {
   EXPECT_EQ(world_.CastRay({-100, 100, 80}, {-100, 100, 0})->actor, level_.FindActor("gate"));
   EXPECT_FALSE(inputs_.bones().Stale(inputs_.bones().last_receive_utime(), 0.5));
   EXPECT_TRUE(inputs_.pose().Stale(inputs_.bones().last_receive_utime(), 0.5));  // never came
+}
+
+TEST_F(RobotInputsTest, CameraCommandsSteerTheTrailingCameraAndSwitchTheActiveOne) {
+  sandbox_msgs::camera_command_t command{};
+  command.active_camera = "belly";
+  command.pan_rad = 0.3, command.tilt_rad = -0.1, command.zoom = 2.0;
+  Publish(link_, "ELAHA/CAMERA", command);
+  link_.Drain();
+  EXPECT_TRUE(inputs_.Apply(&state_, &world_).camera) << inputs_.camera().last_reject_reason();
+  EXPECT_EQ(inputs_.active_camera(), "belly");
+  EXPECT_EQ(inputs_.trailing().pan_rad, 0.3);
+  EXPECT_EQ(inputs_.trailing().tilt_rad, -0.1);
+  EXPECT_EQ(inputs_.trailing().zoom, 2.0);
+  // Bad commands are rejected whole; the last good one stays.
+  command.zoom = 0.0;
+  Publish(link_, "ELAHA/CAMERA", command);
+  link_.Drain();
+  EXPECT_FALSE(inputs_.Apply(&state_, &world_).camera);
+  EXPECT_EQ(inputs_.camera().last_reject_reason(), "zoom must be in (0, 100], got 0.000000");
+  command.zoom = 1.5;
+  command.active_camera = "periscope";
+  Publish(link_, "ELAHA/CAMERA", command);
+  link_.Drain();
+  EXPECT_FALSE(inputs_.Apply(&state_, &world_).camera);
+  EXPECT_EQ(inputs_.camera().last_reject_reason(), "unknown camera 'periscope'");
+  EXPECT_EQ(inputs_.camera().rejected(), 2);
+  EXPECT_EQ(inputs_.active_camera(), "belly");
+  EXPECT_EQ(inputs_.trailing().zoom, 2.0);
+  // An empty name keeps the active camera and still steers.
+  command.active_camera = "";
+  Publish(link_, "ELAHA/CAMERA", command);
+  link_.Drain();
+  EXPECT_TRUE(inputs_.Apply(&state_, &world_).camera);
+  EXPECT_EQ(inputs_.active_camera(), "belly");
+  EXPECT_EQ(inputs_.trailing().zoom, 1.5);
 }
 
 TEST(LcmLinkTest, MulticastUrlsGetABigReceiveBuffer) {

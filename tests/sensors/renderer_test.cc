@@ -197,6 +197,15 @@ TEST(CameraTest, ChaseCameraAimsAtTheRobotAndFollowsWithoutOvershoot) {
   EXPECT_NEAR((straight.translation() - X_WB.translation()).norm(),
               (panned.translation() - X_WB.translation()).norm(), 1e-9);
   EXPECT_GT(TrailingPose(X_WB, 25, 8, {0.0, 0.3, 1.0}).translation().z(), straight.translation().z());
+  // Zoom 2 doubles every off-centre offset in the image.
+  CameraView wide;
+  wide.X_WC = Isometry3d::Identity();  // looking along +x
+  CameraView zoomed = wide;
+  zoomed.fov_y_rad = ZoomedFov(wide.fov_y_rad, 2.0);
+  const Vector3d p(100, 7, -5);
+  const Eigen::Vector2d centre_px(320, 240);
+  EXPECT_TRUE((Project(zoomed, p) - centre_px).isApprox(2.0 * (Project(wide, p) - centre_px), 1e-9));
+  EXPECT_NEAR(ZoomedFov(M_PI / 2, 2.0), 2.0 * std::atan(0.5), 1e-12);
 }
 
 TEST(CameraTest, BadViewsAreRefused) {
