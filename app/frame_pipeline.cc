@@ -148,7 +148,11 @@ void FramePipeline::Write(const Encoded& item) {
       file = name.str() + "." + config_.format;
       WriteColor(item.frame, (dir / file).string());
     }
-    if (item.depth) WriteDepthMillimetres(item.frame, (dir / (name.str() + "_depth.png")).string());
+    if (item.depth && config_.depth_format == "npy") {
+      WriteDepthNpy(item.frame, (dir / (name.str() + "_depth.npy")).string());
+    } else if (item.depth) {
+      WriteDepthMillimetres(item.frame, (dir / (name.str() + "_depth.png")).string());
+    }
     std::unique_ptr<std::ofstream>& index = indexes_[item.camera];
     if (!index) {
       index = std::make_unique<std::ofstream>(dir / (item.camera + ".csv"));

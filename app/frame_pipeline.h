@@ -5,7 +5,7 @@
 // oldest waiting job is dropped and counted, so the loop never waits.
 //
 // Files: DIR/<camera>_<tick>.jpg (or .png), DIR/<camera>_<tick>_depth.png
-// (16-bit millimetres), or one DIR/<camera>.mp4 / .avi for video, and
+// (16-bit millimetres) or _depth.npy (float32 metres), or one DIR/<camera>.mp4 / .avi for video, and
 // DIR/<camera>.csv indexing every frame: tick, time_s, file, robot pose.
 
 #include <atomic>
@@ -29,6 +29,7 @@ namespace sandbox::app {
 struct FramePipelineConfig {
   std::string out_dir;
   std::string format{"jpg"};  // jpg, png, mp4 (mp4v) or avi (MJPG)
+  std::string depth_format{"png"};  // png (16-bit millimetres) or npy (float32 metres)
   double video_fps{30.0};
   std::size_t queue_capacity{4};
 };

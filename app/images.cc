@@ -1,6 +1,7 @@
 #include "app/images.h"
 
 #include <cmath>
+#include <fstream>
 #include <stdexcept>
 
 #include <opencv2/imgcodecs.hpp>
@@ -68,6 +69,25 @@ void WriteDepthMillimetres(const sensors::Frame& frame, const std::string& path)
         std::isfinite(d) && d * 1000.f < 65535.f ? std::uint16_t(std::lround(d * 1000.f)) : 0;
   }
   Write(depth, path);
+}
+
+void WriteDepthNpy(const sensors::Frame& frame, const std::string& path) {
+  // Format 1.0: magic, version, a little-endian header length, then a Python
+  // dict literal padded with spaces and a newline to a multiple of 64 bytes.
+  std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" +
+                       std::to_string(frame.height) + ", " + std::to_string(frame.width) + "), }";
+  const std::size_t preamble = 10;
+  header.append(63 - (preamble + header.size()) % 64, ' ');
+  header += '\n';
+  std::ofstream out(path, std::ios::binary);
+  out.write("\x93NUMPY\x01\x00", 8);
+  const char length[2] = {char(header.size() & 0xff), char(header.size() >> 8)};
+  out.write(length, 2);
+  out << header;
+  static_assert(sizeof(float) == 4, "float32");
+  out.write(reinterpret_cast<const char*>(frame.depth_m.data()),
+            std::streamsize(frame.depth_m.size() * sizeof(float)));  // x86 and ARM: little-endian
+  if (!out.good()) throw std::runtime_error("cannot write " + path);
 }
 
 }  // namespace sandbox::app

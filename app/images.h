@@ -15,5 +15,8 @@ sensors::TextureDecoder OpenCvTextureDecoder();
 void WriteColor(const sensors::Frame& frame, const std::string& path);
 // Writes depth as a 16-bit PNG in millimetres (0: nothing within range).
 void WriteDepthMillimetres(const sensors::Frame& frame, const std::string& path);
+// Writes depth as a NumPy .npy file: float32 metres, shape (height, width),
+// row 0 at the top, +inf where nothing is (numpy.load, or readNPY in MATLAB).
+void WriteDepthNpy(const sensors::Frame& frame, const std::string& path);
 
 }  // namespace sandbox::app

@@ -28,7 +28,7 @@ namespace {
 
 const char* kUsage =
     "usage: sandbox run [LEVEL] [--rate HZ] [--duration S] [--lcm-url URL] [--lockstep]\n"
-    "                   [--replay LOG] [--record LOG]\n"
+    "                   [--replay LOG] [--record LOG] [--out DIR [--frames F] [--depth D]]\n"
     "  LEVEL        a level (default: the bundled sample level)\n"
     "  --rate       loop rate in Hz (default 100)\n"
     "  --duration   stop after this many seconds (default: run until Ctrl-C)\n"
@@ -40,6 +40,7 @@ const char* kUsage =
     "  --out DIR    render the robots' cameras ([[robot.camera]]) into DIR (render and\n"
     "               encoder threads; the loop never waits for them)\n"
     "  --frames     jpg (default), png, mp4 or avi\n"
+    "  --depth      depth images (payload cameras): png (16-bit mm, default) or npy (float32 m)\n"
     "Inputs per robot: <ROBOT>/POSE, /BONES, /ACTORS, /CAMERA (trailing pan, tilt, zoom).\n"
     "Outputs: <ROBOT>/SCAN_FACE, /GROUND, /LIDAR, /RANGE, /STATE, /STATUS (docs/bridge.md).\n";
 
@@ -99,7 +100,9 @@ struct SensorRun {
 
 int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   const auto parsed =
-      ParseArgs(args, "run", {"--rate", "--duration", "--lcm-url", "--replay", "--record", "--out", "--frames"},
+      ParseArgs(args, "run",
+                {"--rate", "--duration", "--lcm-url", "--replay", "--record", "--out", "--frames",
+                 "--depth"},
                 {"--lockstep"}, kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
@@ -162,6 +165,10 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       if (frame_config.format != "jpg" && frame_config.format != "png" &&
           frame_config.format != "mp4" && frame_config.format != "avi") {
         throw CommandError("--frames must be jpg, png, mp4 or avi, got '" + frame_config.format + "'");
+      }
+      frame_config.depth_format = parsed->Value("--depth", "png");
+      if (frame_config.depth_format != "png" && frame_config.depth_format != "npy") {
+        throw CommandError("--depth must be png or npy, got '" + frame_config.depth_format + "'");
       }
       frames = std::make_unique<FramePipeline>(level, frame_config);
     }

@@ -1,0 +1,79 @@
+// Depth files as other tools read them: the 16-bit PNG in millimetres through
+// OpenCV, the .npy parsed by the format's own rules.
+
+#include "app/images.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "tests/test_util.h"
+
+namespace sandbox::app {
+namespace {
+
+sensors::Frame DepthFrame() {
+  sensors::Frame frame;
+  frame.width = 3;
+  frame.height = 2;
+  frame.rgb.assign(18, 0);
+  const float inf = std::numeric_limits<float>::infinity();
+  frame.depth_m = {1.2345f, 2.0f, inf, 0.5f, 65.0f, 70.0f};  // row 0 first
+  return frame;
+}
+
+TEST(DepthFileTest, PngHoldsRoundedMillimetresAndZeroWhereNothingOrTooFar) {
+  testing::TempDir dir;
+  const std::string path = (dir.path() / "d.png").string();
+  WriteDepthMillimetres(DepthFrame(), path);
+  const cv::Mat png = cv::imread(path, cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(png.type(), CV_16UC1);
+  ASSERT_EQ(png.cols, 3);
+  ASSERT_EQ(png.rows, 2);
+  EXPECT_EQ(png.at<std::uint16_t>(0, 0), 1235);  // 1.2345 m, rounded
+  EXPECT_EQ(png.at<std::uint16_t>(0, 1), 2000);
+  EXPECT_EQ(png.at<std::uint16_t>(0, 2), 0);      // sky
+  EXPECT_EQ(png.at<std::uint16_t>(1, 0), 500);
+  EXPECT_EQ(png.at<std::uint16_t>(1, 1), 65000);
+  EXPECT_EQ(png.at<std::uint16_t>(1, 2), 0);      // beyond 65.535 m
+}
+
+TEST(DepthFileTest, NpyIsFloat32MetresInRowsAsNumpyReadsIt) {
+  testing::TempDir dir;
+  const std::string path = (dir.path() / "d.npy").string();
+  const sensors::Frame frame = DepthFrame();
+  WriteDepthNpy(frame, path);
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  std::string bytes(std::size_t(in.tellg()), '\0');
+  in.seekg(0);
+  in.read(bytes.data(), std::streamsize(bytes.size()));
+  ASSERT_GE(bytes.size(), 10u);
+  EXPECT_EQ(bytes.substr(0, 6), "\x93NUMPY");
+  EXPECT_EQ(bytes[6], 1);
+  EXPECT_EQ(bytes[7], 0);
+  const std::size_t header_length =
+      std::size_t(std::uint8_t(bytes[8])) | std::size_t(std::uint8_t(bytes[9])) << 8;
+  const std::size_t data_start = 10 + header_length;
+  EXPECT_EQ(data_start % 64, 0u);  // the format aligns the data
+  const std::string header = bytes.substr(10, header_length);
+  EXPECT_NE(header.find("'descr': '<f4'"), std::string::npos) << header;
+  EXPECT_NE(header.find("'fortran_order': False"), std::string::npos) << header;
+  EXPECT_NE(header.find("'shape': (2, 3)"), std::string::npos) << header;
+  EXPECT_EQ(header.back(), '\n');
+  ASSERT_EQ(bytes.size(), data_start + 6 * 4);
+  for (std::size_t i = 0; i < 6; ++i) {
+    std::uint32_t bits = 0;  // little-endian float32
+    for (int b = 3; b >= 0; --b) bits = bits << 8 | std::uint8_t(bytes[data_start + 4 * i + std::size_t(b)]);
+    float value;
+    std::memcpy(&value, &bits, 4);
+    EXPECT_EQ(value, frame.depth_m[i]) << i;
+  }
+}
+
+}  // namespace
+}  // namespace sandbox::app
