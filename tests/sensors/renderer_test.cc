@@ -1,11 +1,13 @@
 // The OSMesa renderer and the cameras: colours, depth against the ray caster,
-// textures, the bent wing's silhouette, the chase camera's aim and lag.
+// textures (a generated quad, CesiumMan's embedded texture), the bent wing's silhouette, the chase camera's aim and lag.
 
 #include "sensors/renderer.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <set>
 #include <opencv2/imgcodecs.hpp>
 
 #include "app/images.h"
@@ -137,6 +139,81 @@ TEST(RendererTextureTest, TextureColoursShow) {
   plain->SetLevel(missing, app::OpenCvTextureDecoder());
   ASSERT_EQ(plain->warnings().size(), 1u);
   EXPECT_NE(plain->warnings()[0].find("missing.png cannot be read"), std::string::npos);
+}
+
+// Chromaticity (r, g) / (r + g + b) on a 0.02 grid, for colours bright enough
+// that 8-bit rounding does not move it; -1 for darker ones.
+int ChromaBin(int r, int g, int b) {
+  const int sum = r + g + b;
+  if (sum < 90) return -1;
+  return int(50.0 * r / sum) * 64 + int(50.0 * g / sum);
+}
+
+TEST(RendererTextureTest, CesiumManShowsItsEmbeddedTextureColours) {
+  const std::string file = std::string(SANDBOX_SHARED_ASSETS) + "/cesium-man/CesiumMan.glb";
+  if (!std::ifstream(file).good()) GTEST_SKIP() << "no " << file << " (shared assets absent)";
+  testing::TempDir dir;
+  const scene::Level level =
+      scene::LoadLevel(dir.Write("level.toml", "[[actor]]\nname = \"man\"\nfile = \"" + file + "\"\n"));
+  ASSERT_EQ(level.textures.size(), 1u);
+  // The texture's own colours, decoded here from the file's bytes.
+  const scene::EmbeddedTexture& embedded = level.textures[0];
+  const cv::Mat texels = cv::imdecode(embedded.bytes, cv::IMREAD_COLOR);  // BGR
+  ASSERT_FALSE(texels.empty());
+  std::set<int> texture_bins;
+  for (int y = 0; y < texels.rows; ++y) {
+    for (int x = 0; x < texels.cols; ++x) {
+      const cv::Vec3b t = texels.at<cv::Vec3b>(y, x);
+      texture_bins.insert(ChromaBin(t[2], t[1], t[0]));
+    }
+  }
+  // Seen from 4 m in front of its middle, with and without its texture.
+  const Vector3d centre = level.bounds_W().center();
+  CameraView view;
+  view.X_WC = LookAt(centre + Vector3d(0, -4, 0), centre);
+  Frame textured, plain;
+  auto renderer = MakeRenderer();
+  renderer->SetLevel(level, app::OpenCvTextureDecoder());
+  EXPECT_TRUE(renderer->warnings().empty());
+  renderer->Render(view, {}, {}, {}, &textured);
+  auto untextured = MakeRenderer();
+  untextured->SetLevel(level, {});
+  untextured->Render(view, {}, {}, {}, &plain);
+  // Where the man is drawn (not sky), lighting scales a colour but keeps its
+  // chromaticity: textured pixels take the texture's, many of them; the plain
+  // render has the one base colour.
+  const RenderSettings sky;
+  auto is_sky = [&](const std::uint8_t* p) {
+    return std::abs(p[0] - 255 * sky.sky_rgb.x()) < 3 && std::abs(p[1] - 255 * sky.sky_rgb.y()) < 3 &&
+           std::abs(p[2] - 255 * sky.sky_rgb.z()) < 3;
+  };
+  auto near_texture = [&](int bin) {
+    for (int dr = -1; dr <= 1; ++dr) {
+      for (int dg = -1; dg <= 1; ++dg) {
+        if (texture_bins.count(bin + 64 * dr + dg)) return true;
+      }
+    }
+    return false;
+  };
+  int drawn = 0, matching = 0;
+  std::set<int> textured_bins, plain_bins;
+  for (int row = 0; row < view.height; ++row) {
+    for (int column = 0; column < view.width; ++column) {
+      const std::uint8_t* t = Pixel(textured, column, row);
+      const std::uint8_t* p = Pixel(plain, column, row);
+      if (is_sky(t)) continue;
+      const int bin = ChromaBin(t[0], t[1], t[2]);
+      if (bin < 0) continue;
+      ++drawn;
+      matching += near_texture(bin);
+      textured_bins.insert(bin);
+      plain_bins.insert(ChromaBin(p[0], p[1], p[2]));
+    }
+  }
+  ASSERT_GT(drawn, 2000) << "the man is not in view";
+  EXPECT_GT(matching, 0.95 * drawn) << matching << " of " << drawn;
+  EXPECT_GT(textured_bins.size(), 20u);
+  EXPECT_LE(plain_bins.size(), 3u);
 }
 
 TEST(RendererWingTest, BendingMovesTheSilhouetteToTheAnalyticTip) {
