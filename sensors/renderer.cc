@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <tuple>
 #include <stdexcept>
 
 namespace sandbox::sensors {
@@ -104,6 +105,32 @@ GpuMesh Upload(const std::vector<Eigen::Vector3f>& positions,
   return mesh;
 }
 
+// Static geometry, merged: one buffer set per material and ground cell, with
+// its bounds for culling. Positions are relative to `origin` (double) so that
+// floats keep their precision in large levels.
+struct StaticChunk {
+  std::vector<Eigen::Vector3f> positions, normals;
+  std::vector<Eigen::Vector2f> uvs;
+  std::vector<std::uint32_t> indices;
+  Eigen::AlignedBox3f bounds;
+  bool any_uvs{false};
+};
+constexpr double kChunkCell_m = 128.0;
+
+// False when the box lies wholly outside one plane of the frustum of clip
+// matrix M (rows of M combined as in Gribb and Hartmann).
+bool InFrustum(const Eigen::Matrix4f& M, const Eigen::AlignedBox3f& box) {
+  for (int plane = 0; plane < 6; ++plane) {
+    const Eigen::Vector4f p = M.row(3) + (plane % 2 == 0 ? 1.f : -1.f) * M.row(plane / 2);
+    // The box corner furthest along the plane's normal.
+    const Eigen::Vector3f corner(p.x() >= 0 ? box.max().x() : box.min().x(),
+                                 p.y() >= 0 ? box.max().y() : box.min().y(),
+                                 p.z() >= 0 ? box.max().z() : box.min().z());
+    if (p.head<3>().dot(corner) + p.w() < 0.f) return false;
+  }
+  return true;
+}
+
 // Column-major float matrix of X relative to the camera position (double).
 Eigen::Matrix4f Relative(const Eigen::Affine3d& X, const Eigen::Vector3d& camera) {
   Eigen::Affine3d rel = X;
@@ -141,7 +168,9 @@ class OsMesaRenderer : public Renderer {
 
   void SetLevel(const scene::Level& level, const TextureDecoder& decoder) override {
     level_ = &level;
+    MergeStatic(level);
     for (std::size_t a = 0; a < level.actors.size(); ++a) {
+      if (!level.actors[a].movable) continue;  // merged above
       for (const scene::Mesh& mesh : level.actors[a].meshes) {
         actor_meshes_.push_back({int(a), Upload(mesh.positions_A, mesh.normals_A, mesh.uvs,
                                                 mesh.indices, mesh.material, GL_STATIC_DRAW)});
@@ -214,8 +243,15 @@ class OsMesaRenderer : public Renderer {
     glUniform2f(uniforms_.fog, settings.fog_start_m, settings.fog_end_m);
     glUniform1i(uniforms_.base_texture, 0);
 
-    // Opaque first, then the translucent (water) on top.
+    // Opaque first, then the translucent (water) on top. Static chunks outside
+    // the view are skipped.
+    const Eigen::Matrix4f static_model = Relative(Eigen::Affine3d(Eigen::Translation3d(origin_)), camera);
+    const Eigen::Matrix4f static_clip = view_proj * static_model;
     for (const bool translucent : {false, true}) {
+      for (const auto& [bounds, mesh] : static_meshes_) {
+        if (IsTranslucent(mesh.material) != translucent || !InFrustum(static_clip, bounds)) continue;
+        Draw(mesh, static_model);
+      }
       for (const auto& [actor, mesh] : actor_meshes_) {
         if (IsTranslucent(mesh.material) != translucent) continue;
         const Eigen::Isometry3d& X_WA = actor_poses.size() == level_->actors.size()
@@ -274,6 +310,52 @@ class OsMesaRenderer : public Renderer {
   std::string description() const override { return description_; }
 
  private:
+  // Static actors' meshes in world coordinates, grouped by material and by
+  // ground cell, uploaded once: few draws, and whole cells culled.
+  void MergeStatic(const scene::Level& level) {
+    origin_ = level.bounds_W().isEmpty() ? Eigen::Vector3d(Eigen::Vector3d::Zero())
+                                         : Eigen::Vector3d(level.bounds_W().center());
+    std::map<std::tuple<int, long, long>, StaticChunk> chunks;
+    for (const scene::Actor& actor : level.actors) {
+      if (actor.movable) continue;
+      const Eigen::Matrix3d R = actor.X_WA.linear();
+      for (const scene::Mesh& mesh : actor.meshes) {
+        // This mesh's vertices already copied into each chunk.
+        std::map<std::tuple<int, long, long>, std::vector<std::int64_t>> copied;
+        for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+          Eigen::Vector3d p[3];
+          for (int k = 0; k < 3; ++k) {
+            p[k] = actor.X_WA * mesh.positions_A[mesh.indices[t + std::size_t(k)]].cast<double>() - origin_;
+          }
+          const Eigen::Vector3d c = (p[0] + p[1] + p[2]) / 3.0;
+          const std::tuple<int, long, long> key{mesh.material, std::lround(std::floor(c.x() / kChunkCell_m)),
+                                                std::lround(std::floor(c.y() / kChunkCell_m))};
+          StaticChunk& chunk = chunks[key];
+          std::vector<std::int64_t>& map = copied[key];
+          if (map.empty()) map.assign(mesh.positions_A.size(), -1);
+          chunk.any_uvs = chunk.any_uvs || mesh.uvs.size() == mesh.positions_A.size();
+          for (int k = 0; k < 3; ++k) {
+            const std::uint32_t v = mesh.indices[t + std::size_t(k)];
+            if (map[v] < 0) {
+              map[v] = std::int64_t(chunk.positions.size());
+              chunk.positions.push_back(p[k].cast<float>());
+              chunk.normals.push_back((R * mesh.normals_A[v].cast<double>()).cast<float>());
+              chunk.uvs.push_back(mesh.uvs.size() == mesh.positions_A.size() ? mesh.uvs[v]
+                                                                            : Eigen::Vector2f::Zero());
+              chunk.bounds.extend(chunk.positions.back());
+            }
+            chunk.indices.push_back(std::uint32_t(map[v]));
+          }
+        }
+      }
+    }
+    for (auto& [key, chunk] : chunks) {
+      if (!chunk.any_uvs) chunk.uvs.clear();
+      static_meshes_.push_back({chunk.bounds, Upload(chunk.positions, chunk.normals, chunk.uvs,
+                                                     chunk.indices, std::get<0>(key), GL_STATIC_DRAW)});
+    }
+  }
+
   bool IsTranslucent(int material) const {
     return material >= 0 && material < int(level_->materials.size()) &&
            level_->materials[std::size_t(material)].base_color.w() < 0.999f;
@@ -325,7 +407,9 @@ class OsMesaRenderer : public Renderer {
   } uniforms_{};
   int width_{0}, height_{0};
   const scene::Level* level_{nullptr};
-  std::vector<std::pair<int, GpuMesh>> actor_meshes_;
+  Eigen::Vector3d origin_{Eigen::Vector3d::Zero()};                 // of the static chunks
+  std::vector<std::pair<Eigen::AlignedBox3f, GpuMesh>> static_meshes_;
+  std::vector<std::pair<int, GpuMesh>> actor_meshes_;  // movable actors'
   std::map<const scene::RobotModel*, std::vector<GpuMesh>> robot_meshes_;
   std::map<int, GLuint> textures_;
   std::vector<std::string> warnings_;
