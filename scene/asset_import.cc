@@ -96,9 +96,10 @@ Eigen::Matrix4d ToEigen(const aiMatrix4x4& m) {
 
 namespace {
 
-// Drops faces whose vertex indices are out of range (the Quake 3 importer of
-// assimp 5.2.5 leaves uninitialised indices). Runs before any post-processing
-// step reads the indices. Returns how many faces were dropped.
+// Drops faces whose vertex indices are out of range (a safety net: the Quake 3
+// faces, where assimp 5.2.5 left such indices, are rebuilt before this). Runs
+// before any post-processing step reads the indices. Returns how many faces
+// were dropped.
 std::size_t DropFacesWithBadIndices(const aiScene& scene) {
   std::size_t dropped = 0;
   for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
@@ -122,6 +123,29 @@ std::size_t DropFacesWithBadIndices(const aiScene& scene) {
     mesh->mNumFaces = kept;
   }
   return dropped;
+}
+
+// The Quake 3 importer of assimp 5.2.5 writes three vertices a triangle, in
+// order, but leaves most face indices wrong (repeats, uninitialised values):
+// rebuilds face f as vertices 3f, 3f + 1, 3f + 2 in every mesh laid out so.
+// Returns how many meshes it rebuilt.
+std::size_t RebuildQuake3Faces(const aiScene& scene) {
+  std::size_t rebuilt = 0;
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    aiMesh* mesh = scene.mMeshes[m];
+    if (mesh->mNumVertices != 3 * mesh->mNumFaces) continue;
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      aiFace& face = mesh->mFaces[f];
+      if (face.mNumIndices != 3) {
+        delete[] face.mIndices;
+        face.mIndices = new unsigned[3];
+        face.mNumIndices = 3;
+      }
+      for (unsigned k = 0; k < 3; ++k) face.mIndices[k] = 3 * f + k;
+    }
+    ++rebuilt;
+  }
+  return rebuilt;
 }
 
 Material ConvertMaterial(const aiScene& scene, const aiMaterial& in, const fs::path& folder) {
@@ -310,6 +334,13 @@ AssimpScene ReadAssimpScene(Assimp::Importer& importer, const fs::path& file,
     throw LevelError(file.string() + ": assimp could not read it: " + importer.GetErrorString());
   }
   AssimpScene out;
+  if (FormatOf(file) == Format::kQuake3) {
+    if (const std::size_t rebuilt = RebuildQuake3Faces(*scene); rebuilt > 0) {
+      out.warnings.push_back(file.string() + ": rebuilt the faces of " + std::to_string(rebuilt) +
+                             " meshes as consecutive vertex triples (assimp's Quake 3 importer "
+                             "leaves their indices wrong)");
+    }
+  }
   if (const std::size_t dropped = DropFacesWithBadIndices(*scene); dropped > 0) {
     out.warnings.push_back(file.string() + ": dropped " + std::to_string(dropped) +
                            " faces with out-of-range vertex indices");

@@ -25,8 +25,9 @@ struct AssimpScene {
   std::vector<std::string> warnings;
 };
 
-// Reads `file` without validation, drops faces with out-of-range indices
-// (one warning), triangulates and adds smooth normals where missing. Throws
+// Reads `file` without validation, rebuilds Quake 3 faces (assimp 5.2.5
+// leaves their indices wrong), drops faces with out-of-range indices (one
+// warning each), triangulates and adds smooth normals where missing. Throws
 // LevelError for an unsupported or unreadable file.
 AssimpScene ReadAssimpScene(Assimp::Importer& importer, const std::filesystem::path& file,
                             const AssetConversion& conversion);
