@@ -1,5 +1,9 @@
 #include "app/frame_pipeline.h"
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -11,6 +15,13 @@
 #include "app/images.h"
 
 namespace sandbox::app {
+namespace {
+
+// Frames yield to the loop: on a machine with few cores the loop's wake-ups
+// would otherwise wait behind rendering and encoding (Linux nice is per thread).
+void LowerThisThreadsPriority() { setpriority(PRIO_PROCESS, id_t(syscall(SYS_gettid)), 10); }
+
+}  // namespace
 
 struct FramePipeline::Video {
   cv::VideoWriter writer;
@@ -19,8 +30,8 @@ struct FramePipeline::Video {
 FramePipeline::FramePipeline(const scene::Level& level, const FramePipelineConfig& config)
     : level_(level), config_(config) {
   std::error_code error;
-  std::filesystem::create_directories(config_.out_dir, error);
-  if (error || !std::filesystem::is_directory(config_.out_dir)) {
+  if (!config_.out_dir.empty()) std::filesystem::create_directories(config_.out_dir, error);
+  if (!config_.out_dir.empty() && (error || !std::filesystem::is_directory(config_.out_dir))) {
     throw std::runtime_error("cannot create the output folder '" + config_.out_dir + "'");
   }
   render_thread_ = std::thread([this] { RenderLoop(); });
@@ -63,6 +74,7 @@ std::string FramePipeline::error() const {
 }
 
 void FramePipeline::RenderLoop() {
+  LowerThisThreadsPriority();  // before the context: llvmpipe's threads inherit it
   std::unique_ptr<sensors::Renderer> renderer;
   try {
     renderer = sensors::MakeRenderer();
@@ -88,12 +100,14 @@ void FramePipeline::RenderLoop() {
     std::vector<const scene::RobotState*> robots;
     for (const scene::RobotState& state : job.robots) robots.push_back(&state);
     try {
-      renderer->Render(job.view, job.actor_poses, robots, {}, &item.frame);
+      renderer->Render(job.view, job.actor_poses, robots, {}, &item.frame, &job.overlay);
     } catch (const std::exception& e) {
       Fail("camera " + job.camera + ": " + e.what());
       continue;
     }
     ++rendered_;
+    if (job.show && config_.show) config_.show(job.camera, item.frame);
+    if (!job.write || config_.out_dir.empty()) continue;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       if (write_queue_.size() >= config_.queue_capacity) {
@@ -107,6 +121,7 @@ void FramePipeline::RenderLoop() {
 }
 
 void FramePipeline::WriteLoop() {
+  LowerThisThreadsPriority();
   for (;;) {
     Encoded item;
     {
@@ -150,6 +165,8 @@ void FramePipeline::Write(const Encoded& item) {
     }
     if (item.depth && config_.depth_format == "npy") {
       WriteDepthNpy(item.frame, (dir / (name.str() + "_depth.npy")).string());
+    } else if (item.depth && config_.depth_format == "exr") {
+      WriteDepthExr(item.frame, (dir / (name.str() + "_depth.exr")).string());
     } else if (item.depth) {
       WriteDepthMillimetres(item.frame, (dir / (name.str() + "_depth.png")).string());
     }

@@ -5,7 +5,7 @@
 // oldest waiting job is dropped and counted, so the loop never waits.
 //
 // Files: DIR/<camera>_<tick>.jpg (or .png), DIR/<camera>_<tick>_depth.png
-// (16-bit millimetres) or _depth.npy (float32 metres), or one DIR/<camera>.mp4 / .avi for video, and
+// (16-bit millimetres), _depth.npy or _depth.exr (float32 metres), or one DIR/<camera>.mp4 / .avi for video, and
 // DIR/<camera>.csv indexing every frame: tick, time_s, file, robot pose.
 
 #include <atomic>
@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <deque>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -27,11 +28,13 @@
 namespace sandbox::app {
 
 struct FramePipelineConfig {
-  std::string out_dir;
+  std::string out_dir;  // empty: nothing written (a live view only)
   std::string format{"jpg"};  // jpg, png, mp4 (mp4v) or avi (MJPG)
-  std::string depth_format{"png"};  // png (16-bit millimetres) or npy (float32 metres)
+  std::string depth_format{"png"};  // png (16-bit millimetres), npy or exr (float32 metres)
   double video_fps{30.0};
   std::size_t queue_capacity{4};
+  // Called on the render thread with each frame of a job marked `show`.
+  std::function<void(const std::string& camera, const sensors::Frame& frame)> show;
 };
 
 // What the loop hands over: a camera view and copies of the robot states.
@@ -44,6 +47,9 @@ struct RenderJob {
   std::vector<scene::RobotState> robots;
   std::vector<Eigen::Isometry3d> actor_poses;
   Eigen::Isometry3d robot_pose{Eigen::Isometry3d::Identity()};  // for the index
+  sensors::Overlay overlay;  // empty: none
+  bool write{true};          // to the output folder
+  bool show{false};          // to FramePipelineConfig::show (the live view)
 };
 
 class FramePipeline {

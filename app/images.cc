@@ -1,7 +1,10 @@
 #include "app/images.h"
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
+#include <mutex>
+#include <vector>
 #include <stdexcept>
 
 #include <opencv2/imgcodecs.hpp>
@@ -42,10 +45,10 @@ sensors::TextureDecoder OpenCvTextureDecoder() {
 namespace {
 
 // cv::imwrite, failing with the path whether OpenCV returns false or throws.
-void Write(const cv::Mat& image, const std::string& path) {
+void Write(const cv::Mat& image, const std::string& path, const std::vector<int>& params = {}) {
   bool written = false;
   try {
-    written = cv::imwrite(path, image);
+    written = cv::imwrite(path, image, params);
   } catch (const cv::Exception&) {
     written = false;
   }
@@ -88,6 +91,14 @@ void WriteDepthNpy(const sensors::Frame& frame, const std::string& path) {
   out.write(reinterpret_cast<const char*>(frame.depth_m.data()),
             std::streamsize(frame.depth_m.size() * sizeof(float)));  // x86 and ARM: little-endian
   if (!out.good()) throw std::runtime_error("cannot write " + path);
+}
+
+void WriteDepthExr(const sensors::Frame& frame, const std::string& path) {
+  // OpenCV reads this once, at its first EXR file.
+  static std::once_flag enabled;
+  std::call_once(enabled, [] { setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0); });
+  const cv::Mat depth(frame.height, frame.width, CV_32F, const_cast<float*>(frame.depth_m.data()));
+  Write(depth, path, {cv::IMWRITE_EXR_TYPE, cv::IMWRITE_EXR_TYPE_FLOAT});
 }
 
 }  // namespace sandbox::app

@@ -18,5 +18,8 @@ void WriteDepthMillimetres(const sensors::Frame& frame, const std::string& path)
 // Writes depth as a NumPy .npy file: float32 metres, shape (height, width),
 // row 0 at the top, +inf where nothing is (numpy.load, or readNPY in MATLAB).
 void WriteDepthNpy(const sensors::Frame& frame, const std::string& path);
+// Writes depth as OpenEXR: one float32 channel (Y) in metres, ZIP compressed,
+// +inf where nothing is. Turns on OpenCV's EXR codec (off by default).
+void WriteDepthExr(const sensors::Frame& frame, const std::string& path);
 
 }  // namespace sandbox::app

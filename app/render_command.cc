@@ -3,13 +3,17 @@
 #include <chrono>
 #include <filesystem>
 #include <iomanip>
+#include <variant>
 
 #include "app/bone_values.h"
 #include "app/command_line.h"
 #include "app/defaults.h"
 #include "app/images.h"
 #include "scene/level.h"
+#include "scene/collision_world.h"
 #include "sensors/cameras.h"
+#include "sensors/debug_overlay.h"
+#include "sensors/robot_sensors.h"
 
 namespace sandbox::app {
 namespace {
@@ -17,7 +21,7 @@ namespace {
 const char* kUsage =
     "usage: sandbox render [LEVEL] --camera chase|trailing|payload|fixed --at X,Y,Z[,R,P,Y]\n"
     "                      [--robot NAME] [--bones LIST] [--width W] [--height H] [--fov DEG]\n"
-    "                      --out FILE.jpg|.png\n"
+    "                      [--overlay] [--stub M] --out FILE.jpg|.png\n"
     "  --camera  chase: the spring arm behind the robot; trailing: 25 m behind, 8 m up;\n"
     "            payload: on the robot, looking forward (also writes FILE_depth.png, 16-bit\n"
     "            millimetres); fixed: the camera itself at --at\n"
@@ -25,14 +29,48 @@ const char* kUsage =
     "            metres, roll/pitch/yaw in degrees\n"
     "  --bones   bone values as for `sandbox pose`\n"
     "  --width, --height, --fov   image size (default 640 x 480) and vertical field of view\n"
-    "            in degrees (default 60)\n";
+    "            in degrees (default 60)\n"
+    "  --overlay the debug overlay: the robot's face scanners (or a default one, 1 m over\n"
+    "            25 m) scanned in full at the pose, occupied samples red and free green,\n"
+    "            bone frames and movable actors' bounds\n"
+    "  --stub    draw samples as stubs of M metres along their rays instead of points\n";
+
+// The overlay at one robot state: its face scanners scanned in full.
+void BuildOverlay(const scene::Level& level, int robot_index, const scene::RobotState* robot,
+                  double stub_m, sensors::Overlay* overlay) {
+  if (robot != nullptr) {
+    scene::CollisionWorld world(level);
+    world.UpdateRobot(robot_index, *robot);
+    sensors::RayCaster caster;
+    sensors::RayFilter filter;
+    filter.ignore_robot = robot_index;
+    std::vector<std::pair<sensors::FaceScannerConfig, Eigen::Isometry3d>> scanners;
+    for (const sensors::MountedSensor& mounted : sensors::MakeRobotSensors(level)) {
+      const auto* face = std::get_if<sensors::FaceScannerConfig>(&mounted.config);
+      if (face != nullptr && mounted.robot == robot_index) {
+        scanners.push_back({*face, mounted.Pose(*robot)});
+      }
+    }
+    if (scanners.empty()) scanners.push_back({sensors::FaceScannerConfig{}, robot->pose()});
+    for (auto& [config, X_WS] : scanners) {
+      config.refresh = sensors::Refresh::kFull;
+      const sensors::FaceScanner scanner(config);
+      sensors::FaceScan scan = scanner.EmptyScan();
+      scanner.Scan(world, caster, filter, X_WS, 0, &scan);
+      sensors::AddFaceScan(scan, stub_m, overlay);
+    }
+    sensors::AddBoneFrames(*robot, 1.0, overlay);
+  }
+  sensors::AddActorBounds(level, {}, false, overlay);
+}
 
 }  // namespace
 
 int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   const auto parsed = ParseArgs(
-      args, "render", {"--camera", "--at", "--robot", "--bones", "--width", "--height", "--fov", "--out"},
-      {}, kUsage, err);
+      args, "render", {"--camera", "--at", "--robot", "--bones", "--width", "--height", "--fov", "--out",
+                       "--stub"},
+      {"--overlay"}, kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
     out << kUsage;
@@ -61,9 +99,11 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
                                                     : 60.0) * M_PI / 180.0;
     const scene::Level level = scene::LoadLevel(parsed->level.value_or(kDefaultLevel));
     std::unique_ptr<scene::RobotState> robot;
+    int robot_index = -1;
     if (!level.robots.empty()) {
       const int index = parsed->Value("--robot").empty() ? 0 : level.FindRobot(parsed->Value("--robot"));
       if (index < 0) throw CommandError("the level has no robot '" + parsed->Value("--robot") + "'");
+      robot_index = index;
       robot = std::make_unique<scene::RobotState>(level.robots[std::size_t(index)]);
       if (camera != "fixed" && !robot->SetPose(X_at)) {
         throw CommandError("--at rejected: " + robot->last_rejection());
@@ -90,7 +130,13 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
     sensors::Frame frame;
     std::vector<const scene::RobotState*> robots;
     if (robot) robots.push_back(robot.get());
-    renderer->Render(view, {}, robots, {}, &frame);
+    sensors::Overlay overlay;
+    if (parsed->flags.count("--overlay")) {
+      const double stub_m =
+          parsed->values.count("--stub") ? ParseNumbers(parsed->Value("--stub"), "--stub").at(0) : 0.0;
+      BuildOverlay(level, robot_index, robot.get(), stub_m, &overlay);
+    }
+    renderer->Render(view, {}, robots, {}, &frame, &overlay);
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     WriteColor(frame, out_file);

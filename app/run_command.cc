@@ -14,12 +14,14 @@
 #include "app/command_line.h"
 #include "app/defaults.h"
 #include "app/frame_pipeline.h"
+#include "app/live_view.h"
 #include "bridge/lcm_link.h"
 #include "bridge/outputs.h"
 #include "bridge/robot_inputs.h"
 #include "bridge/udp_inputs.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
+#include "sensors/debug_overlay.h"
 #include "sensors/range_sensor.h"
 #include "sensors/robot_sensors.h"
 
@@ -28,7 +30,7 @@ namespace {
 
 const char* kUsage =
     "usage: sandbox run [LEVEL] [--rate HZ] [--duration S] [--lcm-url URL] [--lockstep]\n"
-    "                   [--replay LOG] [--record LOG] [--out DIR [--frames F] [--depth D]]\n"
+    "                   [--replay LOG] [--record LOG] [--out DIR [--frames F] [--depth D]] [--view]\n"
     "  LEVEL        a level (default: the bundled sample level)\n"
     "  --rate       loop rate in Hz (default 100)\n"
     "  --duration   stop after this many seconds (default: run until Ctrl-C)\n"
@@ -40,7 +42,10 @@ const char* kUsage =
     "  --out DIR    render the robots' cameras ([[robot.camera]]) into DIR (render and\n"
     "               encoder threads; the loop never waits for them)\n"
     "  --frames     jpg (default), png, mp4 or avi\n"
-    "  --depth      depth images (payload cameras): png (16-bit mm, default) or npy (float32 m)\n"
+    "  --depth      depth images (payload cameras): png (16-bit mm, default), npy or exr\n"
+    "               (float32 m)\n"
+    "  --view       a window showing the active camera (needs a display); keys: c next camera,\n"
+    "               a/d pan, w/s tilt, +/- zoom (trailing), o overlay, space pause, q quit\n"
     "Inputs per robot: <ROBOT>/POSE, /BONES, /ACTORS, /CAMERA (trailing pan, tilt, zoom).\n"
     "Outputs: <ROBOT>/SCAN_FACE, /GROUND, /LIDAR, /RANGE, /STATE, /STATUS (docs/bridge.md).\n";
 
@@ -103,7 +108,7 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       ParseArgs(args, "run",
                 {"--rate", "--duration", "--lcm-url", "--replay", "--record", "--out", "--frames",
                  "--depth"},
-                {"--lockstep"}, kUsage, err);
+                {"--lockstep", "--view"}, kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
     out << kUsage;
@@ -158,17 +163,30 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     // Cameras: rendered off the loop when --out is given.
     const std::vector<sensors::MountedCamera> cameras = sensors::MakeRobotCameras(level);
     std::unique_ptr<FramePipeline> frames;
-    if (!parsed->Value("--out").empty()) {
+    std::unique_ptr<LiveView> live_view;
+    ViewControls controls;
+    if (parsed->flags.count("--view")) {
+      if (cameras.empty()) throw CommandError("--view: the level declares no [[robot.camera]]");
+      live_view = std::make_unique<LiveView>("sandbox: " + level.name);
+    }
+    const bool write_frames = !parsed->Value("--out").empty();
+    if (write_frames || live_view) {
       FramePipelineConfig frame_config;
       frame_config.out_dir = parsed->Value("--out");
+      if (live_view) {
+        frame_config.show = [&live_view](const std::string& camera, const sensors::Frame& frame) {
+          live_view->Show(frame, camera);
+        };
+      }
       frame_config.format = parsed->Value("--frames", "jpg");
       if (frame_config.format != "jpg" && frame_config.format != "png" &&
           frame_config.format != "mp4" && frame_config.format != "avi") {
         throw CommandError("--frames must be jpg, png, mp4 or avi, got '" + frame_config.format + "'");
       }
       frame_config.depth_format = parsed->Value("--depth", "png");
-      if (frame_config.depth_format != "png" && frame_config.depth_format != "npy") {
-        throw CommandError("--depth must be png or npy, got '" + frame_config.depth_format + "'");
+      if (frame_config.depth_format != "png" && frame_config.depth_format != "npy" &&
+          frame_config.depth_format != "exr") {
+        throw CommandError("--depth must be png, npy or exr, got '" + frame_config.depth_format + "'");
       }
       frames = std::make_unique<FramePipeline>(level, frame_config);
     }
@@ -181,6 +199,7 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     for (const sensors::MountedCamera& camera : cameras) {
       camera_runs.push_back({&camera, sensors::ChaseCamera(camera.chase)});
     }
+    std::string last_active_camera;
     std::vector<SensorRun> sensor_runs;
     for (const sensors::MountedSensor& m : mounted) sensor_runs.push_back({&m, 0.0, {}});
 
@@ -239,6 +258,16 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       const auto tick_start = Clock::now();
       if (!lockstep) lateness_ms.push_back(std::chrono::duration<double, std::milli>(tick_start - deadline).count());
       std::int64_t now = NowUtime();
+      if (live_view) {
+        for (const ViewKey key : live_view->TakeKeys()) controls.Apply(key, int(cameras.size()));
+        if (controls.quit) break;
+        if (controls.paused) {  // the world holds still; inputs keep only their newest
+          link.Drain();
+          std::this_thread::sleep_for(std::chrono::milliseconds(10));
+          deadline = Clock::now();
+          continue;
+        }
+      }
       // 1-2. Inputs: the newest message per channel (lock-step: the next pose), applied.
       if (!lockstep) link.Drain();
       for (RobotRun& robot : robots) {
@@ -300,17 +329,30 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
         robot.outputs->PublishState(*robot.state, robot.bone_values, robot.input, now);
       }
       // 5. Cameras that are due: a job for the render thread (copies, no waiting).
+      // The live view's camera: the one the keys chose, or the bridge's.
+      for (const RobotRun& robot : robots) {
+        const std::string& name = robot.inputs->active_camera();
+        if (name.empty() || name == last_active_camera) continue;
+        last_active_camera = name;
+        for (std::size_t c = 0; c < cameras.size(); ++c) {
+          if (cameras[c].spec.name == name) controls.camera = int(c);
+        }
+      }
       for (CameraRun& run : camera_runs) {
+        const bool active = live_view && &run == &camera_runs[std::size_t(controls.camera)];
         const double dt = run.last_s < 0.0 ? 0.0 : t - run.last_s;
         run.last_s = t;
         const RobotRun& robot = robots[std::size_t(run.camera->robot)];
         sensors::CameraView view = run.camera->view;
-        const sensors::TrailingCommand& steer = robot.inputs->trailing();  // from <ROBOT>/CAMERA
+        sensors::TrailingCommand steer = robot.inputs->trailing();  // from <ROBOT>/CAMERA
+        steer.pan_rad += controls.steer.pan_rad;  // and the keys
+        steer.tilt_rad += controls.steer.tilt_rad;
+        steer.zoom *= controls.steer.zoom;
         view.X_WC = run.camera->Pose(*robot.state, &run.chase, steer, dt);  // chase lag advances every tick
         if (run.camera->spec.type == "trailing") {
           view.fov_y_rad = sensors::ZoomedFov(view.fov_y_rad, steer.zoom);
         }
-        if (!frames || t < run.next_due_s) continue;
+        if (!frames || (!write_frames && !active) || t < run.next_due_s) continue;
         const double rate = run.camera->spec.rate_hz > 0.0 ? run.camera->spec.rate_hz : 30.0;
         run.next_due_s = std::max(run.next_due_s + 1.0 / rate, t);
         RenderJob job;
@@ -319,9 +361,20 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
         job.time_s = t;
         job.view = view;
         job.depth = run.camera->depth;
+        job.write = write_frames;
+        job.show = active;
         for (const RobotRun& r : robots) job.robots.push_back(*r.state);
         for (std::size_t a = 0; a < level.actors.size(); ++a) job.actor_poses.push_back(world.actor_pose(int(a)));
         job.robot_pose = robot.state->pose();
+        if (run.camera->overlay != (active && controls.overlay)) {  // 'o' flips the view's
+          for (const SensorRun& sensor : sensor_runs) {
+            if (sensor.mounted->robot == run.camera->robot) {
+              sensors::AddFaceScan(sensor.face_scan, run.camera->overlay_stub_m, &job.overlay);
+            }
+          }
+          sensors::AddBoneFrames(*robot.state, 1.0, &job.overlay);
+          sensors::AddActorBounds(level, job.actor_poses, false, &job.overlay);
+        }
         frames->Submit(std::move(job));
       }
       if (t >= next_status_s) {
@@ -359,7 +412,13 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
           << lateness_ms[lateness_ms.size() * 99 / 100] << " ms, max " << lateness_ms.back()
           << " ms\n";
     }
-    if (frames) {
+    if (live_view) {
+      out << "  live view: " << live_view->shown() << " frames shown, last camera "
+          << cameras[std::size_t(controls.camera)].spec.name
+          << (controls.overlay ? ", overlay toggled" : "") << (controls.quit ? ", quit by key" : "")
+          << "\n";
+    }
+    if (frames && write_frames) {
       out << "  frames: " << frames->rendered() << " rendered, " << frames->written() << " written, "
           << frames->dropped() << " dropped, " << frames->failed() << " failed"
           << (frames->failed() > 0 ? " (" + frames->error() + ")" : "") << " -> "

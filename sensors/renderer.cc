@@ -54,6 +54,25 @@ void main() {
 }
 )";
 
+// The overlay: coloured points and lines, pulled 0.2% towards the camera so
+// that marks lying on a surface are not hidden by it.
+const char* kOverlayVertexShader = R"(#version 450 core
+layout(location = 0) in vec3 position;  // camera-centred world
+layout(location = 1) in vec3 rgb;
+uniform mat4 view_proj;
+out vec3 mark_rgb;
+void main() {
+  mark_rgb = rgb;
+  gl_Position = view_proj * vec4(0.998 * position, 1.0);
+}
+)";
+
+const char* kOverlayFragmentShader = R"(#version 450 core
+in vec3 mark_rgb;
+out vec4 color;
+void main() { color = vec4(mark_rgb, 1.0); }
+)";
+
 GLuint Compile(GLenum type, const char* source) {
   const GLuint shader = glCreateShader(type);
   glShaderSource(shader, 1, &source, nullptr);
@@ -66,6 +85,17 @@ GLuint Compile(GLenum type, const char* source) {
     throw std::runtime_error(std::string("Renderer: shader does not compile: ") + log);
   }
   return shader;
+}
+
+GLuint Link(const char* vertex, const char* fragment) {
+  const GLuint program = glCreateProgram();
+  glAttachShader(program, Compile(GL_VERTEX_SHADER, vertex));
+  glAttachShader(program, Compile(GL_FRAGMENT_SHADER, fragment));
+  glLinkProgram(program);
+  GLint ok = 0;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (!ok) throw std::runtime_error("Renderer: shaders do not link");
+  return program;
 }
 
 // A mesh on the GPU.
@@ -152,13 +182,11 @@ class OsMesaRenderer : public Renderer {
     }
     description_ = std::string("OpenGL ") + reinterpret_cast<const char*>(glGetString(GL_VERSION)) +
                    ", " + reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-    program_ = glCreateProgram();
-    glAttachShader(program_, Compile(GL_VERTEX_SHADER, kVertexShader));
-    glAttachShader(program_, Compile(GL_FRAGMENT_SHADER, kFragmentShader));
-    glLinkProgram(program_);
-    GLint ok = 0;
-    glGetProgramiv(program_, GL_LINK_STATUS, &ok);
-    if (!ok) throw std::runtime_error("Renderer: shaders do not link");
+    program_ = Link(kVertexShader, kFragmentShader);
+    overlay_program_ = Link(kOverlayVertexShader, kOverlayFragmentShader);
+    overlay_view_proj_ = glGetUniformLocation(overlay_program_, "view_proj");
+    glGenVertexArrays(1, &overlay_vao_);
+    glGenBuffers(2, overlay_buffers_);
     auto location = [&](const char* name) { return glGetUniformLocation(program_, name); };
     uniforms_ = {location("model"), location("view_proj"), location("base_color"),
                  location("has_texture"), location("base_texture"), location("sun"),
@@ -208,7 +236,7 @@ class OsMesaRenderer : public Renderer {
 
   void Render(const CameraView& view, const std::vector<Eigen::Isometry3d>& actor_poses,
               const std::vector<const scene::RobotState*>& robots, const RenderSettings& settings,
-              Frame* frame) override {
+              Frame* frame, const Overlay* overlay) override {
     view.ValidateOrThrow();
     Resize(view.width, view.height);
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
@@ -281,14 +309,14 @@ class OsMesaRenderer : public Renderer {
         Draw(meshes[m], Relative(Eigen::Affine3d(state.pose().matrix()), camera));
       }
     }
-    glFinish();
-
-    // Read back, bottom row first in GL; flip to top first.
+    // Read back, bottom row first in GL (flipped below); depth before the overlay.
     const int w = view.width, h = view.height;
     pixels_.resize(std::size_t(w) * h * 4);
     depth_.resize(std::size_t(w) * h);
-    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, pixels_.data());
     glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, depth_.data());
+    if (overlay != nullptr && !overlay->empty()) DrawOverlay(*overlay, camera, view_proj);
+    glFinish();
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, pixels_.data());
     frame->width = w;
     frame->height = h;
     frame->rgb.resize(std::size_t(w) * h * 3);
@@ -378,6 +406,42 @@ class OsMesaRenderer : public Renderer {
     glDrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
   }
 
+  // Points and lines with one colour each, relative to the camera.
+  void DrawOverlay(const Overlay& overlay, const Eigen::Vector3d& camera,
+                   const Eigen::Matrix4f& view_proj) {
+    if (overlay.point_rgb.size() != overlay.points_W.size() ||
+        overlay.line_rgb.size() * 2 != overlay.lines_W.size()) {
+      throw std::invalid_argument("Renderer: an overlay needs one colour per point and per line");
+    }
+    overlay_positions_.clear();
+    overlay_colors_.clear();
+    for (std::size_t i = 0; i < overlay.points_W.size(); ++i) {
+      overlay_positions_.push_back((overlay.points_W[i] - camera).cast<float>());
+      overlay_colors_.push_back(overlay.point_rgb[i]);
+    }
+    for (std::size_t i = 0; i < overlay.lines_W.size(); ++i) {
+      overlay_positions_.push_back((overlay.lines_W[i] - camera).cast<float>());
+      overlay_colors_.push_back(overlay.line_rgb[i / 2]);
+    }
+    glUseProgram(overlay_program_);
+    glUniformMatrix4fv(overlay_view_proj_, 1, GL_FALSE, view_proj.data());
+    glBindVertexArray(overlay_vao_);
+    const std::pair<GLuint, const std::vector<Eigen::Vector3f>*> attributes[] = {
+        {overlay_buffers_[0], &overlay_positions_}, {overlay_buffers_[1], &overlay_colors_}};
+    for (GLuint location = 0; location < 2; ++location) {
+      glBindBuffer(GL_ARRAY_BUFFER, attributes[location].first);
+      glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(attributes[location].second->size() * 12),
+                   attributes[location].second->data(), GL_STREAM_DRAW);
+      glEnableVertexAttribArray(location);
+      glVertexAttribPointer(location, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+    }
+    glDisable(GL_BLEND);
+    glPointSize(overlay.point_size_px);
+    glDrawArrays(GL_POINTS, 0, GLsizei(overlay.points_W.size()));
+    glDrawArrays(GL_LINES, GLsizei(overlay.points_W.size()), GLsizei(overlay.lines_W.size()));
+    glBindVertexArray(0);
+  }
+
   void Resize(int width, int height) {
     if (width == width_ && height == height_) return;
     if (fbo_ == 0) {
@@ -402,6 +466,9 @@ class OsMesaRenderer : public Renderer {
   std::vector<std::uint8_t> backing_;
   std::string description_;
   GLuint program_{0}, fbo_{0}, buffers_[2]{0, 0};
+  GLuint overlay_program_{0}, overlay_vao_{0}, overlay_buffers_[2]{0, 0};
+  GLint overlay_view_proj_{-1};
+  std::vector<Eigen::Vector3f> overlay_positions_, overlay_colors_;
   struct {
     GLint model, view_proj, base_color, has_texture, base_texture, sun, sky, fog;
   } uniforms_{};
@@ -418,6 +485,18 @@ class OsMesaRenderer : public Renderer {
 };
 
 }  // namespace
+
+void Overlay::AddPoint(const Eigen::Vector3d& p_W, const Eigen::Vector3f& rgb) {
+  points_W.push_back(p_W);
+  point_rgb.push_back(rgb);
+}
+
+void Overlay::AddLine(const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W,
+                      const Eigen::Vector3f& rgb) {
+  lines_W.push_back(a_W);
+  lines_W.push_back(b_W);
+  line_rgb.push_back(rgb);
+}
 
 void CameraView::ValidateOrThrow() const {
   if (width < 1 || width > 8192 || height < 1 || height > 8192) {

@@ -58,6 +58,21 @@ struct Frame {
   std::vector<float> depth_m;     // distance along the optical axis; +inf where sky
 };
 
+// Debug marks drawn over the scene, hidden behind nearer surfaces: points and
+// short line segments in world coordinates, each with its own colour. They
+// change the colour image only, never the depth image.
+struct Overlay {
+  std::vector<Eigen::Vector3d> points_W;
+  std::vector<Eigen::Vector3f> point_rgb;  // one per point, 0..1
+  std::vector<Eigen::Vector3d> lines_W;    // two ends per segment
+  std::vector<Eigen::Vector3f> line_rgb;   // one per segment
+  float point_size_px{3.0f};
+
+  void AddPoint(const Eigen::Vector3d& p_W, const Eigen::Vector3f& rgb);
+  void AddLine(const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W, const Eigen::Vector3f& rgb);
+  bool empty() const { return points_W.empty() && lines_W.empty(); }
+};
+
 class Renderer {
  public:
   virtual ~Renderer() = default;
@@ -65,10 +80,12 @@ class Renderer {
   // `warnings` for each texture that cannot be decoded (the base colour stays).
   virtual void SetLevel(const scene::Level& level, const TextureDecoder& decoder) = 0;
   // Renders the level (movable actors at `actor_poses`, indexed like
-  // Level::actors; empty: load-time poses) and `robots` as posed.
+  // Level::actors; empty: load-time poses), `robots` as posed and, when given,
+  // the overlay on top.
   virtual void Render(const CameraView& view, const std::vector<Eigen::Isometry3d>& actor_poses,
                       const std::vector<const scene::RobotState*>& robots,
-                      const RenderSettings& settings, Frame* frame) = 0;
+                      const RenderSettings& settings, Frame* frame,
+                      const Overlay* overlay = nullptr) = 0;
   virtual const std::vector<std::string>& warnings() const = 0;
   virtual std::string description() const = 0;  // "OpenGL 4.5 (Core Profile) Mesa ... llvmpipe"
 };

@@ -119,6 +119,11 @@ std::vector<MountedCamera> MakeRobotCameras(const scene::Level& level) {
       camera.trailing_distance_m = read.Number("distance_m", camera.trailing_distance_m);
       camera.trailing_height_m = read.Number("height_m", camera.trailing_height_m);
       camera.depth = read.Flag("depth", spec.type == "payload");
+      camera.overlay = read.Flag("overlay", false);
+      camera.overlay_stub_m = read.Number("overlay_stub_m", 0.0);
+      if (!(camera.overlay_stub_m >= 0.0 && camera.overlay_stub_m <= 100.0)) {
+        throw LevelError(spec.Where() + "overlay_stub_m must be 0 (points) to 100 m");
+      }
       read.RejectUnknownKeys(spec.type + " camera");
       try {
         camera.view.ValidateOrThrow();

@@ -38,6 +38,8 @@ struct MountedCamera {
   double trailing_distance_m{25.0};
   double trailing_height_m{8.0};
   bool depth{false};       // payload cameras: also a depth image
+  bool overlay{false};     // the debug overlay (scanner samples, bone frames, actor bounds)
+  double overlay_stub_m{0.0};  // scanner samples as points (0) or stubs this long
 
   // The camera pose for a robot state (fixed cameras: their own pose; chase
   // cameras keep their lag in `chase_state`, advanced by dt_s).

@@ -1,5 +1,6 @@
 // Depth files as other tools read them: the 16-bit PNG in millimetres through
-// OpenCV, the .npy parsed by the format's own rules.
+// OpenCV, the .npy parsed by the format's own rules, the EXR's header parsed
+// and its values read through OpenEXR.
 
 #include "app/images.h"
 
@@ -73,6 +74,35 @@ TEST(DepthFileTest, NpyIsFloat32MetresInRowsAsNumpyReadsIt) {
     std::memcpy(&value, &bits, 4);
     EXPECT_EQ(value, frame.depth_m[i]) << i;
   }
+}
+
+TEST(DepthFileTest, ExrIsOneFloat32ChannelOfMetres) {
+  testing::TempDir dir;
+  const std::string path = (dir.path() / "d.exr").string();
+  const sensors::Frame frame = DepthFrame();
+  WriteDepthExr(frame, path);
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  std::string bytes(std::size_t(in.tellg()), '\0');
+  in.seekg(0);
+  in.read(bytes.data(), std::streamsize(bytes.size()));
+  ASSERT_GE(bytes.size(), 8u);
+  EXPECT_EQ(bytes.substr(0, 4), std::string("\x76\x2f\x31\x01", 4));  // OpenEXR's magic number
+  // The header's channel list (attribute "channels", type "chlist"): one
+  // channel, pixel type 2 = FLOAT.
+  const std::size_t list = bytes.find(std::string("channels\0chlist\0", 16));
+  ASSERT_NE(list, std::string::npos);
+  const std::size_t first = list + 16 + 4;  // after the attribute's size
+  const std::size_t name_end = bytes.find('\0', first);
+  std::int32_t pixel_type = 0;
+  std::memcpy(&pixel_type, &bytes[name_end + 1], 4);
+  EXPECT_EQ(pixel_type, 2);
+  EXPECT_EQ(bytes[name_end + 1 + 16], '\0') << "more than one channel";
+  // The values, through OpenEXR (OpenCV's reader).
+  const cv::Mat exr = cv::imread(path, cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(exr.type(), CV_32FC1);
+  ASSERT_EQ(exr.cols, 3);
+  ASSERT_EQ(exr.rows, 2);
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(exr.at<float>(i / 3, i % 3), frame.depth_m[std::size_t(i)]) << i;
 }
 
 }  // namespace

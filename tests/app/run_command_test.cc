@@ -101,9 +101,10 @@ TEST(RunCommandTest, BadFrameOptionsFailClearly) {
   EXPECT_NE(gif.exit_code, 0);
   EXPECT_NE(gif.out.find("--frames must be jpg, png, mp4 or avi, got 'gif'"), std::string::npos)
       << gif.out;
-  const auto exr =
-      RunSandbox("run --duration 0.1 --lcm-url memq:// --depth exr --out " + dir.path().string());
-  EXPECT_NE(exr.out.find("--depth must be png or npy, got 'exr'"), std::string::npos) << exr.out;
+  const auto tiff =
+      RunSandbox("run --duration 0.1 --lcm-url memq:// --depth tiff --out " + dir.path().string());
+  EXPECT_NE(tiff.exit_code, 0);
+  EXPECT_NE(tiff.out.find("--depth must be png, npy or exr, got 'tiff'"), std::string::npos) << tiff.out;
   const std::string file = (dir.path() / "not_a_folder").string();
   std::ofstream(file) << "x";
   const auto blocked = RunSandbox("run --duration 0.1 --lcm-url memq:// --out " + file);

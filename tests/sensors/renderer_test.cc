@@ -14,6 +14,8 @@
 #include "scene/collision_world.h"
 #include "scene/level.h"
 #include "sensors/cameras.h"
+#include "sensors/debug_overlay.h"
+#include "sensors/face_scanner.h"
 #include "sensors/ray_caster.h"
 #include "tests/test_util.h"
 
@@ -105,6 +107,89 @@ TEST_F(RendererTest, DepthAgreesWithTheRayCaster) {
     ++compared;
   }
   EXPECT_GT(compared, 60);
+}
+
+TEST_F(RendererTest, OverlayMarksEachScannedSampleInItsColourWithoutTouchingDepth) {
+  // A full face scan 12 m above the valley floor: the lower face hits the
+  // terrain (occupied), the upper faces reach into the sky (free).
+  const scene::CollisionWorld world(level_);
+  RayCaster caster(1);
+  FaceScannerConfig config;
+  config.resolution_m = 2.0;
+  config.refresh = Refresh::kFull;
+  const FaceScanner scanner(config);
+  FaceScan scan = scanner.EmptyScan();
+  const Isometry3d X_WS(Eigen::Translation3d(0, 0, 12));
+  scanner.Scan(world, caster, {}, X_WS, 0, &scan);
+  Overlay overlay;
+  AddFaceScan(scan, 0.0, &overlay);
+  CameraView view;
+  view.X_WC = LookAt(Vector3d(0, -70, 45), Vector3d(0, 0, 5));
+  Frame plain, marked;
+  renderer_->Render(view, {}, {}, {}, &plain);
+  renderer_->Render(view, {}, {}, {}, &marked, &overlay);
+  EXPECT_EQ(plain.depth_m, marked.depth_m);
+  // Each sample in front of the scene (its distance along the optical axis
+  // at most the depth drawn there) shows its own colour at its pixel.
+  int checked[2] = {0, 0}, right[2] = {0, 0};
+  for (std::size_t i = 0; i < overlay.points_W.size(); ++i) {
+    const Eigen::Vector2d pixel = Project(view, overlay.points_W[i]);
+    const double along = (view.X_WC.inverse() * overlay.points_W[i]).x();
+    const int column = int(std::floor(pixel.x())), row = int(std::floor(pixel.y()));
+    if (along <= 0 || column < 2 || row < 2 || column >= view.width - 2 || row >= view.height - 2) continue;
+    const float depth = plain.depth_m[std::size_t(row) * std::size_t(view.width) + std::size_t(column)];
+    if (along > depth * 1.001 + 0.05) continue;  // behind the terrain: hidden
+    const bool occupied = overlay.point_rgb[i].x() > 0.5f;
+    const std::uint8_t* rgb = Pixel(marked, column, row);
+    const bool red = rgb[0] > 200 && rgb[1] < 80, green = rgb[1] > 180 && rgb[0] < 80;
+    ++checked[occupied];
+    right[occupied] += occupied ? red : green;
+  }
+  EXPECT_GT(checked[0], 500);
+  EXPECT_GT(checked[1], 200);
+  EXPECT_GT(right[0], 0.95 * checked[0]) << right[0] << " of " << checked[0] << " free samples green";
+  EXPECT_GT(right[1], 0.95 * checked[1]) << right[1] << " of " << checked[1] << " occupied samples red";
+}
+
+TEST(DebugOverlayTest, ActorBoundsFollowTheActorAndStubsPointBackAlongTheRay) {
+  scene::Level level;
+  scene::Actor crate;
+  crate.movable = true;
+  crate.bounds_W = Eigen::AlignedBox3d(Vector3d(-1, -2, 0), Vector3d(1, 2, 3));
+  level.actors.push_back(crate);
+  Overlay overlay;
+  // Moved 10 m east and turned 90 degrees about z: x spans -2..2 around 10, y -1..1.
+  Isometry3d X_WA = Eigen::Translation3d(10, 0, 0) * Eigen::AngleAxisd(M_PI / 2, Vector3d::UnitZ());
+  AddActorBounds(level, {X_WA}, false, &overlay);
+  ASSERT_EQ(overlay.line_rgb.size(), 12u);
+  Eigen::AlignedBox3d box;
+  for (const Vector3d& p : overlay.lines_W) box.extend(p);
+  EXPECT_TRUE(box.min().isApprox(Vector3d(8, -1, 0), 1e-9)) << box.min().transpose();
+  EXPECT_TRUE(box.max().isApprox(Vector3d(12, 1, 3), 1e-9)) << box.max().transpose();
+  for (std::size_t i = 0; i < overlay.lines_W.size(); i += 2) {  // each edge along one axis, full length
+    const Vector3d edge = (overlay.lines_W[i + 1] - overlay.lines_W[i]).cwiseAbs();
+    EXPECT_EQ((edge.array() > 1e-9).count(), 1);
+  }
+  // A static actor is skipped unless asked for.
+  level.actors[0].movable = false;
+  Overlay none, all;
+  AddActorBounds(level, {}, false, &none);
+  AddActorBounds(level, {}, true, &all);
+  EXPECT_TRUE(none.empty());
+  EXPECT_EQ(all.line_rgb.size(), 12u);
+
+  // Stubs: 0.5 m from the sample back towards the sensor.
+  FaceScan scan;
+  scan.n = 1;
+  scan.faces[0].tick = 3;
+  scan.faces[0].X_WS = Isometry3d(Eigen::Translation3d(1, 2, 3));
+  scan.faces[0].occupancy = {kOccupied};
+  scan.faces[0].points_W = {Vector3d(11, 2, 3)};
+  Overlay stubs;
+  AddFaceScan(scan, 0.5, &stubs);
+  ASSERT_EQ(stubs.lines_W.size(), 2u);
+  EXPECT_TRUE(stubs.lines_W[1].isApprox(Vector3d(10.5, 2, 3)));
+  EXPECT_TRUE(stubs.points_W.empty());
 }
 
 TEST(RendererTextureTest, TextureColoursShow) {

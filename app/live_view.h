@@ -1,0 +1,73 @@
+#pragma once
+// The live view (`sandbox run --view`): a window (OpenCV highgui) showing the
+// active camera, and the keys pressed in it. The window belongs to its own
+// thread; Show and TakeKeys never wait, so the loop keeps its rate.
+//
+// Keys: c or Tab next camera; a/d (or left/right) pan and w/s (or up/down)
+// tilt the trailing camera; + and - zoom; o the debug overlay; space or p
+// pause; q or Esc stop.
+
+#include <atomic>
+#include <cstdint>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "sensors/cameras.h"
+#include "sensors/renderer.h"
+
+namespace sandbox::app {
+
+enum class ViewKey { kNextCamera, kPanLeft, kPanRight, kTiltUp, kTiltDown, kZoomIn, kZoomOut,
+                     kToggleOverlay, kPause, kQuit };
+
+// The key of a code from cv::waitKeyEx; nullopt for keys without a use.
+std::optional<ViewKey> KeyFromCode(int code);
+
+// What the keys have set.
+struct ViewControls {
+  int camera{0};                     // index of the active camera
+  sensors::TrailingCommand steer;    // added to the bridge's <ROBOT>/CAMERA command
+  bool overlay{false};
+  bool paused{false};
+  bool quit{false};
+
+  // Pan and tilt in 5 degree steps (tilt within +-80 degrees), zoom by 1.25
+  // (1 to 16), cameras in turn.
+  void Apply(ViewKey key, int num_cameras);
+};
+
+class LiveView {
+ public:
+  // Opens the window. Throws std::runtime_error when there is no display
+  // (neither DISPLAY nor WAYLAND_DISPLAY set) or the window cannot be made.
+  explicit LiveView(const std::string& title);
+  ~LiveView();
+  LiveView(const LiveView&) = delete;
+  LiveView& operator=(const LiveView&) = delete;
+
+  // Any thread: the newest frame replaces one not yet shown.
+  void Show(const sensors::Frame& frame, const std::string& caption);
+  // The keys pressed since the last call, in order.
+  std::vector<ViewKey> TakeKeys();
+  std::int64_t shown() const { return shown_; }
+
+ private:
+  void WindowLoop();
+
+  std::string title_;
+  std::mutex mutex_;
+  sensors::Frame pending_;
+  std::string pending_caption_;
+  bool has_pending_{false};
+  std::vector<ViewKey> keys_;
+  std::string open_error_;
+  bool opened_{false};
+  std::atomic<bool> stop_{false};
+  std::atomic<std::int64_t> shown_{0};
+  std::thread thread_;
+};
+
+}  // namespace sandbox::app

@@ -1,0 +1,63 @@
+#include "sensors/debug_overlay.h"
+
+namespace sandbox::sensors {
+
+void AddFaceScan(const FaceScan& scan, double stub_m, Overlay* overlay) {
+  const Eigen::Vector3f red(1.f, 0.1f, 0.1f), green(0.1f, 0.9f, 0.1f);
+  for (const ScanFace& face : scan.faces) {
+    if (face.tick < 0) continue;
+    const Eigen::Vector3d origin_W = face.X_WS.translation();
+    for (std::size_t i = 0; i < face.points_W.size() && i < face.occupancy.size(); ++i) {
+      if (face.occupancy[i] == kUnvisited) continue;
+      const Eigen::Vector3f& rgb = face.occupancy[i] == kOccupied ? red : green;
+      const Eigen::Vector3d& p_W = face.points_W[i];
+      if (stub_m <= 0.0) {
+        overlay->AddPoint(p_W, rgb);
+        continue;
+      }
+      const Eigen::Vector3d back = origin_W - p_W;
+      const double length = back.norm();
+      overlay->AddLine(p_W, length > 1e-9 ? Eigen::Vector3d(p_W + back * std::min(1.0, stub_m / length)) : p_W,
+                       rgb);
+    }
+  }
+}
+
+void AddBoneFrames(const scene::RobotState& state, double axis_m, Overlay* overlay) {
+  const Eigen::Vector3f axis_rgb[3] = {{1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}, {0.f, 0.3f, 1.f}};
+  for (const scene::Bone& bone : state.model().bones) {
+    const Eigen::Isometry3d X_WN =
+        state.pose() * scene::RigidPart(state.node_poses_B()[std::size_t(bone.node)]);
+    for (int k = 0; k < 3; ++k) {
+      overlay->AddLine(X_WN.translation(), X_WN * Eigen::Vector3d(axis_m * Eigen::Vector3d::Unit(k)),
+                       axis_rgb[k]);
+    }
+  }
+}
+
+void AddActorBounds(const scene::Level& level, const std::vector<Eigen::Isometry3d>& actor_poses,
+                    bool static_too, Overlay* overlay) {
+  const Eigen::Vector3f movable_rgb(1.f, 0.85f, 0.1f), static_rgb(0.6f, 0.6f, 0.6f);
+  for (std::size_t a = 0; a < level.actors.size(); ++a) {
+    const scene::Actor& actor = level.actors[a];
+    if (actor.bounds_W.isEmpty() || (!actor.movable && !static_too)) continue;
+    // The box was taken at the load pose; carry it to the current one.
+    const Eigen::Isometry3d move = actor_poses.size() == level.actors.size()
+                                       ? actor_poses[a] * actor.X_WA.inverse()
+                                       : Eigen::Isometry3d::Identity();
+    Eigen::Vector3d corner[8];
+    for (int c = 0; c < 8; ++c) {
+      corner[c] = move * actor.bounds_W.corner(Eigen::AlignedBox3d::CornerType(c));
+    }
+    // Corner bits: 1 = x max, 2 = y max, 4 = z max; edges join corners one bit apart.
+    for (int c = 0; c < 8; ++c) {
+      for (int bit = 1; bit < 8; bit <<= 1) {
+        if ((c & bit) == 0) {
+          overlay->AddLine(corner[c], corner[c | bit], actor.movable ? movable_rgb : static_rgb);
+        }
+      }
+    }
+  }
+}
+
+}  // namespace sandbox::sensors

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# The live view on a virtual display (Xvfb): the window opens and shows
+# frames; keys typed into it (xdotool) switch the camera, toggle the overlay
+# and stop the run long before its duration. Without a display, --view fails
+# with a clear message.
+#
+#   live_view.sh SANDBOX
+set -euo pipefail
+sandbox=$1
+out=$(mktemp /tmp/sandbox-live-view-XXXXXX.txt)
+trap 'rm -f "$out"' EXIT
+status=0
+if env -u DISPLAY -u WAYLAND_DISPLAY "$sandbox" run --view --duration 1 --lcm-url memq:// > "$out" 2>&1; then
+  echo "--view without a display did not fail"; status=1
+fi
+grep -q -- "--view needs a display" "$out" || { cat "$out"; status=1; }
+
+"$sandbox" run --view --duration 30 --lcm-url memq:// > "$out" 2>&1 &
+pid=$!
+window=""
+for _ in $(seq 100); do
+  window=$(xdotool search --name "^sandbox: " 2> /dev/null | head -1) && [ -n "$window" ] && break
+  sleep 0.1
+done
+[ -n "$window" ] || { echo "no window appeared"; kill "$pid"; cat "$out"; exit 1; }
+sleep 1
+for key in c o q; do xdotool key --window "$window" "$key" 2> /dev/null; sleep 0.3; done
+wait "$pid"
+cat "$out"
+grep -q "last camera belly, overlay toggled, quit by key" "$out" || { echo "the keys did not act"; status=1; }
+shown=$(sed -n 's/.*live view: \([0-9]*\) frames shown.*/\1/p' "$out")
+[ "${shown:-0}" -ge 10 ] || { echo "only ${shown:-0} frames shown"; status=1; }
+ticks=$(sed -n 's/^sandbox run: \([0-9]*\) ticks in \([0-9.]*\) s.*/\2/p' "$out")
+awk -v s="$ticks" 'BEGIN { exit !(s < 20) }' || { echo "q did not stop the run ($ticks s)"; status=1; }
+exit "$status"
