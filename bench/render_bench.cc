@@ -25,7 +25,10 @@
 
 #include "bench/bench_levels.h"
 #include "scene/level.h"
+#include "scene/collision_world.h"
 #include "sensors/cameras.h"
+#include "sensors/debug_overlay.h"
+#include "sensors/face_scanner.h"
 #include "sensors/renderer.h"
 
 namespace {
@@ -153,6 +156,48 @@ int main(int argc, char** argv) {
       }
     }
     fs::remove_all(dir);
+  }
+  // 3. The overlay's cost.
+  {
+    const scene::Level level = scene::LoadLevel(std::string(SANDBOX_SOURCE_DIR) + "/assets/sample/level.toml");
+    const scene::CollisionWorld world(level);
+    sensors::RayCaster caster;
+    sensors::FaceScannerConfig config;
+    config.refresh = sensors::Refresh::kFull;
+    const sensors::FaceScanner scanner(config);
+    sensors::FaceScan scan = scanner.EmptyScan();
+    scene::RobotState wing(level.robots[0]);
+    wing.SetPose(Eigen::Isometry3d(Eigen::Translation3d(0, 0, 12)));
+    wing.Update();
+    sensors::RayFilter filter;
+    filter.ignore_robot = 0;
+    scanner.Scan(world, caster, filter, wing.pose(), 0, &scan);
+    sensors::Overlay points, stubs, rays;
+    sensors::AddFaceScan(scan, 0.0, &points);
+    sensors::AddFaceScan(scan, 0.5, &stubs);
+    sensors::AddFaceScan(scan, 100.0, &rays);
+    auto renderer = sensors::MakeRenderer();
+    renderer->SetLevel(level, {});
+    sensors::CameraView view;
+    view.X_WC = sensors::TrailingPose(wing.pose(), 25.0, 8.0, {});
+    auto median_ms = [&](const sensors::Overlay* overlay) {
+      std::vector<double> ms;
+      sensors::Frame frame;
+      for (int i = 0; i < 21; ++i) {
+        const auto start = Clock::now();
+        renderer->Render(view, {}, {&wing}, {}, &frame, overlay);
+        if (i > 0) ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+      }
+      return bench::Median(ms);
+    };
+    const double plain = median_ms(nullptr);
+    std::printf("\noverlay, trailing 640x480, %zu samples: plain %.2f ms", points.points_W.size(), plain);
+    for (const auto& [name, overlay] : {std::pair<const char*, const sensors::Overlay*>{"points", &points},
+                                        {"0.5 m stubs", &stubs}, {"whole rays", &rays}}) {
+      const double ms = median_ms(overlay);
+      std::printf(", %s %.2f ms (%.2fx)", name, ms, ms / plain);
+    }
+    std::printf("\n");
   }
   return 0;
 }
