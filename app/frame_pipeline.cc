@@ -4,6 +4,7 @@
 #include <sys/syscall.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -137,6 +138,13 @@ void FramePipeline::WriteLoop() {
 }
 
 void FramePipeline::Write(const Encoded& item) {
+  // After a failure (a full disk, say) writing pauses for a second: frames
+  // meanwhile are counted as failed without trying, and without noise.
+  const auto now = std::chrono::steady_clock::now();
+  if (now < retry_after_) {
+    ++failed_;
+    return;
+  }
   const std::filesystem::path dir = config_.out_dir;
   std::ostringstream name;
   name << item.camera << "_" << std::setw(6) << std::setfill('0') << item.tick;
@@ -182,6 +190,14 @@ void FramePipeline::Write(const Encoded& item) {
     ++written_;
   } catch (const std::exception& e) {
     Fail(e.what());
+    retry_after_ = now + std::chrono::seconds(1);
+    std::error_code ignored;  // no truncated files left behind
+    if (config_.format != "mp4" && config_.format != "avi") {
+      std::filesystem::remove(dir / (name.str() + "." + config_.format), ignored);
+    }
+    for (const char* depth : {"_depth.png", "_depth.npy", "_depth.exr"}) {
+      std::filesystem::remove(dir / (name.str() + depth), ignored);
+    }
   }
 }
 

@@ -9,6 +9,7 @@
 // DIR/<camera>.csv indexing every frame: tick, time_s, file, robot pose.
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -100,6 +101,7 @@ class FramePipeline {
   struct Video;
   std::map<std::string, std::unique_ptr<Video>> videos_;  // write thread only
   std::map<std::string, std::unique_ptr<std::ofstream>> indexes_;  // write thread only
+  std::chrono::steady_clock::time_point retry_after_{};            // write thread only
   std::thread render_thread_, write_thread_;
 };
 
