@@ -59,8 +59,10 @@ void FramePipeline::Finish() {
 
 void FramePipeline::Submit(RenderJob job) {
   {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (render_queue_.size() >= config_.queue_capacity) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (config_.lossless) {
+      room_.wait(lock, [&] { return render_queue_.size() < config_.queue_capacity; });
+    } else if (render_queue_.size() >= config_.queue_capacity) {
       render_queue_.pop_front();
       ++dropped_render_;
     }
@@ -93,6 +95,7 @@ void FramePipeline::RenderLoop() {
       job = std::move(render_queue_.front());
       render_queue_.pop_front();
     }
+    room_.notify_all();
     if (!renderer) {  // every frame fails alike: counted, reported once
       ++failed_;
       continue;
@@ -110,8 +113,10 @@ void FramePipeline::RenderLoop() {
     if (job.show && config_.show) config_.show(job.camera, item.frame);
     if (!job.write || config_.out_dir.empty()) continue;
     {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (write_queue_.size() >= config_.queue_capacity) {
+      std::unique_lock<std::mutex> lock(mutex_);
+      if (config_.lossless) {
+        room_.wait(lock, [&] { return write_queue_.size() < config_.queue_capacity; });
+      } else if (write_queue_.size() >= config_.queue_capacity) {
         write_queue_.pop_front();
         ++dropped_write_;
       }
@@ -132,6 +137,7 @@ void FramePipeline::WriteLoop() {
       item = std::move(write_queue_.front());
       write_queue_.pop_front();
     }
+    room_.notify_all();
     Write(item);
   }
   for (auto& [camera, video] : videos_) video->writer.release();
@@ -150,13 +156,13 @@ void FramePipeline::Write(const Encoded& item) {
   name << item.camera << "_" << std::setw(6) << std::setfill('0') << item.tick;
   std::string file;
   try {
-    if (config_.format == "mp4" || config_.format == "avi") {
+    if (!config_.video_format.empty()) {
       std::unique_ptr<Video>& video = videos_[item.camera];
       if (!video) {
         video = std::make_unique<Video>();
-        file = (dir / (item.camera + "." + config_.format)).string();
-        const int fourcc = config_.format == "mp4" ? cv::VideoWriter::fourcc('m', 'p', '4', 'v')
-                                                   : cv::VideoWriter::fourcc('M', 'J', 'P', 'G');
+        file = (dir / (item.camera + "." + config_.video_format)).string();
+        const int fourcc = config_.video_format == "mp4" ? cv::VideoWriter::fourcc('m', 'p', '4', 'v')
+                                                         : cv::VideoWriter::fourcc('M', 'J', 'P', 'G');
         video->writer.open(file, cv::CAP_FFMPEG, fourcc, config_.video_fps,
                            cv::Size(item.frame.width, item.frame.height));
         if (!video->writer.isOpened()) throw std::runtime_error("cannot open the video " + file);
@@ -166,9 +172,10 @@ void FramePipeline::Write(const Encoded& item) {
       cv::Mat bgr;
       cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
       video->writer.write(bgr);
-      file = item.camera + "." + config_.format;
-    } else {
-      file = name.str() + "." + config_.format;
+      file = item.camera + "." + config_.video_format;
+    }
+    if (!config_.image_format.empty()) {
+      file = name.str() + "." + config_.image_format;
       WriteColor(item.frame, (dir / file).string());
     }
     if (item.depth && config_.depth_format == "npy") {
@@ -192,8 +199,8 @@ void FramePipeline::Write(const Encoded& item) {
     Fail(e.what());
     retry_after_ = now + std::chrono::seconds(1);
     std::error_code ignored;  // no truncated files left behind
-    if (config_.format != "mp4" && config_.format != "avi") {
-      std::filesystem::remove(dir / (name.str() + "." + config_.format), ignored);
+    if (!config_.image_format.empty()) {
+      std::filesystem::remove(dir / (name.str() + "." + config_.image_format), ignored);
     }
     for (const char* depth : {"_depth.png", "_depth.npy", "_depth.exr"}) {
       std::filesystem::remove(dir / (name.str() + depth), ignored);

@@ -4,9 +4,10 @@
 // OpenCV. Both queues are small and bounded: when a stage is behind, the
 // oldest waiting job is dropped and counted, so the loop never waits.
 //
-// Files: DIR/<camera>_<tick>.jpg (or .png), DIR/<camera>_<tick>_depth.png
-// (16-bit millimetres), _depth.npy or _depth.exr (float32 metres), or one DIR/<camera>.mp4 / .avi for video, and
-// DIR/<camera>.csv indexing every frame: tick, time_s, file, robot pose.
+// Files: DIR/<camera>_<tick>.jpg (or .png) and/or one DIR/<camera>.mp4 (or
+// .avi) per camera; DIR/<camera>_<tick>_depth.png (16-bit millimetres),
+// _depth.npy or _depth.exr (float32 metres); DIR/<camera>.csv indexing every
+// frame: tick, time_s, file (the image, else the video), robot pose.
 
 #include <atomic>
 #include <chrono>
@@ -30,10 +31,14 @@ namespace sandbox::app {
 
 struct FramePipelineConfig {
   std::string out_dir;  // empty: nothing written (a live view only)
-  std::string format{"jpg"};  // jpg, png, mp4 (mp4v) or avi (MJPG)
+  std::string image_format{"jpg"};  // jpg, png, or empty: no image files
+  std::string video_format;        // mp4 (mp4v), avi (MJPG), or empty: no video
   std::string depth_format{"png"};  // png (16-bit millimetres), npy or exr (float32 metres)
   double video_fps{30.0};
   std::size_t queue_capacity{4};
+  // Lock-step runs: Submit waits for room instead of dropping, so that every
+  // due frame is written and a run's frames depend on its inputs alone.
+  bool lossless{false};
   // Called on the render thread with each frame of a job marked `show`.
   std::function<void(const std::string& camera, const sensors::Frame& frame)> show;
 };
@@ -64,7 +69,7 @@ class FramePipeline {
   FramePipeline(const FramePipeline&) = delete;
   FramePipeline& operator=(const FramePipeline&) = delete;
 
-  // Loop thread: never blocks.
+  // Loop thread: never blocks (unless the config is lossless).
   void Submit(RenderJob job);
 
   std::int64_t rendered() const { return rendered_; }
@@ -90,7 +95,7 @@ class FramePipeline {
   const scene::Level& level_;
   FramePipelineConfig config_;
   mutable std::mutex mutex_;
-  std::condition_variable render_wake_, write_wake_;
+  std::condition_variable render_wake_, write_wake_, room_;
   std::deque<RenderJob> render_queue_;
   std::deque<Encoded> write_queue_;
   bool stopping_{false};

@@ -5,6 +5,8 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <filesystem>
+#include <map>
 #include <iomanip>
 #include <memory>
 #include <sstream>
@@ -15,6 +17,8 @@
 #include "app/defaults.h"
 #include "app/frame_pipeline.h"
 #include "app/live_view.h"
+#include "app/scan_files.h"
+#include "app/tick_stats.h"
 #include "bridge/lcm_link.h"
 #include "bridge/outputs.h"
 #include "bridge/robot_inputs.h"
@@ -29,23 +33,29 @@ namespace sandbox::app {
 namespace {
 
 const char* kUsage =
-    "usage: sandbox run [LEVEL] [--rate HZ] [--duration S] [--lcm-url URL] [--lockstep]\n"
-    "                   [--replay LOG] [--record LOG] [--out DIR [--frames F] [--depth D]] [--view]\n"
-    "  LEVEL        a level (default: the bundled sample level)\n"
-    "  --rate       loop rate in Hz (default 100)\n"
-    "  --duration   stop after this many seconds (default: run until Ctrl-C)\n"
-    "  --lcm-url    LCM URL (default: LCM's own; multicast URLs get a 4 MB receive buffer)\n"
-    "  --lockstep   each tick consumes exactly one pose message (waits for it); outputs are\n"
-    "               a function of the inputs alone\n"
-    "  --replay     read the inputs from an LCM log file (no network), lock-step, full speed\n"
-    "  --record     write every output message to an LCM log file\n"
-    "  --out DIR    render the robots' cameras ([[robot.camera]]) into DIR (render and\n"
-    "               encoder threads; the loop never waits for them)\n"
-    "  --frames     jpg (default), png, mp4 or avi\n"
-    "  --depth      depth images (payload cameras): png (16-bit mm, default), npy or exr\n"
-    "               (float32 m)\n"
-    "  --view       a window showing the active camera (needs a display); keys: c next camera,\n"
-    "               a/d pan, w/s tilt, +/- zoom (trailing), o overlay, space pause, q quit\n"
+    "usage: sandbox run [LEVEL] [--rate HZ|max] [--duration S] [--lcm-url URL] [--lockstep]\n"
+    "                   [--replay LOG] [--record LOG] [--out DIR] [--frames LIST] [--depth D]\n"
+    "                   [--scans-every S] [--view] [--stall TICK:MS,...]\n"
+    "  LEVEL          a level (default: the bundled sample level)\n"
+    "  --rate         loop rate in Hz (default 100); max: free running, as fast as it can\n"
+    "  --duration     stop after this many seconds (default: run until Ctrl-C)\n"
+    "  --lcm-url      LCM URL (default: LCM's own; multicast URLs get a 4 MB receive buffer)\n"
+    "  --lockstep     each tick consumes exactly one pose message (waits for it); outputs and\n"
+    "                 frames are a function of the inputs alone\n"
+    "  --replay       read the inputs from an LCM log file (no network), lock-step, full speed,\n"
+    "                 with a progress bar\n"
+    "  --record       write every output message to an LCM log file\n"
+    "  --out DIR      write into DIR: ticks.csv and ticks.png (frame statistics), the robots'\n"
+    "                 camera frames ([[robot.camera]]; render and encoder threads, the loop\n"
+    "                 never waits for them) and, with --scans-every, scans\n"
+    "  --frames       jpg (default), png, mp4, avi, an image and a video format (jpg,mp4), or\n"
+    "                 none (statistics and scans only)\n"
+    "  --depth        depth images (payload cameras): png (16-bit mm, default), npy or exr\n"
+    "                 (float32 m)\n"
+    "  --scans-every  write each face scanner's scan as DIR/scans/<sensor>_<tick>.ply every S s\n"
+    "  --view         a window showing the active camera (needs a display); keys: c next camera,\n"
+    "                 a/d pan, w/s tilt, +/- zoom (trailing), o overlay, space pause, q quit\n"
+    "  --stall        test aid: sleep MS milliseconds inside tick TICK (the loop's timing)\n"
     "Inputs per robot: <ROBOT>/POSE, /BONES, /ACTORS, /CAMERA (trailing pan, tilt, zoom).\n"
     "Outputs: <ROBOT>/SCAN_FACE, /GROUND, /LIDAR, /RANGE, /STATE, /STATUS (docs/bridge.md).\n";
 
@@ -101,13 +111,95 @@ struct SensorRun {
   sensors::FaceScan face_scan;
 };
 
+struct CameraRun {
+  const sensors::MountedCamera* camera;
+  sensors::ChaseCamera chase;
+  double next_due_s{0.0}, last_s{-1.0};
+};
+
+// --frames: at most one image and one video format, or none.
+void ParseFrames(const std::string& text, FramePipelineConfig* config) {
+  config->image_format.clear();
+  config->video_format.clear();
+  if (text == "none") return;
+  std::stringstream list(text);
+  std::string format;
+  while (std::getline(list, format, ',')) {
+    std::string& slot = format == "jpg" || format == "png" ? config->image_format
+                        : format == "mp4" || format == "avi" ? config->video_format
+                                                             : format;
+    if (&slot == &format) {
+      throw CommandError("--frames must be jpg, png, mp4 or avi (or a list like jpg,mp4, or none), "
+                         "got '" + format + "'");
+    }
+    if (!slot.empty()) throw CommandError("--frames: one image and one video format at most");
+    slot = format;
+  }
+  if (config->image_format.empty() && config->video_format.empty()) {
+    throw CommandError("--frames: nothing to write in '" + text + "' (none writes no frames)");
+  }
+}
+
+// --stall "TICK:MS,...": milliseconds to sleep inside given ticks.
+std::map<std::int64_t, double> ParseStalls(const std::string& text) {
+  std::map<std::int64_t, double> stalls;
+  std::stringstream list(text);
+  std::string item;
+  while (std::getline(list, item, ',')) {
+    const std::size_t colon = item.find(':');
+    std::vector<double> values;
+    if (colon != std::string::npos) {
+      values = ParseNumbers(item.substr(0, colon) + "," + item.substr(colon + 1), "--stall");
+    }
+    if (values.size() != 2 || values[0] < 0 || values[1] < 0) {
+      throw CommandError("--stall wants TICK:MS items, got '" + item + "'");
+    }
+    stalls[std::int64_t(values[0])] = values[1];
+  }
+  return stalls;
+}
+
+// Runs the sensors due at time t (input time in lock-step) and publishes their outputs.
+void RunDueSensors(double t, std::int64_t tick, std::int64_t now, std::vector<SensorRun>* sensor_runs,
+                   std::vector<RobotRun>* robots, const scene::CollisionWorld& world,
+                   sensors::RayCaster* caster) {
+  for (SensorRun& run : *sensor_runs) {
+    if (t < run.next_due_s) continue;
+    const double rate = run.mounted->spec.rate_hz;
+    run.next_due_s = rate > 0.0 ? std::max(run.next_due_s + 1.0 / rate, t) : t;
+    RobotRun& robot = (*robots)[std::size_t(run.mounted->robot)];
+    sensors::RayFilter filter;
+    filter.ignore_robot = run.mounted->robot;
+    const Eigen::Isometry3d X_WS = run.mounted->Pose(*robot.state);
+    if (const auto* face = std::get_if<sensors::FaceScannerConfig>(&run.mounted->config)) {
+      const sensors::FaceScanner scanner(*face);
+      if (run.face_scan.n == 0) run.face_scan = scanner.EmptyScan();
+      scanner.Scan(world, *caster, filter, X_WS, tick, &run.face_scan);
+      robot.outputs->PublishFaces(run.face_scan, tick, robot.input, now);
+    } else if (const auto* ground = std::get_if<sensors::GroundScannerConfig>(&run.mounted->config)) {
+      sensors::HeightMap map;
+      sensors::GroundScanner(*ground).Scan(world, *caster, filter, X_WS.translation(), &map);
+      robot.outputs->PublishGround(map, robot.input, now);
+    } else if (const auto* lidar = std::get_if<sensors::LidarConfig>(&run.mounted->config)) {
+      sensors::LidarScan scan;
+      sensors::Lidar(*lidar).Sweep(world, *caster, filter, X_WS, X_WS, &scan);
+      robot.outputs->PublishLidar(scan, robot.input, now);
+    } else if (const auto* ray = std::get_if<sensors::RangeSensorConfig>(&run.mounted->config)) {
+      robot.outputs->PublishRange(run.mounted->spec.name,
+                                  sensors::MeasureRange(*ray, world, *caster, filter, X_WS),
+                                  robot.input, now);
+    }
+  }
+}
+
 }  // namespace
 
-int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostream& err,
+            const RunHooks& hooks) {
   const auto parsed =
       ParseArgs(args, "run",
                 {"--rate", "--duration", "--lcm-url", "--replay", "--record", "--out", "--frames",
-                 "--depth"},
+                 "--depth", "--scans-every", "--stall"},
                 {"--lockstep", "--view"}, kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
@@ -115,13 +207,31 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     return 0;
   }
   try {
-    const double rate_hz = parsed->values.count("--rate")
+    const bool free_running = parsed->Value("--rate") == "max";
+    const double rate_hz = free_running ? 0.0
+                           : parsed->values.count("--rate")
                                ? ParseNumbers(parsed->Value("--rate"), "--rate").at(0)
                                : 100.0;
     const double duration_s = parsed->values.count("--duration")
                                   ? ParseNumbers(parsed->Value("--duration"), "--duration").at(0)
                                   : -1.0;
-    if (!(rate_hz > 0.0)) throw CommandError("--rate must be positive");
+    if (!free_running && !(rate_hz > 0.0)) throw CommandError("--rate must be positive or max");
+    const std::string out_dir = parsed->Value("--out");
+    const double scans_every_s =
+        parsed->values.count("--scans-every")
+            ? ParseNumbers(parsed->Value("--scans-every"), "--scans-every").at(0)
+            : 0.0;
+    if (parsed->values.count("--scans-every") && (out_dir.empty() || !(scans_every_s > 0.0))) {
+      throw CommandError("--scans-every needs --out and a positive number of seconds");
+    }
+    const std::map<std::int64_t, double> stalls = ParseStalls(parsed->Value("--stall"));
+    FramePipelineConfig frame_config;
+    ParseFrames(parsed->Value("--frames", "jpg"), &frame_config);
+    frame_config.depth_format = parsed->Value("--depth", "png");
+    if (frame_config.depth_format != "png" && frame_config.depth_format != "npy" &&
+        frame_config.depth_format != "exr") {
+      throw CommandError("--depth must be png, npy or exr, got '" + frame_config.depth_format + "'");
+    }
 
     const scene::Level level = scene::LoadLevel(parsed->level.value_or(kDefaultLevel));
     const std::vector<sensors::MountedSensor> mounted = sensors::MakeRobotSensors(level);
@@ -129,12 +239,22 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     const std::string replay_file = parsed->Value("--replay");
     const bool replay = !replay_file.empty();
     const bool lockstep = replay || parsed->flags.count("--lockstep") > 0;
+    std::unique_ptr<bridge::LogReader> log;
+    if (replay) log = std::make_unique<bridge::LogReader>(replay_file);
     // A replay feeds its inputs through an in-process link: nothing on the network.
     bridge::LcmLink link(replay ? "memq://" : parsed->Value("--lcm-url"));
     if (!parsed->Value("--record").empty()) link.RecordTo(parsed->Value("--record"));
-    std::unique_ptr<bridge::LogReader> log;
-    if (replay) log = std::make_unique<bridge::LogReader>(replay_file);
     sensors::RayCaster caster;
+    if (!out_dir.empty()) {
+      std::error_code error;
+      std::filesystem::create_directories(out_dir, error);
+      if (error || !std::filesystem::is_directory(out_dir)) {
+        throw CommandError("cannot create the output folder '" + out_dir + "'");
+      }
+      if (scans_every_s > 0.0) std::filesystem::create_directories(std::filesystem::path(out_dir) / "scans");
+    }
+    ScanFileWriter scan_files;
+    TickStats stats(out_dir.empty() ? "" : (std::filesystem::path(out_dir) / "ticks.csv").string());
 
     bridge::RejectLog reject_log(&err);
     std::vector<RobotRun> robots(level.robots.size());
@@ -160,41 +280,27 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       }
       robots[r].bone_values.assign(std::size_t(level.robots[r].num_values), 0.0);
     }
-    // Cameras: rendered off the loop when --out is given.
+    // Cameras: rendered off the loop, into --out and/or the live view.
     const std::vector<sensors::MountedCamera> cameras = sensors::MakeRobotCameras(level);
-    std::unique_ptr<FramePipeline> frames;
     std::unique_ptr<LiveView> live_view;
     ViewControls controls;
     if (parsed->flags.count("--view")) {
       if (cameras.empty()) throw CommandError("--view: the level declares no [[robot.camera]]");
       live_view = std::make_unique<LiveView>("sandbox: " + level.name);
     }
-    const bool write_frames = !parsed->Value("--out").empty();
+    const bool write_frames = !out_dir.empty() && !cameras.empty() &&
+                              (!frame_config.image_format.empty() || !frame_config.video_format.empty());
+    std::unique_ptr<FramePipeline> frames;
     if (write_frames || live_view) {
-      FramePipelineConfig frame_config;
-      frame_config.out_dir = parsed->Value("--out");
+      frame_config.out_dir = write_frames ? out_dir : "";
+      frame_config.lossless = lockstep;
       if (live_view) {
         frame_config.show = [&live_view](const std::string& camera, const sensors::Frame& frame) {
           live_view->Show(frame, camera);
         };
       }
-      frame_config.format = parsed->Value("--frames", "jpg");
-      if (frame_config.format != "jpg" && frame_config.format != "png" &&
-          frame_config.format != "mp4" && frame_config.format != "avi") {
-        throw CommandError("--frames must be jpg, png, mp4 or avi, got '" + frame_config.format + "'");
-      }
-      frame_config.depth_format = parsed->Value("--depth", "png");
-      if (frame_config.depth_format != "png" && frame_config.depth_format != "npy" &&
-          frame_config.depth_format != "exr") {
-        throw CommandError("--depth must be png, npy or exr, got '" + frame_config.depth_format + "'");
-      }
       frames = std::make_unique<FramePipeline>(level, frame_config);
     }
-    struct CameraRun {
-      const sensors::MountedCamera* camera;
-      sensors::ChaseCamera chase;
-      double next_due_s{0.0}, last_s{-1.0};
-    };
     std::vector<CameraRun> camera_runs;
     for (const sensors::MountedCamera& camera : cameras) {
       camera_runs.push_back({&camera, sensors::ChaseCamera(camera.chase)});
@@ -206,7 +312,8 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     out << "sandbox run: " << level.name << ", " << level.robots.size() << " robots, "
         << mounted.size() << " sensors, "
         << (replay ? "replaying " + replay_file
-                   : (lockstep ? std::string("lock-step") : Format(rate_hz) + " Hz") +
+                   : (lockstep ? std::string("lock-step")
+                               : free_running ? std::string("free running") : Format(rate_hz) + " Hz") +
                          ", LCM " + link.url())
         << "\n"
         << std::flush;
@@ -215,12 +322,11 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     std::signal(SIGTERM, OnSignal);
 
     using Clock = std::chrono::steady_clock;
-    const auto period = std::chrono::duration<double>(1.0 / rate_hz);
+    const auto period = std::chrono::duration<double>(free_running ? 0.0 : 1.0 / rate_hz);
     const auto start = Clock::now();
     auto deadline = start;
-    std::int64_t tick = 0, overruns = 0, first_input_utime = -1;
-    std::vector<double> lateness_ms;  // tick start after its deadline (free running)
-    double next_status_s = 0.0, busy_s = 0.0, next_progress_s = 0.0;
+    std::int64_t tick = 0, first_input_utime = -1;
+    double next_status_s = 0.0, next_progress_s = 0.0, next_scan_file_s = 0.0;
     auto has_pose = [&] {
       for (const RobotRun& robot : robots) {
         if (robot.inputs->HasPose()) return true;
@@ -256,7 +362,12 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
         }
       }
       const auto tick_start = Clock::now();
-      if (!lockstep) lateness_ms.push_back(std::chrono::duration<double, std::milli>(tick_start - deadline).count());
+      TickRecord record;
+      record.tick = tick;
+      record.start_s = std::chrono::duration<double>(tick_start - start).count();
+      record.lateness_ms =
+          lockstep || free_running ? 0.0 : std::chrono::duration<double, std::milli>(tick_start - deadline).count();
+      const std::int64_t rays_before = caster.rays_cast();
       std::int64_t now = NowUtime();
       if (live_view) {
         for (const ViewKey key : live_view->TakeKeys()) controls.Apply(key, int(cameras.size()));
@@ -268,12 +379,14 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
           continue;
         }
       }
+      if (hooks.before_tick) hooks.before_tick(link, wall_s);
       // 1-2. Inputs: the newest message per channel (lock-step: the next pose), applied.
       if (!lockstep) link.Drain();
       for (RobotRun& robot : robots) {
         const bridge::RobotInputs::Applied applied =
             lockstep ? robot.inputs->ApplyNext(robot.state.get(), &world)
                      : robot.inputs->Apply(robot.state.get(), &world);
+        record.inputs += int(applied.pose) + int(applied.bones) + int(applied.actors) + int(applied.camera);
         if (lockstep && applied.pose) {
           // Lock-step time is input time: the outputs depend on the inputs alone.
           if (first_input_utime < 0) first_input_utime = applied.pose_utime;
@@ -283,10 +396,12 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
         bool moved = applied.pose || applied.bones;
         if (robot.net_fdm && robot.net_fdm->Apply(robot.state.get())) {
           moved = true;
+          ++record.inputs;
           robot.input = {robot.net_fdm->socket().received(), now};
         }
         if (robot.doubles && robot.doubles->Apply(robot.state.get())) {
           moved = true;
+          ++record.inputs;
           robot.input = {robot.doubles->socket().received(), now};
         }
         if (moved) {
@@ -298,35 +413,18 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
           lockstep ? double(now - std::max<std::int64_t>(first_input_utime, 0)) * 1e-6 : wall_s;
       link.set_record_utime(now);
       // 3-4. Sensors that are due, and their outputs.
-      for (SensorRun& run : sensor_runs) {
-        if (t < run.next_due_s) continue;
-        const double rate = run.mounted->spec.rate_hz;
-        run.next_due_s = rate > 0.0 ? std::max(run.next_due_s + 1.0 / rate, t) : t;
-        RobotRun& robot = robots[std::size_t(run.mounted->robot)];
-        sensors::RayFilter filter;
-        filter.ignore_robot = run.mounted->robot;
-        const Eigen::Isometry3d X_WS = run.mounted->Pose(*robot.state);
-        if (const auto* face = std::get_if<sensors::FaceScannerConfig>(&run.mounted->config)) {
-          const sensors::FaceScanner scanner(*face);
-          scanner.Scan(world, caster, filter, X_WS, tick, &run.face_scan);
-          robot.outputs->PublishFaces(run.face_scan, tick, robot.input, now);
-        } else if (const auto* ground =
-                       std::get_if<sensors::GroundScannerConfig>(&run.mounted->config)) {
-          sensors::HeightMap map;
-          sensors::GroundScanner(*ground).Scan(world, caster, filter, X_WS.translation(), &map);
-          robot.outputs->PublishGround(map, robot.input, now);
-        } else if (const auto* lidar = std::get_if<sensors::LidarConfig>(&run.mounted->config)) {
-          sensors::LidarScan scan;
-          sensors::Lidar(*lidar).Sweep(world, caster, filter, X_WS, X_WS, &scan);
-          robot.outputs->PublishLidar(scan, robot.input, now);
-        } else if (const auto* ray = std::get_if<sensors::RangeSensorConfig>(&run.mounted->config)) {
-          robot.outputs->PublishRange(run.mounted->spec.name,
-                                      sensors::MeasureRange(*ray, world, caster, filter, X_WS),
-                                      robot.input, now);
-        }
-      }
+      RunDueSensors(t, tick, now, &sensor_runs, &robots, world, &caster);
       for (RobotRun& robot : robots) {
         robot.outputs->PublishState(*robot.state, robot.bone_values, robot.input, now);
+      }
+      if (scans_every_s > 0.0 && t >= next_scan_file_s) {
+        next_scan_file_s = std::max(next_scan_file_s + scans_every_s, t);
+        for (const SensorRun& run : sensor_runs) {
+          if (run.face_scan.n == 0) continue;
+          std::ostringstream name;
+          name << run.mounted->spec.name << "_" << std::setw(6) << std::setfill('0') << tick << ".ply";
+          scan_files.Submit(run.face_scan, (std::filesystem::path(out_dir) / "scans" / name.str()).string());
+        }
       }
       // 5. Cameras that are due: a job for the render thread (copies, no waiting).
       // The live view's camera: the one the keys chose, or the bridge's.
@@ -376,41 +474,75 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
           sensors::AddActorBounds(level, job.actor_poses, false, &job.overlay);
         }
         frames->Submit(std::move(job));
+        ++record.frames;
       }
       if (t >= next_status_s) {
         next_status_s = t + 1.0;
         for (RobotRun& robot : robots) {
           const double rate_now = t > 0.0 ? double(tick) / t : 0.0;
-          robot.outputs->PublishStatus(rate_now, tick, overruns, robot.Channels(now), now);
+          robot.outputs->PublishStatus(rate_now, tick, stats.overruns(), robot.Channels(now), now);
         }
       }
-      ++tick;
-      busy_s += std::chrono::duration<double>(Clock::now() - tick_start).count();
-      // 6. Wait for the next tick; a late tick starts the next at once, no catching up.
-      if (lockstep) continue;  // paced by its inputs
-      deadline += std::chrono::duration_cast<Clock::duration>(period);
-      const auto after = Clock::now();
-      if (after > deadline) {
-        ++overruns;
-        deadline = after;
-      } else {
-        std::this_thread::sleep_until(deadline);
+      if (const auto stall = stalls.find(tick); stall != stalls.end()) {
+        std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(stall->second));
       }
+      ++tick;
+      const auto tick_end = Clock::now();
+      record.duration_ms = std::chrono::duration<double, std::milli>(tick_end - tick_start).count();
+      record.rays = caster.rays_cast() - rays_before;
+      // 6. Wait for the next tick; a late tick starts the next at once, no catching up.
+      bool overrun = false;
+      if (!lockstep && !free_running) {
+        deadline += std::chrono::duration_cast<Clock::duration>(period);
+        if (tick_end > deadline) {
+          overrun = true;
+          deadline = tick_end;
+        } else {
+          std::this_thread::sleep_until(deadline);
+        }
+      }
+      stats.Add(record, overrun);
     }
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
     if (frames) frames->Finish();  // queues drained, videos and indexes closed
-    if (replay) err << "\rreplay: 100% | " << tick << " ticks" << std::string(30, ' ') << "\n";
+    scan_files.Finish();
+    if (replay) {
+      err << "\rreplay: " << (log->stopped_early().empty() ? "100% | " : "") << tick << " ticks"
+          << std::string(30, ' ') << "\n";
+      if (!log->stopped_early().empty()) {
+        err << "sandbox run: the log '" << replay_file << "' is " << log->stopped_early()
+            << "; the " << log->events() << " events before it were replayed\n";
+      } else if (tick == 0) {
+        err << "sandbox run: the log '" << replay_file << "' has " << log->events()
+            << " events but no pose message for this level's robots\n";
+      }
+    }
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    const StatsSummary summary = stats.Summary();
     out << "sandbox run: " << tick << " ticks in " << std::fixed << std::setprecision(2) << elapsed
         << " s (" << (elapsed > 0 ? tick / elapsed : 0.0) << " Hz), mean tick "
-        << std::setprecision(3) << (tick > 0 ? 1e3 * busy_s / double(tick) : 0.0) << " ms, "
-        << overruns << " overruns\n";
-    if (!lateness_ms.empty()) {
-      std::sort(lateness_ms.begin(), lateness_ms.end());
-      out << "  tick lateness: p50 " << lateness_ms[lateness_ms.size() / 2] << " ms, p99 "
-          << lateness_ms[lateness_ms.size() * 99 / 100] << " ms, max " << lateness_ms.back()
-          << " ms\n";
+        << std::setprecision(3) << summary.mean_ms << " ms, " << summary.overruns << " overruns\n";
+    out << "  tick duration: p50 " << summary.p50_ms << " ms, p99 " << summary.p99_ms << " ms, max "
+        << summary.max_ms << " ms\n";
+    if (!lockstep && !free_running) {
+      out << "  tick lateness: p50 " << summary.lateness_p50_ms << " ms, p99 "
+          << summary.lateness_p99_ms << " ms, max " << summary.lateness_max_ms << " ms\n";
+    }
+    if (!out_dir.empty()) {
+      const std::filesystem::path plot = std::filesystem::path(out_dir) / "ticks.png";
+      PlotFrameDurations({{"tick duration", stats.durations_ms()}},
+                         level.name + ": " + std::to_string(tick) + " ticks, " +
+                             (free_running ? std::string("free running") : lockstep ? std::string("lock-step") : Format(rate_hz) + " Hz"),
+                         free_running || lockstep ? 0.0 : 1e3 / rate_hz, plot.string());
+      out << "  statistics: " << (std::filesystem::path(out_dir) / "ticks.csv").string() << ", "
+          << plot.string() << "\n";
+      if (scans_every_s > 0.0) {
+        out << "  scans: " << scan_files.written() << " PLY files written, " << scan_files.dropped()
+            << " dropped, " << scan_files.failed() << " failed"
+            << (scan_files.failed() > 0 ? " (" + scan_files.error() + ")" : "") << " -> "
+            << (std::filesystem::path(out_dir) / "scans").string() << "\n";
+      }
     }
     if (live_view) {
       out << "  live view: " << live_view->shown() << " frames shown, last camera "
@@ -421,8 +553,7 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     if (frames && write_frames) {
       out << "  frames: " << frames->rendered() << " rendered, " << frames->written() << " written, "
           << frames->dropped() << " dropped, " << frames->failed() << " failed"
-          << (frames->failed() > 0 ? " (" + frames->error() + ")" : "") << " -> "
-          << parsed->Value("--out") << "\n";
+          << (frames->failed() > 0 ? " (" + frames->error() + ")" : "") << " -> " << out_dir << "\n";
     }
     for (const RobotRun& robot : robots) {
       if (!robot.inputs->active_camera().empty()) {

@@ -55,37 +55,70 @@ void LcmLink::RecordTo(const std::string& path) {
   }
 }
 
-struct LogReader::Impl {
-  explicit Impl(const std::string& path) : log(path, "r") {}
-  lcm::LogFile log;
-  long size{1};
-};
+namespace {
 
-LogReader::LogReader(const std::string& path) : impl_(std::make_unique<Impl>(path)) {
-  if (!impl_->log.good())
-    throw std::runtime_error("LogReader: cannot read the LCM log '" + path + "'");
-  std::FILE* file = impl_->log.getFilePtr();
-  const long at = std::ftell(file);
-  std::fseek(file, 0, SEEK_END);
-  impl_->size = std::max(1L, std::ftell(file));
-  std::fseek(file, at, SEEK_SET);
+constexpr std::uint32_t kLogSync = 0xEDA1DA01;
+
+std::uint64_t BigEndian(const unsigned char* bytes, int n) {
+  std::uint64_t value = 0;
+  for (int i = 0; i < n; ++i) value = value << 8 | bytes[i];
+  return value;
 }
 
-LogReader::~LogReader() = default;
+}  // namespace
+
+LogReader::LogReader(const std::string& path) : path_(path) {
+  file_ = std::fopen(path.c_str(), "rb");
+  if (file_ == nullptr) throw std::runtime_error("cannot read the LCM log '" + path + "'");
+  std::fseek(file_, 0, SEEK_END);
+  size_ = std::max<std::int64_t>(1, std::ftell(file_));
+  std::fseek(file_, 0, SEEK_SET);
+  unsigned char sync[4];
+  if (std::fread(sync, 1, 4, file_) != 4 || BigEndian(sync, 4) != kLogSync) {
+    std::fclose(file_);
+    file_ = nullptr;
+    throw std::runtime_error("'" + path + "' is not an LCM log (it does not start with the sync word "
+                             "0xEDA1DA01)");
+  }
+  std::fseek(file_, 0, SEEK_SET);
+}
+
+LogReader::~LogReader() {
+  if (file_ != nullptr) std::fclose(file_);
+}
 
 bool LogReader::Next(std::string* channel, std::vector<std::uint8_t>* data, std::int64_t* utime) {
-  const lcm::LogEvent* event = impl_->log.readNextEvent();
-  if (event == nullptr) return false;
-  *channel = event->channel;
-  const auto* bytes = static_cast<const std::uint8_t*>(event->data);
-  data->assign(bytes, bytes + event->datalen);
-  *utime = event->timestamp;
+  if (file_ == nullptr || !stopped_early_.empty()) return false;
+  unsigned char header[28];
+  const std::size_t got = std::fread(header, 1, sizeof(header), file_);
+  if (got == 0) return false;  // a clean end
+  auto stop = [&](const std::string& why) {
+    stopped_early_ = why + ": event " + std::to_string(events_ + 1) + " at byte " +
+                     std::to_string(offset_) + " of " + std::to_string(size_);
+    return false;
+  };
+  if (got < sizeof(header)) return stop("truncated inside an event header");
+  if (BigEndian(header, 4) != kLogSync) return stop("corrupt (no sync word)");
+  const std::int64_t event_utime = std::int64_t(BigEndian(header + 12, 8));
+  const std::uint64_t channel_length = BigEndian(header + 20, 4), data_length = BigEndian(header + 24, 4);
+  if (channel_length == 0 || channel_length > 256) return stop("corrupt (channel name length)");
+  const std::int64_t needed = 28 + std::int64_t(channel_length + data_length);
+  if (offset_ + needed > size_) {
+    return stop("truncated (the event needs " + std::to_string(needed) + " bytes)");
+  }
+  channel->resize(channel_length);
+  data->resize(data_length);
+  if (std::fread(channel->data(), 1, channel_length, file_) != channel_length ||
+      std::fread(data->data(), 1, data_length, file_) != data_length) {
+    return stop("unreadable");
+  }
+  *utime = event_utime;
+  offset_ += needed;
+  ++events_;
   return true;
 }
 
-double LogReader::fraction_read() const {
-  return double(std::ftell(impl_->log.getFilePtr())) / double(impl_->size);
-}
+double LogReader::fraction_read() const { return double(offset_) / double(size_); }
 
 namespace {
 

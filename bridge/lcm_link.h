@@ -6,6 +6,7 @@
 #include <deque>
 #include <map>
 #include <memory>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -53,19 +54,29 @@ class LcmLink {
   std::int64_t record_utime_{0};
 };
 
-// Reads an LCM log file event by event (no network), for replays.
+// Reads an LCM log file event by event (no network), for replays. The
+// format (lcm-logger's): per event a big-endian sync word 0xEDA1DA01, event
+// number (int64), utime (int64), channel length and data length (int32),
+// then the channel name and the data.
 class LogReader {
  public:
-  // Throws std::runtime_error naming the file when it cannot be read.
+  // Throws std::runtime_error naming the file when it cannot be read or does
+  // not start like an LCM log.
   explicit LogReader(const std::string& path);
   ~LogReader();
-  // The next event, or false at the end.
+  // The next event, or false at the end of the file or of its valid part.
   bool Next(std::string* channel, std::vector<std::uint8_t>* data, std::int64_t* utime);
   double fraction_read() const;  // 0 .. 1
+  std::int64_t events() const { return events_; }  // read so far
+  // Empty after a clean end; otherwise where and why reading stopped, e.g.
+  // "truncated: event 1201 at byte 120345 of 120400 needs 88 bytes".
+  const std::string& stopped_early() const { return stopped_early_; }
 
  private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
+  std::string path_;
+  std::FILE* file_{nullptr};
+  std::int64_t size_{1}, offset_{0}, events_{0};
+  std::string stopped_early_;
 };
 
 // One subscribed channel that keeps only its newest message, copied raw and

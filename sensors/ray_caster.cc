@@ -406,6 +406,7 @@ void RayCaster::RunParallel(int chunks, const std::function<void(int)>& job) {
 void RayCaster::Cast(const scene::CollisionWorld& world, const RayBatch& rays,
                      const RayFilter& filter, RayHits* hits) {
   const std::size_t n = rays.size();
+  rays_cast_ += std::int64_t(n);
   hits->distance_m.resize(n);
   hits->normal_W.resize(n);
   hits->body.resize(n);

@@ -63,6 +63,8 @@ class RayCaster {
             RayHits* hits);
 
   int threads() const { return static_cast<int>(workers_.size()) + 1; }
+  // Rays cast since construction (frame statistics).
+  std::int64_t rays_cast() const { return rays_cast_; }
 
  private:
   // Runs job(chunk) for chunk = 0 .. chunks-1 over all threads; returns when done.
@@ -80,6 +82,7 @@ class RayCaster {
   std::atomic<int> unfinished_{0};
   std::atomic<std::uint64_t> generation_{0};
   std::atomic<bool> stop_{false};
+  std::int64_t rays_cast_{0};
 };
 
 }  // namespace sandbox::sensors

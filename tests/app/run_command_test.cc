@@ -55,7 +55,8 @@ TEST(RunCommandTest, CamerasWriteIndexedFramesAtTheirRatesWithDepth) {
   EXPECT_LE(written, rendered);
   EXPECT_GE(written, 5) << run.out;
 
-  // The sample level's cameras: chase 640x480 at 30 Hz, belly 320x240 at 10 Hz with depth.
+  // The sample level's cameras: chase and trailing 640x480 at 30 Hz, belly 320x240 at 10 Hz
+  // with depth.
   struct Camera {
     const char* name;
     int width, height;
@@ -64,6 +65,7 @@ TEST(RunCommandTest, CamerasWriteIndexedFramesAtTheirRatesWithDepth) {
   };
   long indexed = 0;
   for (const Camera& camera : {Camera{"chase", 640, 480, 30.0, false},
+                               Camera{"trailing", 640, 480, 30.0, false},
                                Camera{"belly", 320, 240, 10.0, true}}) {
     const std::vector<IndexRow> rows = ReadIndex(dir.path() / (std::string(camera.name) + ".csv"));
     ASSERT_FALSE(rows.empty()) << camera.name;
@@ -94,13 +96,83 @@ TEST(RunCommandTest, CamerasWriteIndexedFramesAtTheirRatesWithDepth) {
   EXPECT_EQ(indexed, written);
 }
 
+TEST(RunCommandTest, SlowTicksAreFollowedAtOnceWithoutBunchingAndStatisticsAreWritten) {
+  sandbox::testing::TempDir dir;
+  // Ticks 50-52 take 40 ms each: four periods.
+  const auto run = RunSandbox("run --duration 1.5 --lcm-url memq:// --frames none --stall "
+                              "50:40,51:40,52:40 --out " + dir.path().string());
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  std::ifstream csv(dir.path() / "ticks.csv");
+  std::string line;
+  std::getline(csv, line);
+  ASSERT_EQ(line, "tick,start_s,duration_ms,lateness_ms,inputs,rays,frames");
+  std::vector<double> start, duration;
+  std::vector<long> rays;
+  while (std::getline(csv, line)) {
+    std::stringstream cells(line);
+    std::string cell[7];
+    for (std::string& c : cell) std::getline(cells, c, ',');
+    ASSERT_EQ(std::stol(cell[0]), long(start.size()));
+    start.push_back(std::stod(cell[1]));
+    duration.push_back(std::stod(cell[2]));
+    rays.push_back(std::stol(cell[5]));
+  }
+  ASSERT_GT(start.size(), 100u);
+  for (int i = 50; i <= 52; ++i) EXPECT_GE(duration[std::size_t(i)], 40.0) << i;
+  // Each slow tick is followed at once (no wait: it is already late) ...
+  for (int i = 51; i <= 53; ++i) {
+    EXPECT_NEAR(start[std::size_t(i)], start[std::size_t(i - 1)] + duration[std::size_t(i - 1)] / 1e3, 2e-3) << i;
+  }
+  // ... and then the loop keeps its period from there: no burst of ticks to catch up.
+  for (std::size_t i = 54; i + 1 < start.size(); ++i) {
+    EXPECT_GT(start[i] - start[i - 1], 0.005) << "ticks " << i - 1 << " and " << i << " bunch up";
+  }
+  // The summary agrees with the file: the longest tick and the overruns.
+  const double longest = *std::max_element(duration.begin(), duration.end());
+  std::smatch max;
+  ASSERT_TRUE(std::regex_search(run.out, max, std::regex(R"(tick duration: p50 [0-9.]+ ms, p99 [0-9.]+ ms, max ([0-9.]+) ms)")))
+      << run.out;
+  EXPECT_NEAR(std::stod(max[1]), longest, 2e-3);
+  EXPECT_NE(run.out.find(std::to_string(start.size()) + " ticks in"), std::string::npos) << run.out;
+  std::smatch overruns;
+  ASSERT_TRUE(std::regex_search(run.out, overruns, std::regex(R"((\d+) overruns)"))) << run.out;
+  EXPECT_GE(std::stol(overruns[1]), 3);
+  // The six-stage face scanner (51 x 51 a face) casts 2601 rays a tick, the range sensor
+  // one at 50 Hz.
+  EXPECT_GE(rays[10], 2601);
+  EXPECT_LE(rays[10], 2602);
+  const cv::Mat plot = cv::imread((dir.path() / "ticks.png").string());
+  EXPECT_EQ(plot.cols, 1000);
+  EXPECT_EQ(plot.rows, 500);
+}
+
 TEST(RunCommandTest, BadFrameOptionsFailClearly) {
   sandbox::testing::TempDir dir;
   const auto gif =
       RunSandbox("run --duration 0.1 --lcm-url memq:// --frames gif --out " + dir.path().string());
   EXPECT_NE(gif.exit_code, 0);
-  EXPECT_NE(gif.out.find("--frames must be jpg, png, mp4 or avi, got 'gif'"), std::string::npos)
+  EXPECT_NE(gif.out.find("--frames must be jpg, png, mp4 or avi (or a list like jpg,mp4, or none), "
+                         "got 'gif'"), std::string::npos)
       << gif.out;
+  const auto two = RunSandbox("run --duration 0.1 --lcm-url memq:// --frames jpg,png --out " +
+                              dir.path().string());
+  EXPECT_NE(two.out.find("--frames: one image and one video format at most"), std::string::npos)
+      << two.out;
+  const auto scans = RunSandbox("run --duration 0.1 --lcm-url memq:// --scans-every 1");
+  EXPECT_NE(scans.out.find("--scans-every needs --out"), std::string::npos) << scans.out;
+  const auto stall = RunSandbox("run --duration 0.1 --lcm-url memq:// --stall 5");
+  EXPECT_NE(stall.out.find("--stall wants TICK:MS items, got '5'"), std::string::npos) << stall.out;
+  const auto rate = RunSandbox("run --duration 0.1 --lcm-url memq:// --rate -3");
+  EXPECT_NE(rate.out.find("--rate must be positive or max"), std::string::npos) << rate.out;
+  const auto flag = RunSandbox("run --duration 0.1 --fast");
+  EXPECT_EQ(flag.exit_code, 2);
+  EXPECT_NE(flag.out.find("--fast"), std::string::npos) << flag.out;
+  const auto url = RunSandbox("run --duration 0.1 --lcm-url bogus://nowhere");
+  EXPECT_EQ(url.exit_code, 1);
+  EXPECT_NE(url.out.find("bogus://nowhere"), std::string::npos) << url.out;
+  const auto level = RunSandbox("run /nonexistent/level.toml --duration 0.1");
+  EXPECT_EQ(level.exit_code, 1);
+  EXPECT_NE(level.out.find("/nonexistent/level.toml"), std::string::npos) << level.out;
   const auto tiff =
       RunSandbox("run --duration 0.1 --lcm-url memq:// --depth tiff --out " + dir.path().string());
   EXPECT_NE(tiff.exit_code, 0);

@@ -1,0 +1,134 @@
+#include "app/tick_stats.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iomanip>
+#include <numeric>
+#include <stdexcept>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace sandbox::app {
+
+double Quantile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  const std::size_t rank =
+      std::min(values.size() - 1, std::size_t(std::ceil(q * double(values.size()))) - (q > 0 ? 1 : 0));
+  std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(rank), values.end());
+  return values[rank];
+}
+
+TickStats::TickStats(const std::string& csv_path) {
+  if (csv_path.empty()) return;
+  csv_ = std::make_unique<std::ofstream>(csv_path);
+  if (!*csv_) throw std::runtime_error("cannot create " + csv_path);
+  *csv_ << "tick,start_s,duration_ms,lateness_ms,inputs,rays,frames\n" << std::fixed;
+}
+
+void TickStats::Add(const TickRecord& record, bool overrun) {
+  durations_ms_.push_back(record.duration_ms);
+  lateness_ms_.push_back(record.lateness_ms);
+  overruns_ += overrun;
+  if (csv_) {
+    *csv_ << record.tick << ',' << std::setprecision(6) << record.start_s << ','
+          << std::setprecision(4) << record.duration_ms << ',' << record.lateness_ms << ','
+          << record.inputs << ',' << record.rays << ',' << record.frames << '\n';
+  }
+}
+
+StatsSummary TickStats::Summary() const {
+  StatsSummary summary;
+  summary.ticks = std::int64_t(durations_ms_.size());
+  summary.overruns = overruns_;
+  if (durations_ms_.empty()) return summary;
+  summary.mean_ms = std::accumulate(durations_ms_.begin(), durations_ms_.end(), 0.0) /
+                    double(durations_ms_.size());
+  summary.p50_ms = Quantile(durations_ms_, 0.5);
+  summary.p99_ms = Quantile(durations_ms_, 0.99);
+  summary.max_ms = *std::max_element(durations_ms_.begin(), durations_ms_.end());
+  summary.lateness_p50_ms = Quantile(lateness_ms_, 0.5);
+  summary.lateness_p99_ms = Quantile(lateness_ms_, 0.99);
+  summary.lateness_max_ms = *std::max_element(lateness_ms_.begin(), lateness_ms_.end());
+  return summary;
+}
+
+namespace {
+
+std::string Label(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), value >= 10 || value == 0 ? "%.0f" : "%.1f", value);
+  return text;
+}
+
+// 1, 2 or 5 times a power of ten, about range / 5.
+double NiceStep(double range) {
+  const double rough = range / 5.0, power = std::pow(10.0, std::floor(std::log10(rough)));
+  for (const double m : {1.0, 2.0, 5.0}) {
+    if (m * power >= rough) return m * power;
+  }
+  return 10.0 * power;
+}
+
+}  // namespace
+
+void PlotFrameDurations(const std::vector<PlotSeries>& series, const std::string& title,
+                        double period_ms, const std::string& png_path) {
+  const int width = 1000, height = 500, left = 70, right = 20, top = 40, bottom = 50;
+  cv::Mat image(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
+  std::size_t frames = 1;
+  std::vector<double> all;
+  for (const PlotSeries& s : series) {
+    frames = std::max(frames, s.values.size());
+    all.insert(all.end(), s.values.begin(), s.values.end());
+  }
+  // The y axis reaches the largest value (a spike stays visible) or twice the period.
+  double y_max = std::max({all.empty() ? 1.0 : *std::max_element(all.begin(), all.end()),
+                           period_ms * 1.2, 1e-3});
+  const double y_step = NiceStep(y_max);
+  y_max = std::ceil(y_max / y_step) * y_step;
+  const double x_step = NiceStep(double(frames));
+  const int plot_w = width - left - right, plot_h = height - top - bottom;
+  auto X = [&](double i) { return left + int(std::lround(i / double(std::max<std::size_t>(frames - 1, 1)) * plot_w)); };
+  auto Y = [&](double v) { return top + plot_h - int(std::lround(std::min(v, y_max) / y_max * plot_h)); };
+  const cv::Scalar grid(225, 225, 225), ink(40, 40, 40);
+  const int font = cv::FONT_HERSHEY_SIMPLEX;
+  for (double v = 0; v <= y_max + 1e-9; v += y_step) {
+    cv::line(image, {left, Y(v)}, {left + plot_w, Y(v)}, grid, 1);
+    cv::putText(image, Label(v), {8, Y(v) + 5}, font, 0.45, ink, 1, cv::LINE_AA);
+  }
+  for (double i = 0; i < double(frames); i += x_step) {
+    cv::line(image, {X(i), top}, {X(i), top + plot_h}, grid, 1);
+    cv::putText(image, Label(i), {X(i) - 12, top + plot_h + 20}, font, 0.45, ink, 1, cv::LINE_AA);
+  }
+  cv::rectangle(image, {left, top}, {left + plot_w, top + plot_h}, ink, 1);
+  if (period_ms > 0) {
+    for (int x = left; x < left + plot_w; x += 12) {
+      cv::line(image, {x, Y(period_ms)}, {std::min(x + 6, left + plot_w), Y(period_ms)}, {0, 0, 220}, 1);
+    }
+    cv::putText(image, "period " + Label(period_ms) + " ms", {left + plot_w - 140, Y(period_ms) - 6},
+                font, 0.45, {0, 0, 220}, 1, cv::LINE_AA);
+  }
+  for (const PlotSeries& s : series) {
+    std::vector<cv::Point> points;
+    for (std::size_t i = 0; i < s.values.size(); ++i) points.push_back({X(double(i)), Y(s.values[i])});
+    if (points.size() >= 2) cv::polylines(image, points, false, cv::Scalar(s.b, s.g, s.r), 1, cv::LINE_AA);
+  }
+  for (std::size_t k = 0; k < series.size(); ++k) {
+    const int y = top + 18 + 18 * int(k);
+    cv::line(image, {left + 12, y - 4}, {left + 36, y - 4}, cv::Scalar(series[k].b, series[k].g, series[k].r), 2);
+    cv::putText(image, series[k].label, {left + 42, y}, font, 0.45, ink, 1, cv::LINE_AA);
+  }
+  cv::putText(image, title, {left, 26}, font, 0.6, ink, 1, cv::LINE_AA);
+  cv::putText(image, "frame", {left + plot_w / 2 - 20, height - 10}, font, 0.5, ink, 1, cv::LINE_AA);
+  cv::putText(image, "ms", {8, top - 12}, font, 0.5, ink, 1, cv::LINE_AA);
+  bool written = false;
+  try {
+    written = cv::imwrite(png_path, image);
+  } catch (const cv::Exception&) {
+  }
+  if (!written) throw std::runtime_error("cannot write " + png_path);
+}
+
+}  // namespace sandbox::app

@@ -1,0 +1,65 @@
+#pragma once
+// Frame statistics of the loop: every tick's start, duration, lateness and
+// what it did, written as CSV; a summary (mean, p50, p99, max, overruns); and
+// a plot of tick duration against tick number drawn with OpenCV, like the
+// evaluation plots of a report.
+
+#include <cstdint>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace sandbox::app {
+
+struct TickRecord {
+  std::int64_t tick{0};
+  double start_s{0.0};      // since the loop started
+  double duration_ms{0.0};  // the work of the tick (the wait after it excluded)
+  double lateness_ms{0.0};  // start after its deadline (0 in lock-step)
+  int inputs{0};            // input messages applied
+  std::int64_t rays{0};     // rays cast
+  int frames{0};            // camera frames submitted
+};
+
+struct StatsSummary {
+  std::int64_t ticks{0};
+  double mean_ms{0}, p50_ms{0}, p99_ms{0}, max_ms{0};  // tick duration
+  double lateness_p50_ms{0}, lateness_p99_ms{0}, lateness_max_ms{0};
+  std::int64_t overruns{0};  // ticks that ended after the next one was due
+};
+
+// The value at quantile q (0..1) of `values` (nearest rank); 0 when empty.
+double Quantile(std::vector<double> values, double q);
+
+class TickStats {
+ public:
+  // `csv_path` empty: kept in memory only. Throws std::runtime_error naming
+  // the file when it cannot be created.
+  explicit TickStats(const std::string& csv_path = "");
+
+  void Add(const TickRecord& record, bool overrun);
+  StatsSummary Summary() const;
+  const std::vector<double>& durations_ms() const { return durations_ms_; }
+  std::int64_t overruns() const { return overruns_; }
+
+ private:
+  std::unique_ptr<std::ofstream> csv_;
+  std::vector<double> durations_ms_, lateness_ms_;
+  std::int64_t overruns_{0};
+};
+
+// One series of a plot: values against their index, in a colour (B, G, R).
+struct PlotSeries {
+  std::string label;
+  std::vector<double> values;
+  int b{200}, g{80}, r{30};
+};
+
+// Draws the series as lines against frame number with axes, ticks, a legend
+// and, when period_ms > 0, the period as a dashed line; writes a PNG.
+// Throws std::runtime_error naming the file when it cannot be written.
+void PlotFrameDurations(const std::vector<PlotSeries>& series, const std::string& title,
+                        double period_ms, const std::string& png_path);
+
+}  // namespace sandbox::app

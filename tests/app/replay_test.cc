@@ -1,0 +1,113 @@
+// `sandbox run --replay` on log files written here with LCM's own LogFile:
+// one tick per pose, the same frame indexes and scans from two replays, a
+// truncated log replayed up to where it breaks (and said so), and a file that
+// is not an LCM log refused.
+
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "sandbox_msgs/robot_pose_t.hpp"
+#include "tests/app/run_sandbox.h"
+#include "tests/test_util.h"
+
+namespace {
+
+using sandbox::testing::RunSandbox;
+namespace fs = std::filesystem;
+
+// A log of `poses` ELAHA/POSE messages at 50 Hz, circling 60 m up.
+void WriteFlightLog(const std::string& path, int poses) {
+  lcm::LogFile log(path, "w");
+  ASSERT_TRUE(log.good());
+  for (int i = 0; i < poses; ++i) {
+    sandbox_msgs::robot_pose_t pose{};
+    pose.utime = 1'000'000 + 20'000 * std::int64_t(i);
+    pose.seq = i;
+    const double a = 0.01 * i;
+    pose.position[0] = 100 * std::cos(a);
+    pose.position[1] = 100 * std::sin(a);
+    pose.position[2] = 60;
+    pose.orientation[0] = std::cos((a + M_PI / 2) / 2);
+    pose.orientation[3] = std::sin((a + M_PI / 2) / 2);
+    std::vector<std::uint8_t> bytes(std::size_t(pose.getEncodedSize()));
+    pose.encode(bytes.data(), 0, int(bytes.size()));
+    lcm::LogEvent event;
+    event.eventnum = i;
+    event.timestamp = pose.utime;
+    event.channel = "ELAHA/POSE";
+    event.datalen = int32_t(bytes.size());
+    event.data = bytes.data();
+    ASSERT_EQ(log.writeEvent(&event), 0);
+  }
+}
+
+std::string Read(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+TEST(ReplayTest, TwoReplaysGiveOneTickPerPoseAndIdenticalFrameIndexesAndScans) {
+  sandbox::testing::TempDir dir;
+  const std::string log = (dir.path() / "flight.lcmlog").string();
+  WriteFlightLog(log, 120);  // 2.4 s of flight
+  std::string first_out;
+  for (const char* name : {"a", "b"}) {
+    const auto run = RunSandbox("run --replay " + log + " --out " + (dir.path() / name).string() +
+                                " --scans-every 0.5");
+    ASSERT_EQ(run.exit_code, 0) << run.out;
+    EXPECT_NE(run.out.find("sandbox run: 120 ticks"), std::string::npos) << run.out;
+    EXPECT_NE(run.out.find("0 dropped, 0 failed"), std::string::npos) << run.out;  // lossless
+  }
+  // Cameras due by input time: chase 30 fps over 2.38 s of input is 72 frames.
+  for (const char* file : {"chase.csv", "belly.csv", "trailing.csv"}) {
+    const std::string a = Read(dir.path() / "a" / file);
+    EXPECT_FALSE(a.empty()) << file;
+    EXPECT_EQ(a, Read(dir.path() / "b" / file)) << file;
+  }
+  int lines = 0;
+  for (const char c : Read(dir.path() / "a" / "chase.csv")) lines += c == '\n';
+  EXPECT_EQ(lines - 1, 72);
+  int scans = 0;
+  for (const auto& entry : fs::directory_iterator(dir.path() / "a" / "scans")) {
+    ++scans;
+    EXPECT_EQ(Read(entry.path()), Read(dir.path() / "b" / "scans" / entry.path().filename()))
+        << entry.path().filename();
+  }
+  EXPECT_EQ(scans, 5);  // at 0, 0.5, 1.0, 1.5 and 2.0 s of input time
+}
+
+TEST(ReplayTest, TruncatedLogIsReplayedUpToTheBreakAndNotALogIsRefused) {
+  sandbox::testing::TempDir dir;
+  const std::string log = (dir.path() / "flight.lcmlog").string();
+  WriteFlightLog(log, 50);
+  const auto size = fs::file_size(log);
+  const std::string cut = (dir.path() / "cut.lcmlog").string();
+  fs::copy_file(log, cut);
+  fs::resize_file(cut, size - 20);  // the last event loses its end
+  const auto run = RunSandbox("run --replay " + cut + " --lcm-url memq://");
+  EXPECT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("sandbox run: 49 ticks"), std::string::npos) << run.out;
+  const std::size_t event_size = size / 50;
+  EXPECT_NE(run.out.find("is truncated (the event needs " + std::to_string(event_size) +
+                         " bytes): event 50 at byte " + std::to_string(49 * event_size) + " of " +
+                         std::to_string(size - 20) + "; the 49 events before it were replayed"),
+            std::string::npos)
+      << run.out;
+
+  const std::string text = dir.Write("notes.lcmlog", "these are not LCM events\n");
+  const auto bad = RunSandbox("run --replay " + text);
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.out.find("'" + text + "' is not an LCM log"), std::string::npos) << bad.out;
+  const auto missing = RunSandbox("run --replay " + (dir.path() / "nothing.lcmlog").string());
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_NE(missing.out.find("cannot read the LCM log"), std::string::npos) << missing.out;
+}
+
+}  // namespace
