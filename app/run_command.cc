@@ -530,11 +530,22 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
           << summary.lateness_p99_ms << " ms, max " << summary.lateness_max_ms << " ms\n";
     }
     if (!out_dir.empty()) {
+      // Files that cannot be finished (a full disk) are reported; the run's results stand.
       const std::filesystem::path plot = std::filesystem::path(out_dir) / "ticks.png";
-      PlotFrameDurations({{"tick duration", stats.durations_ms()}},
-                         level.name + ": " + std::to_string(tick) + " ticks, " +
-                             (free_running ? std::string("free running") : lockstep ? std::string("lock-step") : Format(rate_hz) + " Hz"),
-                         free_running || lockstep ? 0.0 : 1e3 / rate_hz, plot.string());
+      const std::string mode = free_running ? std::string("free running")
+                               : lockstep   ? std::string("lock-step")
+                                            : Format(rate_hz) + " Hz";
+      try {
+        PlotFrameDurations({{"tick duration", stats.durations_ms()}},
+                           level.name + ": " + std::to_string(tick) + " ticks, " + mode,
+                           free_running || lockstep ? 0.0 : 1e3 / rate_hz, plot.string());
+      } catch (const std::exception& error) {
+        err << "sandbox run: warning: " << error.what() << "\n";
+      }
+      if (!stats.Flush()) {
+        err << "sandbox run: warning: " << (std::filesystem::path(out_dir) / "ticks.csv").string()
+            << " is incomplete (cannot write)\n";
+      }
       out << "  statistics: " << (std::filesystem::path(out_dir) / "ticks.csv").string() << ", "
           << plot.string() << "\n";
       if (scans_every_s > 0.0) {

@@ -38,6 +38,12 @@ void TickStats::Add(const TickRecord& record, bool overrun) {
   }
 }
 
+bool TickStats::Flush() {
+  if (!csv_) return true;
+  csv_->flush();
+  return bool(*csv_);
+}
+
 StatsSummary TickStats::Summary() const {
   StatsSummary summary;
   summary.ticks = std::int64_t(durations_ms_.size());

@@ -40,6 +40,8 @@ class TickStats {
 
   void Add(const TickRecord& record, bool overrun);
   StatsSummary Summary() const;
+  // Flushes the CSV; false when some of it could not be written.
+  bool Flush();
   const std::vector<double>& durations_ms() const { return durations_ms_; }
   std::int64_t overruns() const { return overruns_; }
 

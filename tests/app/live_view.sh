@@ -27,7 +27,7 @@ sleep 1
 for key in c o q; do xdotool key --window "$window" "$key" 2> /dev/null; sleep 0.3; done
 wait "$pid"
 cat "$out"
-grep -q "last camera belly, overlay toggled, quit by key" "$out" || { echo "the keys did not act"; status=1; }
+grep -q "last camera trailing, overlay toggled, quit by key" "$out" || { echo "the keys did not act"; status=1; }
 shown=$(sed -n 's/.*live view: \([0-9]*\) frames shown.*/\1/p' "$out")
 [ "${shown:-0}" -ge 10 ] || { echo "only ${shown:-0} frames shown"; status=1; }
 ticks=$(sed -n 's/^sandbox run: \([0-9]*\) ticks in \([0-9.]*\) s.*/\2/p' "$out")
