@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "app/demo_command.h"
 #include "app/info_command.h"
 #include "app/pose_command.h"
 #include "app/render_command.h"
@@ -16,6 +17,8 @@ namespace {
 const char* kUsage =
     "usage: sandbox COMMAND [ARGS]\n"
     "commands:\n"
+    "  demo [--duration S]     the sample level flown by the example model: frames, video, scans,\n"
+    "                          statistics (start here)\n"
     "  info [LEVEL] [--json]   actors, robots, triangles, bounds, load time and memory of a level\n"
     "  pose [LEVEL] --out M.ply  a robot posed from the command line, as a mesh and bone frames\n"
     "  scan [LEVEL] --at X,Y,Z --out F  one sensor once at a pose, as CSV or PLY\n"
@@ -34,6 +37,7 @@ int main(int argc, char** argv) {
   }
   const std::vector<std::string> rest(args.begin() + 1, args.end());
   try {
+    if (args[0] == "demo") return sandbox::app::RunDemo(rest, std::cout, std::cerr);
     if (args[0] == "info") return sandbox::app::RunInfo(rest, std::cout, std::cerr);
     if (args[0] == "pose") return sandbox::app::RunPose(rest, std::cout, std::cerr);
     if (args[0] == "scan") return sandbox::app::RunScan(rest, std::cout, std::cerr);

@@ -4,6 +4,9 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <pthread.h>
+#include <sched.h>
+
 #include <csignal>
 #include <filesystem>
 #include <map>
@@ -35,7 +38,7 @@ namespace {
 const char* kUsage =
     "usage: sandbox run [LEVEL] [--rate HZ|max] [--duration S] [--lcm-url URL] [--lockstep]\n"
     "                   [--replay LOG] [--record LOG] [--out DIR] [--frames LIST] [--depth D]\n"
-    "                   [--scans-every S] [--view] [--stall TICK:MS,...]\n"
+    "                   [--scans-every S] [--view] [--realtime auto|off] [--stall TICK:MS,...]\n"
     "  LEVEL          a level (default: the bundled sample level)\n"
     "  --rate         loop rate in Hz (default 100); max: free running, as fast as it can\n"
     "  --duration     stop after this many seconds (default: run until Ctrl-C)\n"
@@ -55,6 +58,8 @@ const char* kUsage =
     "  --scans-every  write each face scanner's scan as DIR/scans/<sensor>_<tick>.ply every S s\n"
     "  --view         a window showing the active camera (needs a display); keys: c next camera,\n"
     "                 a/d pan, w/s tilt, +/- zoom (trailing), o overlay, space pause, q quit\n"
+    "  --realtime     auto (default): the loop thread at real-time priority (SCHED_FIFO) when\n"
+    "                 the user may (root, CAP_SYS_NICE or ulimit -r); off: normal priority\n"
     "  --stall        test aid: sleep MS milliseconds inside tick TICK (the loop's timing)\n"
     "Inputs per robot: <ROBOT>/POSE, /BONES, /ACTORS, /CAMERA (trailing pan, tilt, zoom).\n"
     "Outputs: <ROBOT>/SCAN_FACE, /GROUND, /LIDAR, /RANGE, /STATE, /STATUS (docs/bridge.md).\n";
@@ -115,6 +120,22 @@ struct CameraRun {
   const sensors::MountedCamera* camera;
   sensors::ChaseCamera chase;
   double next_due_s{0.0}, last_s{-1.0};
+};
+
+// SCHED_FIFO for the calling thread (threads it starts later inherit it; the
+// caster's workers, started earlier, do not). False when not permitted.
+bool RaiseToRealTime() {
+  sched_param param{};
+  param.sched_priority = 10;  // above every normal thread, below the kernel's own
+  return pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
+}
+
+// Back to normal priority when the loop ends, however it ends.
+struct NormalPriorityAtExit {
+  ~NormalPriorityAtExit() {
+    sched_param param{};
+    pthread_setschedparam(pthread_self(), SCHED_OTHER, &param);
+  }
 };
 
 // --frames: at most one image and one video format, or none.
@@ -199,7 +220,7 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   const auto parsed =
       ParseArgs(args, "run",
                 {"--rate", "--duration", "--lcm-url", "--replay", "--record", "--out", "--frames",
-                 "--depth", "--scans-every", "--stall"},
+                 "--depth", "--scans-every", "--stall", "--realtime"},
                 {"--lockstep", "--view"}, kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
@@ -225,6 +246,10 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       throw CommandError("--scans-every needs --out and a positive number of seconds");
     }
     const std::map<std::int64_t, double> stalls = ParseStalls(parsed->Value("--stall"));
+    const std::string realtime = parsed->Value("--realtime", "auto");
+    if (realtime != "auto" && realtime != "off") {
+      throw CommandError("--realtime must be auto or off, got '" + realtime + "'");
+    }
     FramePipelineConfig frame_config;
     ParseFrames(parsed->Value("--frames", "jpg"), &frame_config);
     frame_config.depth_format = parsed->Value("--depth", "png");
@@ -244,6 +269,13 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     // A replay feeds its inputs through an in-process link: nothing on the network.
     bridge::LcmLink link(replay ? "memq://" : parsed->Value("--lcm-url"));
     if (!parsed->Value("--record").empty()) link.RecordTo(parsed->Value("--record"));
+    struct CloseHook {
+      const RunHooks& hooks;
+      bridge::LcmLink& link;
+      ~CloseHook() {
+        if (hooks.before_close) hooks.before_close(link);
+      }
+    } close_hook{hooks, link};
     sensors::RayCaster caster;
     if (!out_dir.empty()) {
       std::error_code error;
@@ -309,13 +341,21 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     std::vector<SensorRun> sensor_runs;
     for (const sensors::MountedSensor& m : mounted) sensor_runs.push_back({&m, 0.0, {}});
 
+    // The loop thread at real-time priority when allowed (and when it sleeps
+    // between ticks): the kernel then wakes it at once, whatever else runs.
+    std::string priority;
+    const NormalPriorityAtExit restore_priority;
+    if (realtime == "auto" && !free_running) {
+      priority = RaiseToRealTime() ? ", real-time priority"
+                                   : ", normal priority (real-time needs CAP_SYS_NICE or ulimit -r)";
+    }
     out << "sandbox run: " << level.name << ", " << level.robots.size() << " robots, "
         << mounted.size() << " sensors, "
         << (replay ? "replaying " + replay_file
                    : (lockstep ? std::string("lock-step")
                                : free_running ? std::string("free running") : Format(rate_hz) + " Hz") +
                          ", LCM " + link.url())
-        << "\n"
+        << priority << "\n"
         << std::flush;
     stop_requested = false;
     std::signal(SIGINT, OnSignal);

@@ -19,6 +19,9 @@ struct RunHooks {
   // Called at the start of each tick, before the inputs are drained, with the
   // seconds since the loop started.
   std::function<void(bridge::LcmLink& link, double wall_s)> before_tick;
+  // Called before the link closes (however the loop ends): let go of what
+  // before_tick subscribed.
+  std::function<void(bridge::LcmLink& link)> before_close;
 };
 
 // Returns the exit code (0 ok, 1 bad level or LCM, 2 bad usage).

@@ -14,8 +14,7 @@
 #include <thread>
 #include <vector>
 
-#include "sandbox_msgs/bone_values_t.hpp"
-#include "sandbox_msgs/robot_pose_t.hpp"
+#include "bridge/example_flight.h"
 
 int main(int argc, char** argv) {
   double rate_hz = 100.0, duration_s = 10.0;
@@ -51,34 +50,12 @@ int main(int argc, char** argv) {
     const std::int64_t utime = std::chrono::duration_cast<std::chrono::microseconds>(
                                    std::chrono::system_clock::now().time_since_epoch())
                                    .count();
-    // A 120 m circle at 15 m/s, banked into the turn.
-    const double radius = 120.0, speed = 15.0, w = speed / radius, a = w * t;
-    sandbox_msgs::robot_pose_t pose{};
-    pose.utime = utime;
-    pose.seq = seq;
-    pose.position[0] = radius * std::cos(a);
-    pose.position[1] = radius * std::sin(a);
-    pose.position[2] = 60.0 + 5.0 * std::sin(0.3 * t);
-    const double yaw = a + M_PI / 2, roll = -0.2;  // heading along the circle, banked left
-    const double cy = std::cos(yaw / 2), sy = std::sin(yaw / 2), cr = std::cos(roll / 2),
-                 sr = std::sin(roll / 2);
-    pose.orientation[0] = cy * cr;  // Rz(yaw) Rx(roll)
-    pose.orientation[1] = cy * sr;
-    pose.orientation[2] = sy * sr;
-    pose.orientation[3] = sy * cr;
+    sandbox_msgs::robot_pose_t pose;
+    sandbox_msgs::bone_values_t bones;
+    sandbox::bridge::ExampleFlight(t, seq, utime, &pose, &bones);  // the flight itself
     std::vector<std::uint8_t> bytes(std::size_t(pose.getEncodedSize()));
     pose.encode(bytes.data(), 0, int(bytes.size()));
     lcm.publish(robot + "/POSE", bytes.data(), unsigned(bytes.size()));
-
-    // Bones: root (2 angles), R1-R10 and L1-L10 (roll, pitch), E1-E3 (pitch).
-    sandbox_msgs::bone_values_t bones{};
-    bones.utime = utime;
-    bones.seq = seq;
-    bones.num_values = 45;
-    bones.values.assign(45, 0.0);
-    const double bend = 0.06 * std::sin(1.5 * t);  // up to 3.4 degrees a joint
-    for (int b = 1; b <= 20; ++b) bones.values[std::size_t(2 * b)] = b <= 10 ? bend : -bend;
-    for (int e = 0; e < 3; ++e) bones.values[std::size_t(42 + e)] = 0.2 * std::sin(2.0 * t + e);
     bytes.resize(std::size_t(bones.getEncodedSize()));
     bones.encode(bytes.data(), 0, int(bytes.size()));
     lcm.publish(robot + "/BONES", bytes.data(), unsigned(bytes.size()));

@@ -1,0 +1,194 @@
+#include "app/demo_command.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <iomanip>
+#include <memory>
+#include <sstream>
+#include <thread>
+
+#include "app/command_line.h"
+#include "app/defaults.h"
+#include "app/run_command.h"
+#include "bridge/example_flight.h"
+#include "bridge/lcm_link.h"
+#include "sandbox_msgs/status_t.hpp"
+
+extern char** environ;
+
+namespace sandbox::app {
+namespace {
+
+const char* kUsage =
+    "usage: sandbox demo [--duration S] [--out DIR] [--in-process]\n"
+    "  The sample level and the flying wing, flown by the example model (examples/fly_wing)\n"
+    "  as a separate process over LCM inside a private network namespace (nothing reaches\n"
+    "  the LAN). Face scanner on; chase, trailing and belly cameras write JPEG and an mp4\n"
+    "  each; the face scan is written as PLY every second; frame statistics and their plot.\n"
+    "  --duration    seconds of flight (default 20)\n"
+    "  --out         where everything goes (default: sandbox-demo)\n"
+    "  --in-process  no namespace: the model flies in this process over memq:// (also what\n"
+    "                happens when no namespace can be made: that needs root or user namespaces)\n";
+
+bool InNamespace() {
+  const char* flag = std::getenv("SANDBOX_IN_NETNS");
+  return flag != nullptr && std::string(flag) == "1";
+}
+
+bool CanMakeNamespace() {
+  return std::system((std::string(kNetnsRunScript) + " true > /dev/null 2>&1").c_str()) == 0;
+}
+
+// Runs this program again inside a private network namespace; returns only on failure.
+void ReExecInNamespace(const std::vector<std::string>& args) {
+  char self[4096];
+  const ssize_t length = readlink("/proc/self/exe", self, sizeof(self) - 1);
+  if (length <= 0) return;
+  self[length] = '\0';
+  std::vector<std::string> argv_strings = {kNetnsRunScript, self, "demo"};
+  argv_strings.insert(argv_strings.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& s : argv_strings) argv.push_back(s.data());
+  argv.push_back(nullptr);
+  execv(kNetnsRunScript, argv.data());
+}
+
+// The example model as a child process, its output in `log_file`.
+pid_t StartFlyWing(double duration_s, const std::string& log_file) {
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log_file.c_str(),
+                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  std::ostringstream seconds;
+  seconds << duration_s;
+  std::vector<std::string> argv_strings = {kFlyWingBinary, "--duration", seconds.str(), "--rate", "100"};
+  std::vector<char*> argv;
+  for (std::string& s : argv_strings) argv.push_back(s.data());
+  argv.push_back(nullptr);
+  pid_t pid = -1;
+  const int error = posix_spawn(&pid, kFlyWingBinary, &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (error != 0) throw CommandError(std::string("cannot start the example model ") + kFlyWingBinary);
+  return pid;
+}
+
+// Listens to ELAHA/STATUS on the loop's own link: the heartbeat, end to end.
+struct StatusListener {
+  std::unique_ptr<bridge::LatestInput> input;
+  std::int64_t heard{0};
+  double last_rate_hz{0.0};
+  void Poll(bridge::LcmLink& link) {
+    if (!input) input = std::make_unique<bridge::LatestInput>(link, "ELAHA/STATUS");
+    if (const std::vector<std::uint8_t>* bytes = input->TakeNewest()) {
+      sandbox_msgs::status_t status;
+      if (status.decode(bytes->data(), 0, int(bytes->size())) > 0) {
+        ++heard;
+        last_rate_hz = status.loop_rate_hz;
+      }
+    }
+  }
+};
+
+}  // namespace
+
+int RunDemo(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  const auto parsed = ParseArgs(args, "demo", {"--duration", "--out"}, {"--in-process"}, kUsage, err);
+  if (!parsed) return 2;
+  if (parsed->help) {
+    out << kUsage;
+    return 0;
+  }
+  if (parsed->level) {
+    err << "sandbox demo: takes no level (it flies the bundled sample level)\n" << kUsage;
+    return 2;
+  }
+  try {
+    const double duration_s = parsed->values.count("--duration")
+                                  ? ParseNumbers(parsed->Value("--duration"), "--duration").at(0)
+                                  : 20.0;
+    if (!(duration_s > 0.0 && duration_s <= 3600.0)) throw CommandError("--duration must be 0 to 3600 s");
+    const std::string out_dir = parsed->Value("--out", "sandbox-demo");
+    bool in_process = parsed->flags.count("--in-process") > 0;
+    if (!in_process && !InNamespace()) {
+      if (CanMakeNamespace()) {
+        out << "sandbox demo: into a private network namespace (scripts/netns-run)\n" << std::flush;
+        ReExecInNamespace(args);
+        err << "sandbox demo: cannot run " << kNetnsRunScript << "; flying in-process instead\n";
+      } else {
+        out << "sandbox demo: no private network namespace here (needs root or user namespaces): "
+               "the example model flies in this process over memq://\n";
+      }
+      in_process = true;
+    }
+    std::error_code error;
+    std::filesystem::create_directories(out_dir, error);
+    if (error || !std::filesystem::is_directory(out_dir)) {
+      throw CommandError("cannot create the output folder '" + out_dir + "'");
+    }
+    std::ostringstream seconds;
+    seconds << duration_s;
+    std::vector<std::string> run_args = {"--duration", seconds.str(), "--out", out_dir, "--frames",
+                                         "jpg,mp4", "--scans-every", "1"};
+    StatusListener status;
+    RunHooks hooks;
+    hooks.before_close = [&status](bridge::LcmLink&) { status.input.reset(); };
+    pid_t model = -1;
+    if (in_process) {
+      run_args.insert(run_args.end(), {"--lcm-url", "memq://"});
+      std::int64_t seq = 0;
+      hooks.before_tick = [&status, &seq](bridge::LcmLink& link, double wall_s) {
+        status.Poll(link);
+        sandbox_msgs::robot_pose_t pose;
+        sandbox_msgs::bone_values_t bones;
+        const std::int64_t utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                                       std::chrono::system_clock::now().time_since_epoch())
+                                       .count();
+        bridge::ExampleFlight(wall_s, seq++, utime, &pose, &bones);
+        std::vector<std::uint8_t> bytes(std::size_t(pose.getEncodedSize()));
+        pose.encode(bytes.data(), 0, int(bytes.size()));
+        link.Inject("ELAHA/POSE", bytes.data(), unsigned(bytes.size()));
+        bytes.resize(std::size_t(bones.getEncodedSize()));
+        bones.encode(bytes.data(), 0, int(bytes.size()));
+        link.Inject("ELAHA/BONES", bytes.data(), unsigned(bytes.size()));
+      };
+      out << "sandbox demo: flying the example model in-process for " << duration_s << " s\n";
+    } else {
+      hooks.before_tick = [&status](bridge::LcmLink& link, double) { status.Poll(link); };
+      const std::string model_log = (std::filesystem::path(out_dir) / "fly_wing.log").string();
+      model = StartFlyWing(duration_s + 1.0, model_log);
+      out << "sandbox demo: the example model (" << kFlyWingBinary << ", pid " << model
+          << ") flies the wing over LCM for " << duration_s << " s\n";
+    }
+    out << std::flush;
+    const int code = RunLoop(run_args, out, err, hooks);
+    if (model > 0) {
+      kill(model, SIGTERM);
+      waitpid(model, nullptr, 0);
+    }
+    if (code != 0) return code;
+    out << "  status heartbeat: " << status.heard << " ELAHA/STATUS messages heard, last loop rate "
+        << std::fixed << std::setprecision(1) << status.last_rate_hz << " Hz\n";
+    const std::filesystem::path dir = std::filesystem::absolute(out_dir);
+    out << "\nsandbox demo: done. Everything is in " << dir.string() << ":\n"
+        << "  chase.mp4, trailing.mp4, belly.mp4   the cameras as video\n"
+        << "  chase_<tick>.jpg, ...                the frames, indexed by chase.csv, ...\n"
+        << "  belly_<tick>_depth.png               the payload camera's depth (16-bit mm)\n"
+        << "  scans/scanner_<tick>.ply             the face scan every second (red occupied)\n"
+        << "  ticks.csv, ticks.png                 every tick's duration, and its plot\n";
+    if (model > 0) out << "  fly_wing.log                         the example model's output\n";
+    return 0;
+  } catch (const std::exception& error) {
+    err << "sandbox demo: " << error.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace sandbox::app

@@ -1,0 +1,36 @@
+#include "bridge/example_flight.h"
+
+#include <cmath>
+
+namespace sandbox::bridge {
+
+void ExampleFlight(double t, std::int64_t seq, std::int64_t utime, sandbox_msgs::robot_pose_t* pose,
+                   sandbox_msgs::bone_values_t* bones) {
+  // A 120 m circle at 15 m/s, banked into the turn.
+  const double radius = 120.0, speed = 15.0, w = speed / radius, a = w * t;
+  *pose = {};
+  pose->utime = utime;
+  pose->seq = seq;
+  pose->position[0] = radius * std::cos(a);
+  pose->position[1] = radius * std::sin(a);
+  pose->position[2] = 60.0 + 5.0 * std::sin(0.3 * t);
+  const double yaw = a + M_PI / 2, roll = -0.2;  // heading along the circle, banked left
+  const double cy = std::cos(yaw / 2), sy = std::sin(yaw / 2), cr = std::cos(roll / 2),
+               sr = std::sin(roll / 2);
+  pose->orientation[0] = cy * cr;  // Rz(yaw) Rx(roll)
+  pose->orientation[1] = cy * sr;
+  pose->orientation[2] = sy * sr;
+  pose->orientation[3] = sy * cr;
+
+  // Bones: root (2 angles), R1-R10 and L1-L10 (roll, pitch), E1-E3 (pitch).
+  *bones = {};
+  bones->utime = utime;
+  bones->seq = seq;
+  bones->num_values = 45;
+  bones->values.assign(45, 0.0);
+  const double bend = 0.06 * std::sin(1.5 * t);  // up to 3.4 degrees a joint
+  for (int b = 1; b <= 20; ++b) bones->values[std::size_t(2 * b)] = b <= 10 ? bend : -bend;
+  for (int e = 0; e < 3; ++e) bones->values[std::size_t(42 + e)] = 0.2 * std::sin(2.0 * t + e);
+}
+
+}  // namespace sandbox::bridge
