@@ -9,10 +9,14 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <memory>
 #include <sstream>
 #include <thread>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "app/command_line.h"
 #include "app/defaults.h"
@@ -97,6 +101,33 @@ struct StatusListener {
   }
 };
 
+// The last frame listed in DIR/<camera>.csv; empty when none.
+cv::Mat LastFrame(const std::filesystem::path& dir, const std::string& camera) {
+  std::ifstream index(dir / (camera + ".csv"));
+  std::string line, last;
+  while (std::getline(index, line)) last = line;
+  const std::size_t a = last.find(','), b = last.find(',', a + 1), c = last.find(',', b + 1);
+  if (c == std::string::npos) return {};
+  return cv::imread((dir / last.substr(b + 1, c - b - 1)).string());
+}
+
+// One picture of the run: the chase, trailing and belly cameras' last frames
+// and the tick-duration plot, 640 x 480 each.
+void WriteOverview(const std::filesystem::path& dir, const std::string& file) {
+  std::vector<cv::Mat> tiles;
+  for (const char* camera : {"chase", "trailing", "belly"}) tiles.push_back(LastFrame(dir, camera));
+  tiles.push_back(cv::imread((dir / "ticks.png").string()));
+  for (cv::Mat& tile : tiles) {
+    if (tile.empty()) tile = cv::Mat(480, 640, CV_8UC3, cv::Scalar(60, 60, 60));
+    cv::resize(tile, tile, cv::Size(640, 480), 0, 0, cv::INTER_AREA);
+  }
+  cv::Mat top, bottom, all;
+  cv::hconcat(tiles[0], tiles[1], top);
+  cv::hconcat(tiles[2], tiles[3], bottom);
+  cv::vconcat(top, bottom, all);
+  cv::imwrite((dir / file).string(), all);
+}
+
 }  // namespace
 
 int RunDemo(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
@@ -163,26 +194,31 @@ int RunDemo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     } else {
       hooks.before_tick = [&status](bridge::LcmLink& link, double) { status.Poll(link); };
       const std::string model_log = (std::filesystem::path(out_dir) / "fly_wing.log").string();
-      model = StartFlyWing(duration_s + 1.0, model_log);
+      model = StartFlyWing(duration_s, model_log);
       out << "sandbox demo: the example model (" << kFlyWingBinary << ", pid " << model
           << ") flies the wing over LCM for " << duration_s << " s\n";
     }
     out << std::flush;
     const int code = RunLoop(run_args, out, err, hooks);
-    if (model > 0) {
-      kill(model, SIGTERM);
-      waitpid(model, nullptr, 0);
+    if (model > 0) {  // it flies as long as the loop runs: give it a moment to finish
+      int model_status = 0;
+      for (int i = 0; i < 40 && waitpid(model, &model_status, WNOHANG) == 0; ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      }
+      if (kill(model, SIGTERM) == 0) waitpid(model, &model_status, 0);
     }
     if (code != 0) return code;
     out << "  status heartbeat: " << status.heard << " ELAHA/STATUS messages heard, last loop rate "
         << std::fixed << std::setprecision(1) << status.last_rate_hz << " Hz\n";
     const std::filesystem::path dir = std::filesystem::absolute(out_dir);
+    WriteOverview(dir, "overview.jpg");
     out << "\nsandbox demo: done. Everything is in " << dir.string() << ":\n"
         << "  chase.mp4, trailing.mp4, belly.mp4   the cameras as video\n"
         << "  chase_<tick>.jpg, ...                the frames, indexed by chase.csv, ...\n"
         << "  belly_<tick>_depth.png               the payload camera's depth (16-bit mm)\n"
         << "  scans/scanner_<tick>.ply             the face scan every second (red occupied)\n"
-        << "  ticks.csv, ticks.png                 every tick's duration, and its plot\n";
+        << "  ticks.csv, ticks.png                 every tick's duration, and its plot\n"
+        << "  overview.jpg                         the cameras' last frames and the plot\n";
     if (model > 0) out << "  fly_wing.log                         the example model's output\n";
     return 0;
   } catch (const std::exception& error) {
