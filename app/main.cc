@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "app/bench_frames_command.h"
 #include "app/demo_command.h"
 #include "app/info_command.h"
 #include "app/pose_command.h"
@@ -19,6 +20,8 @@ const char* kUsage =
     "commands:\n"
     "  demo [--duration S]     the sample level flown by the example model: frames, video, scans,\n"
     "                          statistics (start here)\n"
+    "  bench-frames            frame durations: {empty, sample level} x {robot, + scanner,\n"
+    "                          + overlay}, 3 runs of 500 frames, a table and plots\n"
     "  info [LEVEL] [--json]   actors, robots, triangles, bounds, load time and memory of a level\n"
     "  pose [LEVEL] --out M.ply  a robot posed from the command line, as a mesh and bone frames\n"
     "  scan [LEVEL] --at X,Y,Z --out F  one sensor once at a pose, as CSV or PLY\n"
@@ -38,6 +41,7 @@ int main(int argc, char** argv) {
   const std::vector<std::string> rest(args.begin() + 1, args.end());
   try {
     if (args[0] == "demo") return sandbox::app::RunDemo(rest, std::cout, std::cerr);
+    if (args[0] == "bench-frames") return sandbox::app::RunBenchFrames(rest, std::cout, std::cerr);
     if (args[0] == "info") return sandbox::app::RunInfo(rest, std::cout, std::cerr);
     if (args[0] == "pose") return sandbox::app::RunPose(rest, std::cout, std::cerr);
     if (args[0] == "scan") return sandbox::app::RunScan(rest, std::cout, std::cerr);

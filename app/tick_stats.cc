@@ -62,9 +62,11 @@ StatsSummary TickStats::Summary() const {
 
 namespace {
 
-std::string Label(double value) {
+// An axis label with as many decimals as the step needs.
+std::string Label(double value, double step = 1.0) {
   char text[32];
-  std::snprintf(text, sizeof(text), value >= 10 || value == 0 ? "%.0f" : "%.1f", value);
+  const int decimals = step >= 1.0 ? 0 : int(std::ceil(-std::log10(step) - 1e-9));
+  std::snprintf(text, sizeof(text), "%.*f", decimals, value);
   return text;
 }
 
@@ -102,7 +104,7 @@ void PlotFrameDurations(const std::vector<PlotSeries>& series, const std::string
   const int font = cv::FONT_HERSHEY_SIMPLEX;
   for (double v = 0; v <= y_max + 1e-9; v += y_step) {
     cv::line(image, {left, Y(v)}, {left + plot_w, Y(v)}, grid, 1);
-    cv::putText(image, Label(v), {8, Y(v) + 5}, font, 0.45, ink, 1, cv::LINE_AA);
+    cv::putText(image, Label(v, y_step), {8, Y(v) + 5}, font, 0.45, ink, 1, cv::LINE_AA);
   }
   for (double i = 0; i < double(frames); i += x_step) {
     cv::line(image, {X(i), top}, {X(i), top + plot_h}, grid, 1);
@@ -113,7 +115,7 @@ void PlotFrameDurations(const std::vector<PlotSeries>& series, const std::string
     for (int x = left; x < left + plot_w; x += 12) {
       cv::line(image, {x, Y(period_ms)}, {std::min(x + 6, left + plot_w), Y(period_ms)}, {0, 0, 220}, 1);
     }
-    cv::putText(image, "period " + Label(period_ms) + " ms", {left + plot_w - 140, Y(period_ms) - 6},
+    cv::putText(image, "period " + Label(period_ms, period_ms >= 1 ? 1.0 : 0.01) + " ms", {left + plot_w - 140, Y(period_ms) - 6},
                 font, 0.45, {0, 0, 220}, 1, cv::LINE_AA);
   }
   for (const PlotSeries& s : series) {
