@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
 
 #include "tests/app/run_sandbox.h"
 #include "tests/test_util.h"
@@ -144,6 +145,28 @@ TEST(RunCommandTest, SlowTicksAreFollowedAtOnceWithoutBunchingAndStatisticsAreWr
   const cv::Mat plot = cv::imread((dir.path() / "ticks.png").string());
   EXPECT_EQ(plot.cols, 1000);
   EXPECT_EQ(plot.rows, 500);
+}
+
+TEST(RunCommandTest, CtrlCFinishesVideosIndexesAndTheSummary) {
+  sandbox::testing::TempDir dir;
+  // SIGINT after 2 s, as Ctrl-C sends it; the run has no duration of its own.
+  const auto run = sandbox::testing::RunCommand(
+      "timeout --preserve-status -s INT 2 " + std::string(SANDBOX_BINARY) +
+      " run --lcm-url memq:// --frames mp4 --out " + dir.path().string());
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find(" ticks in "), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("statistics: "), std::string::npos) << run.out;
+  const long indexed = long(ReadIndex(dir.path() / "chase.csv").size());
+  EXPECT_GE(indexed, 20);
+  cv::VideoCapture video((dir.path() / "chase.mp4").string());
+  ASSERT_TRUE(video.isOpened());
+  long frames = 0;
+  for (cv::Mat frame; video.read(frame);) ++frames;
+  EXPECT_EQ(frames, indexed);  // a finalised video holds every indexed frame
+  std::ifstream ticks(dir.path() / "ticks.csv");
+  long rows = -1;
+  for (std::string line; std::getline(ticks, line);) ++rows;
+  EXPECT_GE(rows, 150);
 }
 
 TEST(RunCommandTest, BadFrameOptionsFailClearly) {

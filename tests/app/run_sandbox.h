@@ -14,16 +14,21 @@ struct CommandRun {
   std::string out;  // stdout and stderr together
 };
 
-// `args` go through the shell (quote as on a command line).
-inline CommandRun RunSandbox(const std::string& args) {
+// A shell command line, stdout and stderr captured together.
+inline CommandRun RunCommand(const std::string& command_line) {
   CommandRun run;
-  const std::string command = std::string(SANDBOX_BINARY) + " " + args + " 2>&1";
+  const std::string command = command_line + " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
   std::array<char, 4096> buffer;
   while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) run.out += buffer.data();
   const int status = pclose(pipe);
   run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   return run;
+}
+
+// `args` go through the shell (quote as on a command line).
+inline CommandRun RunSandbox(const std::string& args) {
+  return RunCommand(std::string(SANDBOX_BINARY) + " " + args);
 }
 
 }  // namespace sandbox::testing
