@@ -576,7 +576,12 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
                                : lockstep   ? std::string("lock-step")
                                             : Format(rate_hz) + " Hz";
       try {
-        PlotFrameDurations({{"tick duration", stats.durations_ms()}},
+        PlotSeries series{stats.ticks_per_point() == 1
+                              ? std::string("tick duration")
+                              : "longest of each " + std::to_string(stats.ticks_per_point()) + " ticks",
+                          stats.PlotPoints()};
+        series.frames_per_value = double(stats.ticks_per_point());
+        PlotFrameDurations({series},
                            level.name + ": " + std::to_string(tick) + " ticks, " + mode,
                            free_running || lockstep ? 0.0 : 1e3 / rate_hz, plot.string());
       } catch (const std::exception& error) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iomanip>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 
@@ -20,6 +21,39 @@ double Quantile(std::vector<double> values, double q) {
   return values[rank];
 }
 
+Histogram::Histogram() : bins_(1000 + 9900 + 9900 + 1, 0) {}
+
+std::size_t Histogram::Bin(double ms) {
+  if (!(ms > 0)) return 0;
+  if (ms < 1.0) return std::size_t(ms * 1000.0);                       // 1 us
+  if (ms < 100.0) return 1000 + std::size_t((ms - 1.0) * 100.0);       // 10 us
+  if (ms < 10000.0) return 10900 + std::size_t(ms - 100.0);            // 1 ms
+  return 20800;                                                        // beyond 10 s
+}
+
+double Histogram::UpperEdge(std::size_t bin) {
+  if (bin < 1000) return double(bin + 1) / 1000.0;
+  if (bin < 10900) return 1.0 + double(bin - 1000 + 1) / 100.0;
+  if (bin < 20800) return 100.0 + double(bin - 10900 + 1);
+  return std::numeric_limits<double>::infinity();
+}
+
+void Histogram::Add(double ms) {
+  ++bins_[std::min(Bin(ms), bins_.size() - 1)];
+  ++count_;
+}
+
+double Histogram::Quantile(double q) const {
+  if (count_ == 0) return 0.0;
+  const std::int64_t rank = std::max<std::int64_t>(1, std::int64_t(std::ceil(q * double(count_))));
+  std::int64_t seen = 0;
+  for (std::size_t bin = 0; bin < bins_.size(); ++bin) {
+    seen += bins_[bin];
+    if (seen >= rank) return UpperEdge(bin);
+  }
+  return UpperEdge(bins_.size() - 1);
+}
+
 TickStats::TickStats(const std::string& csv_path) {
   if (csv_path.empty()) return;
   csv_ = std::make_unique<std::ofstream>(csv_path);
@@ -28,14 +62,34 @@ TickStats::TickStats(const std::string& csv_path) {
 }
 
 void TickStats::Add(const TickRecord& record, bool overrun) {
-  durations_ms_.push_back(record.duration_ms);
-  lateness_ms_.push_back(record.lateness_ms);
+  durations_.Add(record.duration_ms);
+  lateness_.Add(record.lateness_ms);
+  sum_ms_ += record.duration_ms;
+  max_ms_ = std::max(max_ms_, record.duration_ms);
+  max_lateness_ms_ = std::max(max_lateness_ms_, record.lateness_ms);
   overruns_ += overrun;
+  // The plot: blocks of ticks, halved in number when full.
+  partial_max_ = partial_count_ == 0 ? record.duration_ms : std::max(partial_max_, record.duration_ms);
+  if (++partial_count_ == block_) {
+    plot_.push_back(partial_max_);
+    partial_count_ = 0;
+    if (plot_.size() == kMaxPlotPoints) {
+      for (std::size_t i = 0; i < plot_.size() / 2; ++i) plot_[i] = std::max(plot_[2 * i], plot_[2 * i + 1]);
+      plot_.resize(plot_.size() / 2);
+      block_ *= 2;
+    }
+  }
   if (csv_) {
     *csv_ << record.tick << ',' << std::setprecision(6) << record.start_s << ','
           << std::setprecision(4) << record.duration_ms << ',' << record.lateness_ms << ','
           << record.inputs << ',' << record.rays << ',' << record.frames << '\n';
   }
+}
+
+std::vector<double> TickStats::PlotPoints() const {
+  std::vector<double> points = plot_;
+  if (partial_count_ > 0) points.push_back(partial_max_);
+  return points;
 }
 
 bool TickStats::Flush() {
@@ -46,17 +100,16 @@ bool TickStats::Flush() {
 
 StatsSummary TickStats::Summary() const {
   StatsSummary summary;
-  summary.ticks = std::int64_t(durations_ms_.size());
+  summary.ticks = durations_.count();
   summary.overruns = overruns_;
-  if (durations_ms_.empty()) return summary;
-  summary.mean_ms = std::accumulate(durations_ms_.begin(), durations_ms_.end(), 0.0) /
-                    double(durations_ms_.size());
-  summary.p50_ms = Quantile(durations_ms_, 0.5);
-  summary.p99_ms = Quantile(durations_ms_, 0.99);
-  summary.max_ms = *std::max_element(durations_ms_.begin(), durations_ms_.end());
-  summary.lateness_p50_ms = Quantile(lateness_ms_, 0.5);
-  summary.lateness_p99_ms = Quantile(lateness_ms_, 0.99);
-  summary.lateness_max_ms = *std::max_element(lateness_ms_.begin(), lateness_ms_.end());
+  if (summary.ticks == 0) return summary;
+  summary.mean_ms = sum_ms_ / double(summary.ticks);
+  summary.p50_ms = durations_.Quantile(0.5);
+  summary.p99_ms = durations_.Quantile(0.99);
+  summary.max_ms = max_ms_;
+  summary.lateness_p50_ms = lateness_.Quantile(0.5);
+  summary.lateness_p99_ms = lateness_.Quantile(0.99);
+  summary.lateness_max_ms = max_lateness_ms_;
   return summary;
 }
 
@@ -85,10 +138,10 @@ void PlotFrameDurations(const std::vector<PlotSeries>& series, const std::string
                         double period_ms, const std::string& png_path) {
   const int width = 1000, height = 500, left = 70, right = 20, top = 40, bottom = 50;
   cv::Mat image(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
-  std::size_t frames = 1;
+  double frames = 1;
   std::vector<double> all;
   for (const PlotSeries& s : series) {
-    frames = std::max(frames, s.values.size());
+    frames = std::max(frames, double(s.values.size()) * s.frames_per_value);
     all.insert(all.end(), s.values.begin(), s.values.end());
   }
   // The y axis reaches the largest value (a spike stays visible) or twice the period.
@@ -96,9 +149,9 @@ void PlotFrameDurations(const std::vector<PlotSeries>& series, const std::string
                            period_ms * 1.2, 1e-3});
   const double y_step = NiceStep(y_max);
   y_max = std::ceil(y_max / y_step) * y_step;
-  const double x_step = NiceStep(double(frames));
+  const double x_step = NiceStep(frames);
   const int plot_w = width - left - right, plot_h = height - top - bottom;
-  auto X = [&](double i) { return left + int(std::lround(i / double(std::max<std::size_t>(frames - 1, 1)) * plot_w)); };
+  auto X = [&](double i) { return left + int(std::lround(i / std::max(frames - 1.0, 1.0) * plot_w)); };
   auto Y = [&](double v) { return top + plot_h - int(std::lround(std::min(v, y_max) / y_max * plot_h)); };
   const cv::Scalar grid(225, 225, 225), ink(40, 40, 40);
   const int font = cv::FONT_HERSHEY_SIMPLEX;
@@ -106,7 +159,7 @@ void PlotFrameDurations(const std::vector<PlotSeries>& series, const std::string
     cv::line(image, {left, Y(v)}, {left + plot_w, Y(v)}, grid, 1);
     cv::putText(image, Label(v, y_step), {8, Y(v) + 5}, font, 0.45, ink, 1, cv::LINE_AA);
   }
-  for (double i = 0; i < double(frames); i += x_step) {
+  for (double i = 0; i < frames; i += x_step) {
     cv::line(image, {X(i), top}, {X(i), top + plot_h}, grid, 1);
     cv::putText(image, Label(i), {X(i) - 12, top + plot_h + 20}, font, 0.45, ink, 1, cv::LINE_AA);
   }
@@ -120,7 +173,9 @@ void PlotFrameDurations(const std::vector<PlotSeries>& series, const std::string
   }
   for (const PlotSeries& s : series) {
     std::vector<cv::Point> points;
-    for (std::size_t i = 0; i < s.values.size(); ++i) points.push_back({X(double(i)), Y(s.values[i])});
+    for (std::size_t i = 0; i < s.values.size(); ++i) {
+      points.push_back({X(double(i) * s.frames_per_value), Y(s.values[i])});
+    }
     if (points.size() >= 2) cv::polylines(image, points, false, cv::Scalar(s.b, s.g, s.r), 1, cv::LINE_AA);
   }
   for (std::size_t k = 0; k < series.size(); ++k) {

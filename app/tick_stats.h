@@ -2,7 +2,10 @@
 // Frame statistics of the loop: every tick's start, duration, lateness and
 // what it did, written as CSV; a summary (mean, p50, p99, max, overruns); and
 // a plot of tick duration against tick number drawn with OpenCV, like the
-// evaluation plots of a report.
+// evaluation plots of a report. Memory stays bounded however long the run:
+// quantiles come from histograms (1 us bins to 1 ms, 10 us to 100 ms, 1 ms
+// to 10 s; a quantile is its bin's upper edge) and the plot keeps at most
+// 20,000 points, each the longest of a block of ticks.
 
 #include <cstdint>
 #include <fstream>
@@ -32,6 +35,21 @@ struct StatsSummary {
 // The value at quantile q (0..1) of `values` (nearest rank); 0 when empty.
 double Quantile(std::vector<double> values, double q);
 
+// Counts of values in bins that widen with the value (see above).
+class Histogram {
+ public:
+  Histogram();
+  void Add(double ms);
+  double Quantile(double q) const;  // nearest rank, the bin's upper edge; 0 when empty
+  std::int64_t count() const { return count_; }
+
+ private:
+  static std::size_t Bin(double ms);
+  static double UpperEdge(std::size_t bin);
+  std::vector<std::int64_t> bins_;
+  std::int64_t count_{0};
+};
+
 class TickStats {
  public:
   // `csv_path` empty: kept in memory only. Throws std::runtime_error naming
@@ -42,13 +60,23 @@ class TickStats {
   StatsSummary Summary() const;
   // Flushes the CSV; false when some of it could not be written.
   bool Flush();
-  const std::vector<double>& durations_ms() const { return durations_ms_; }
   std::int64_t overruns() const { return overruns_; }
+  // Tick durations for the plot: one point per `ticks_per_point` ticks (the
+  // longest of them), the last block possibly partial.
+  std::vector<double> PlotPoints() const;
+  std::int64_t ticks_per_point() const { return block_; }
+
+  static constexpr std::size_t kMaxPlotPoints = 20000;
 
  private:
   std::unique_ptr<std::ofstream> csv_;
-  std::vector<double> durations_ms_, lateness_ms_;
+  Histogram durations_, lateness_;
+  double sum_ms_{0}, max_ms_{0}, max_lateness_ms_{0};
   std::int64_t overruns_{0};
+  std::vector<double> plot_;      // completed blocks
+  std::int64_t block_{1};         // ticks per plot point
+  double partial_max_{0};         // the block being filled
+  std::int64_t partial_count_{0};
 };
 
 // One series of a plot: values against their index, in a colour (B, G, R).
@@ -56,6 +84,7 @@ struct PlotSeries {
   std::string label;
   std::vector<double> values;
   int b{200}, g{80}, r{30};
+  double frames_per_value{1.0};  // x of value i is i * frames_per_value
 };
 
 // Draws the series as lines against frame number with axes, ticks, a legend
