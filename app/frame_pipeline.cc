@@ -37,6 +37,10 @@ FramePipeline::FramePipeline(const scene::Level& level, const FramePipelineConfi
   }
   render_thread_ = std::thread([this] { RenderLoop(); });
   write_thread_ = std::thread([this] { WriteLoop(); });
+  // The context and the level's upload (tens of ms to seconds) before the
+  // first tick, so that the first frames are not dropped while they happen.
+  std::unique_lock<std::mutex> lock(mutex_);
+  room_.wait(lock, [&] { return render_ready_; });
 }
 
 FramePipeline::~FramePipeline() { Finish(); }
@@ -86,6 +90,11 @@ void FramePipeline::RenderLoop() {
   } catch (const std::exception& e) {
     Fail(std::string("cannot render: ") + e.what());
   }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    render_ready_ = true;
+  }
+  room_.notify_all();
   for (;;) {
     RenderJob job;
     {

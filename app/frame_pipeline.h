@@ -60,8 +60,9 @@ struct RenderJob {
 
 class FramePipeline {
  public:
-  // Starts both threads; the renderer is made on the render thread. Throws
-  // std::runtime_error when DIR cannot be created.
+  // Starts both threads and returns once the renderer, made on the render
+  // thread, has the level (or has failed: frames are then counted as failed).
+  // Throws std::runtime_error when DIR cannot be created.
   FramePipeline(const scene::Level& level, const FramePipelineConfig& config);
   // Finishes what is queued, closes videos and indexes (also done by the destructor).
   void Finish();
@@ -100,6 +101,7 @@ class FramePipeline {
   std::deque<Encoded> write_queue_;
   bool stopping_{false};
   bool render_done_{false};  // the render thread has finished: the writer may stop
+  bool render_ready_{false};  // the renderer has the level (or could not be made)
   std::atomic<std::int64_t> rendered_{0}, written_{0}, dropped_render_{0}, dropped_write_{0},
       failed_{0};
   std::string first_error_;
