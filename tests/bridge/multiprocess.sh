@@ -7,7 +7,9 @@
 #   multiprocess.sh SANDBOX FLY_WING FACE_CHECK LEVEL
 set -euo pipefail
 sandbox=$1 fly_wing=$2 face_check=$3 level=$4
-"$sandbox" run "$level" --duration 5 > /tmp/sandbox-multiprocess-run.log &
+run_log=$(mktemp /tmp/sandbox-multiprocess-run-XXXXXX.log)
+trap 'rm -f "$run_log"' EXIT
+"$sandbox" run "$level" --duration 5 > "$run_log" &
 run_pid=$!
 "$fly_wing" --duration 4 --rate 200 > /dev/null &
 fly_pid=$!
@@ -15,5 +17,5 @@ sleep 1  # let the first external poses arrive
 "$face_check" "$level" --faces 24 --seconds 3
 status=$?
 wait "$fly_pid" "$run_pid"
-cat /tmp/sandbox-multiprocess-run.log
+cat "$run_log"
 exit "$status"

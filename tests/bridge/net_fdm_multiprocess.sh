@@ -6,7 +6,9 @@
 #   net_fdm_multiprocess.sh SANDBOX SEND_NET_FDM STATE_CHECK LEVEL
 set -euo pipefail
 sandbox=$1 sender=$2 check=$3 level=$4
-"$sandbox" run "$level" --duration 4 > /tmp/sandbox-net-fdm-run.log &
+run_log=$(mktemp /tmp/sandbox-net-fdm-run-XXXXXX.log)
+trap 'rm -f "$run_log"' EXIT
+"$sandbox" run "$level" --duration 4 > "$run_log" &
 run_pid=$!
 sleep 0.5
 "$sender" --hover --duration 3 --rate 100 > /dev/null &
@@ -16,5 +18,5 @@ send_pid=$!
 "$check" ELAHA 0 30.883 100 0.05 --seconds 2.5
 status=$?
 wait "$send_pid" "$run_pid"
-cat /tmp/sandbox-net-fdm-run.log
+cat "$run_log"
 exit "$status"

@@ -6,8 +6,10 @@
 #   octave.sh SANDBOX STATE_CHECK LEVEL REPO
 set -euo pipefail
 sandbox=$1 check=$2 level=$3 repo=$4
+run_log=$(mktemp /tmp/sandbox-octave-run-XXXXXX.log)
+trap 'rm -f "$run_log"' EXIT
 command -v octave > /dev/null || { echo "octave is not installed: skipped"; exit 77; }
-"$sandbox" run "$level" --duration 12 > /tmp/sandbox-octave-run.log &
+"$sandbox" run "$level" --duration 12 > "$run_log" &
 run_pid=$!
 (cd "$repo" && octave --no-gui --quiet examples/fly_wing.m 9 hover) &
 octave_pid=$!
@@ -15,5 +17,5 @@ octave_pid=$!
 "$check" ELAHA 12 34 56 0.001 --seconds 10
 status=$?
 wait "$octave_pid" "$run_pid"
-cat /tmp/sandbox-octave-run.log
+cat "$run_log"
 exit "$status"
