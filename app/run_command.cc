@@ -196,19 +196,19 @@ void RunDueSensors(double t, std::int64_t tick, std::int64_t now, std::vector<Se
       const sensors::FaceScanner scanner(*face);
       if (run.face_scan.n == 0) run.face_scan = scanner.EmptyScan();
       scanner.Scan(world, *caster, filter, X_WS, tick, &run.face_scan);
-      robot.outputs->PublishFaces(run.face_scan, tick, robot.input, now);
+      robot.outputs->PublishFaces(run.face_scan, tick, robot.input, now, run.mounted->spec.channel);
     } else if (const auto* ground = std::get_if<sensors::GroundScannerConfig>(&run.mounted->config)) {
       sensors::HeightMap map;
       sensors::GroundScanner(*ground).Scan(world, *caster, filter, X_WS.translation(), &map);
-      robot.outputs->PublishGround(map, robot.input, now);
+      robot.outputs->PublishGround(map, robot.input, now, run.mounted->spec.channel);
     } else if (const auto* lidar = std::get_if<sensors::LidarConfig>(&run.mounted->config)) {
       sensors::LidarScan scan;
       sensors::Lidar(*lidar).Sweep(world, *caster, filter, X_WS, X_WS, &scan);
-      robot.outputs->PublishLidar(scan, robot.input, now);
+      robot.outputs->PublishLidar(scan, robot.input, now, run.mounted->spec.channel);
     } else if (const auto* ray = std::get_if<sensors::RangeSensorConfig>(&run.mounted->config)) {
       robot.outputs->PublishRange(run.mounted->spec.name,
                                   sensors::MeasureRange(*ray, world, *caster, filter, X_WS),
-                                  robot.input, now);
+                                  robot.input, now, run.mounted->spec.channel);
     }
   }
 }
@@ -260,6 +260,7 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
 
     const scene::Level level = scene::LoadLevel(parsed->level.value_or(kDefaultLevel));
     const std::vector<sensors::MountedSensor> mounted = sensors::MakeRobotSensors(level);
+    bridge::CheckOutputChannels(level);
     scene::CollisionWorld world(level);
     const std::string replay_file = parsed->Value("--replay");
     const bool replay = !replay_file.empty();

@@ -1,5 +1,7 @@
 #include "bridge/outputs.h"
 
+#include <map>
+
 #include "sandbox_msgs/ground_map_t.hpp"
 #include "sandbox_msgs/lidar_scan_t.hpp"
 #include "sandbox_msgs/range_t.hpp"
@@ -46,8 +48,31 @@ void RobotOutputs::Send(const std::string& topic, const Message& message) {
   if (link_.Publish(prefix_ + topic, buffer_.data(), unsigned(buffer_.size()))) ++published_;
 }
 
+std::string OutputChannel(const scene::SensorSpec& spec) {
+  if (!spec.channel.empty()) return spec.channel;
+  if (spec.type == "face") return "SCAN_FACE";
+  if (spec.type == "ground") return "GROUND";
+  if (spec.type == "lidar") return "LIDAR";
+  return "RANGE";
+}
+
+void CheckOutputChannels(const scene::Level& level) {
+  for (const scene::RobotModel& robot : level.robots) {
+    std::map<std::string, const scene::SensorSpec*> used;
+    for (const scene::SensorSpec& spec : robot.sensors) {
+      const std::string channel = OutputChannel(spec);
+      const auto [it, fresh] = used.emplace(channel, &spec);
+      if (!fresh && !(spec.type == "ray" && it->second->type == "ray")) {
+        throw scene::LevelError(spec.Where() + "publishes on " + channel + " like sensor '" +
+                                it->second->name + "'; give one of them its own 'channel'");
+      }
+    }
+  }
+}
+
 void RobotOutputs::PublishFaces(const sensors::FaceScan& scan, std::int64_t tick,
-                                const InputTag& input, std::int64_t now_utime) {
+                                const InputTag& input, std::int64_t now_utime,
+                                const std::string& channel) {
   for (int f = 0; f < 6; ++f) {
     const sensors::ScanFace& face = scan.faces[std::size_t(f)];
     if (face.tick != tick) continue;
@@ -66,12 +91,12 @@ void RobotOutputs::PublishFaces(const sensors::FaceScan& scan, std::int64_t tick
     message.occupancy = face.occupancy;
     message.num_xyz = int(3 * n);
     Offsets(face.points_W, p, &message.xyz);
-    Send("SCAN_FACE", message);
+    Send(channel.empty() ? "SCAN_FACE" : channel, message);
   }
 }
 
 void RobotOutputs::PublishGround(const sensors::HeightMap& map, const InputTag& input,
-                                 std::int64_t now_utime) {
+                                 std::int64_t now_utime, const std::string& channel) {
   sandbox_msgs::ground_map_t message{};
   Stamp(now_utime, seq_++, input, &message);
   message.n = map.n;
@@ -80,11 +105,11 @@ void RobotOutputs::PublishGround(const sensors::HeightMap& map, const InputTag& 
   message.origin_z = 0.0;
   message.num_points = int(map.height_m.size());
   message.height.assign(map.height_m.begin(), map.height_m.end());
-  Send("GROUND", message);
+  Send(channel.empty() ? "GROUND" : channel, message);
 }
 
 void RobotOutputs::PublishLidar(const sensors::LidarScan& scan, const InputTag& input,
-                                std::int64_t now_utime) {
+                                std::int64_t now_utime, const std::string& channel) {
   sandbox_msgs::lidar_scan_t message{};
   Stamp(now_utime, seq_++, input, &message);
   message.channels = scan.channels;
@@ -98,11 +123,12 @@ void RobotOutputs::PublishLidar(const sensors::LidarScan& scan, const InputTag& 
   message.num_xyz = int(3 * n);
   Offsets(scan.points_W, origin, &message.xyz);
   message.time_s.assign(scan.time_s.begin(), scan.time_s.end());
-  Send("LIDAR", message);
+  Send(channel.empty() ? "LIDAR" : channel, message);
 }
 
 void RobotOutputs::PublishRange(const std::string& sensor, const sensors::RangeReading& reading,
-                                const InputTag& input, std::int64_t now_utime) {
+                                const InputTag& input, std::int64_t now_utime,
+                                const std::string& channel) {
   sandbox_msgs::range_t message{};
   Stamp(now_utime, seq_++, input, &message);
   message.sensor = sensor;
@@ -115,7 +141,7 @@ void RobotOutputs::PublishRange(const std::string& sensor, const sensors::RangeR
   message.hit = reading.hit ? 1 : 0;
   message.range_m = reading.range_m;
   message.body = reading.body;
-  Send("RANGE", message);
+  Send(channel.empty() ? "RANGE" : channel, message);
 }
 
 void RobotOutputs::PublishState(const scene::RobotState& state,

@@ -31,6 +31,14 @@ struct ChannelStatus {
   std::string last_reject_reason;
 };
 
+// The channel (after "<ROBOT>/") a sensor publishes on: its `channel`, or
+// SCAN_FACE, GROUND, LIDAR, RANGE by type.
+std::string OutputChannel(const scene::SensorSpec& spec);
+
+// Throws scene::LevelError when two sensors of one robot would publish on one
+// channel (range sensors may share: their messages carry the sensor's name).
+void CheckOutputChannels(const scene::Level& level);
+
 class RobotOutputs {
  public:
   // Publishes on <channel_prefix>/...; STATE's pose in `state_translation`'s
@@ -38,14 +46,17 @@ class RobotOutputs {
   RobotOutputs(LcmLink& link, std::string channel_prefix,
                const Translation& state_translation = {});
 
-  // Publishes the faces of `scan` scanned at `tick` (the ones this tick refreshed).
+  // Publishes the faces of `scan` scanned at `tick` (the ones this tick
+  // refreshed). `channel`: after the prefix; empty: SCAN_FACE (GROUND, LIDAR).
   void PublishFaces(const sensors::FaceScan& scan, std::int64_t tick, const InputTag& input,
-                    std::int64_t now_utime);
-  void PublishGround(const sensors::HeightMap& map, const InputTag& input, std::int64_t now_utime);
-  void PublishLidar(const sensors::LidarScan& scan, const InputTag& input, std::int64_t now_utime);
+                    std::int64_t now_utime, const std::string& channel = "");
+  void PublishGround(const sensors::HeightMap& map, const InputTag& input, std::int64_t now_utime,
+                     const std::string& channel = "");
+  void PublishLidar(const sensors::LidarScan& scan, const InputTag& input, std::int64_t now_utime,
+                    const std::string& channel = "");
   // One single-ray sensor's reading; `sensor` tells several on one robot apart.
   void PublishRange(const std::string& sensor, const sensors::RangeReading& reading,
-                    const InputTag& input, std::int64_t now_utime);
+                    const InputTag& input, std::int64_t now_utime, const std::string& channel = "");
   // The robot pose and bones in use, and the face scanner's face frames in
   // the robot frame (identity rotations for a body-aligned box at the origin).
   void PublishState(const scene::RobotState& state, const std::vector<double>& bone_values,

@@ -258,13 +258,20 @@ SensorSpec ParseSensor(const fs::path& file, const toml::table& table, int index
     read.Fail(nullptr, "a sensor takes position and rpy_deg or quaternion_wxyz only");
   }
   sensor.X_MS = placement.pose();
+  if (const auto channel = read.String("channel")) {
+    if (kind == "camera") read.Fail(read.Find("channel"), "a camera publishes no channel");
+    if (channel->empty() || channel->find_first_of(" \t\n") != std::string::npos) {
+      read.Fail(read.Find("channel"), "'channel' must be a name without spaces, got '" + *channel + "'");
+    }
+    sensor.channel = *channel;
+  }
   if (const auto rate = read.Number("rate_hz")) {
     if (*rate <= 0.0) read.Fail(read.Find("rate_hz"), "'rate_hz' must be positive");
     sensor.rate_hz = *rate;
   }
   // The rest, as given.
   sensor.settings = ReadSettings(file, table, read,
-                                 {"name", "type", "mount", "position", "rpy_deg", "rate_hz",
+                                 {"name", "type", "mount", "position", "rpy_deg", "rate_hz", "channel",
                                   "quaternion_wxyz", "scale", "up", "unit_scale"},
                                  kind + " '" + sensor.name + "'");
   return sensor;

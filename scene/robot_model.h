@@ -36,6 +36,7 @@ struct SensorSpec {
   int mount_node{-1};  // resolved by LoadRobotModel; -1: the body frame
   Eigen::Isometry3d X_MS{Eigen::Isometry3d::Identity()};  // sensor in its mount's frame
   double rate_hz{0.0};                                    // 0: every tick
+  std::string channel;  // its output channel after "<ROBOT>/"; empty: the type's own
   SettingsTable settings;                                 // the type's own settings, as given
 
   // "level.toml:12: sensor 'scanner': " for messages.

@@ -9,6 +9,7 @@
 #include "sandbox_msgs/range_t.hpp"
 #include "scene/collision_world.h"
 #include "scene/level.h"
+#include "sensors/face_scanner.h"
 #include "sensors/range_sensor.h"
 #include "tests/test_util.h"
 
@@ -52,6 +53,67 @@ TEST(RobotOutputsTest, RangeReadingArrivesOnItsChannelWithItsSensorAndInput) {
   EXPECT_NEAR(message.point[2], 500.0 - message.range_m, 1e-3);
   EXPECT_GT(message.normal[2], 0.0);  // the ground faces up
   EXPECT_EQ(outputs.published(), 1);
+}
+
+// The sample level's wing with extra [[robot.sensor]] tables appended.
+scene::Level WingWith(testing::TempDir& dir, const std::string& sensors) {
+  const std::string wing =
+      (std::filesystem::path(SANDBOX_SOURCE_DIR) / "assets/robots/generated/flying_wing.gltf").string();
+  return scene::LoadLevel(dir.Write("level.toml", "[[robot]]\nname = \"W\"\nfile = \"" + wing +
+                                                      "\"\nbones = [\"root\"]\n" + sensors));
+}
+
+TEST(RobotOutputsTest, TwoSensorsOfATypeNeedTheirOwnChannels) {
+  testing::TempDir dir;
+  const std::string face = "[[robot.sensor]]\nname = \"nose\"\ntype = \"face\"\n"
+                           "[[robot.sensor]]\nname = \"tail\"\ntype = \"face\"\n";
+  try {
+    CheckOutputChannels(WingWith(dir, face));
+    ADD_FAILURE() << "two face scanners on one channel were accepted";
+  } catch (const scene::LevelError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("sensor 'tail': publishes on SCAN_FACE like sensor 'nose'; give one of "
+                           "them its own 'channel'"),
+              std::string::npos)
+        << message;
+  }
+  // With a channel of its own the second scanner publishes there.
+  const scene::Level level = WingWith(dir, face + "channel = \"SCAN_FACE_TAIL\"\n"
+                                                  "[[robot.sensor]]\nname = \"a1\"\ntype = \"ray\"\n"
+                                                  "[[robot.sensor]]\nname = \"a2\"\ntype = \"ray\"\n");
+  EXPECT_NO_THROW(CheckOutputChannels(level));  // range sensors share RANGE: they say their names
+  EXPECT_EQ(OutputChannel(level.robots[0].sensors[1]), "SCAN_FACE_TAIL");
+  LcmLink link("memq://");
+  LatestInput own(link, "W/SCAN_FACE_TAIL"), shared(link, "W/SCAN_FACE");
+  RobotOutputs outputs(link, "W");
+  sensors::FaceScan scan;
+  scan.n = 1;
+  scan.faces[2].tick = 5;
+  scan.faces[2].occupancy = {sensors::kFree};
+  scan.faces[2].points_W = {Eigen::Vector3d(1, 2, 3)};
+  outputs.PublishFaces(scan, 5, {}, 0, OutputChannel(level.robots[0].sensors[1]));
+  link.Drain();
+  EXPECT_NE(own.TakeNewest(), nullptr);
+  EXPECT_EQ(shared.TakeNewest(), nullptr);
+}
+
+TEST(RobotOutputsTest, ChannelMistakesAreNamed) {
+  testing::TempDir dir;
+  try {
+    WingWith(dir, "[[robot.camera]]\nname = \"c\"\ntype = \"chase\"\nchannel = \"CAM\"\n");
+    ADD_FAILURE() << "a camera channel was accepted";
+  } catch (const scene::LevelError& error) {
+    EXPECT_NE(std::string(error.what()).find("camera 'c': a camera publishes no channel"), std::string::npos)
+        << error.what();
+  }
+  try {
+    WingWith(dir, "[[robot.sensor]]\nname = \"s\"\ntype = \"face\"\nchannel = \"MY SCAN\"\n");
+    ADD_FAILURE() << "a channel with a space was accepted";
+  } catch (const scene::LevelError& error) {
+    EXPECT_NE(std::string(error.what()).find("'channel' must be a name without spaces, got 'MY SCAN'"),
+              std::string::npos)
+        << error.what();
+  }
 }
 
 }  // namespace
