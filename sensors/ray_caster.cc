@@ -1,5 +1,7 @@
 #include "sensors/ray_caster.h"
 
+#include <chrono>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -366,10 +368,11 @@ RayCaster::~RayCaster() {
 void RayCaster::WorkerLoop() {
   std::uint64_t seen = 0;
   while (true) {
-    // Wait for a new job: spin briefly (jobs come every tick), then sleep.
-    for (int spin = 0; spin < 20000 && generation_.load(std::memory_order_acquire) == seen &&
-                       !stop_.load(std::memory_order_relaxed);
-         ++spin) {
+    // Wait for a new job: spin briefly (back-to-back casts, a free-running
+    // loop), then sleep, so that a 100 Hz loop does not keep a core busy.
+    const auto spin_until = std::chrono::steady_clock::now() + std::chrono::microseconds(200);
+    while (generation_.load(std::memory_order_acquire) == seen &&
+           !stop_.load(std::memory_order_relaxed) && std::chrono::steady_clock::now() < spin_until) {
       std::this_thread::yield();
     }
     if (generation_.load(std::memory_order_acquire) == seen) {
