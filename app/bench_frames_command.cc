@@ -141,7 +141,7 @@ int RunBenchFrames(const std::vector<std::string>& args, std::ostream& out, std:
               scanner.Scan(world, caster, filter, scanner_mount->Pose(robot), i + warm_up, &scan);
               outputs.PublishFaces(scan, i + warm_up, {i + warm_up, 0}, 0);
             }
-            outputs.PublishState(robot, {}, {i + warm_up, 0}, 0);
+            outputs.PublishState(robot, {i + warm_up, 0}, 0);
             sensors::CameraView view = chase_camera.view;
             view.X_WC = chase.Update(robot.pose(), 0.01);
             sensors::Overlay overlay;

@@ -88,7 +88,6 @@ struct RobotRun {
   std::unique_ptr<bridge::DoublesInput> doubles;
   std::unique_ptr<bridge::RobotOutputs> outputs;
   bridge::InputTag input;
-  std::vector<double> bone_values;
 
   // Every input's counters: the LCM channels, then the UDP sockets.
   std::vector<bridge::ChannelStatus> Channels(std::int64_t now_utime) const {
@@ -311,7 +310,6 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
             std::make_unique<bridge::DoublesInput>(robots[r].config, level.robots[r]);
         robots[r].doubles->set_log(&reject_log);
       }
-      robots[r].bone_values.assign(std::size_t(level.robots[r].num_values), 0.0);
     }
     // Cameras: rendered off the loop, into --out and/or the live view.
     const std::vector<sensors::MountedCamera> cameras = sensors::MakeRobotCameras(level);
@@ -456,7 +454,7 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       // 3-4. Sensors that are due, and their outputs.
       RunDueSensors(t, tick, now, &sensor_runs, &robots, world, &caster);
       for (RobotRun& robot : robots) {
-        robot.outputs->PublishState(*robot.state, robot.bone_values, robot.input, now);
+        robot.outputs->PublishState(*robot.state, robot.input, now);
       }
       if (scans_every_s > 0.0 && t >= next_scan_file_s) {
         next_scan_file_s = std::max(next_scan_file_s + scans_every_s, t);

@@ -145,7 +145,7 @@ void RobotOutputs::PublishRange(const std::string& sensor, const sensors::RangeR
 }
 
 void RobotOutputs::PublishState(const scene::RobotState& state,
-                                const std::vector<double>& bone_values, const InputTag& input,
+                                const InputTag& input,
                                 std::int64_t now_utime) {
   sandbox_msgs::robot_state_t message{};
   Stamp(now_utime, seq_++, input, &message);
@@ -155,8 +155,8 @@ void RobotOutputs::PublishState(const scene::RobotState& state,
   for (int k = 0; k < 3; ++k) message.position[k] = p[k];
   message.orientation[0] = q.w(), message.orientation[1] = q.x();
   message.orientation[2] = q.y(), message.orientation[3] = q.z();
-  message.num_values = int(bone_values.size());
-  message.bone_values = bone_values;
+  message.num_values = int(state.bone_values().size());
+  message.bone_values = state.bone_values();
   // Face frames: at the robot origin, face f's axis along the robot's axis f.
   for (int f = 0; f < 6; ++f) {
     message.face_orientations[4 * f] = 1.0;

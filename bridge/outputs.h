@@ -59,8 +59,7 @@ class RobotOutputs {
                     const InputTag& input, std::int64_t now_utime, const std::string& channel = "");
   // The robot pose and bones in use, and the face scanner's face frames in
   // the robot frame (identity rotations for a body-aligned box at the origin).
-  void PublishState(const scene::RobotState& state, const std::vector<double>& bone_values,
-                    const InputTag& input, std::int64_t now_utime);
+  void PublishState(const scene::RobotState& state, const InputTag& input, std::int64_t now_utime);
   void PublishStatus(double loop_rate_hz, std::int64_t ticks, std::int64_t overruns,
                      const std::vector<ChannelStatus>& channels, std::int64_t now_utime);
 

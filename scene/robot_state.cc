@@ -1,5 +1,6 @@
 #include "scene/robot_state.h"
 
+#include <algorithm>
 #include <cmath>
 
 #if defined(__SSE2__)
@@ -17,6 +18,10 @@ RobotState::RobotState(const RobotModel& model)
       X_BN_(model.nodes.size(), Eigen::Affine3d::Identity()),
       skin_(model.joints.size()),
       rigid_(model.joints.size()) {
+  values_.assign(static_cast<std::size_t>(model.num_values), 0.0);
+  for (const Bone& bone : model.bones) {
+    if (bone.rotation == BoneRotation::kQuaternion) values_[static_cast<std::size_t>(bone.first_value)] = 1.0;
+  }
   for (const SkinnedMesh& mesh : model.meshes) {
     positions_B_.emplace_back(mesh.bind.positions_A.size());
     normals_B_.emplace_back(mesh.bind.normals_A.size());
@@ -60,6 +65,7 @@ bool RobotState::SetBone(int bone, const double* values, int num_values) {
     }
   }
   rotation_[static_cast<std::size_t>(b.node)] = q;
+  std::copy(values, values + num_values, values_.begin() + b.first_value);
   return true;
 }
 
@@ -69,11 +75,13 @@ bool RobotState::SetBones(const std::vector<double>& values) {
   }
   // Check everything first, so that a bad bone leaves every bone as it was.
   const std::vector<Eigen::Quaterniond> before = rotation_;
+  const std::vector<double> values_before = values_;
   for (std::size_t b = 0; b < model_->bones.size(); ++b) {
     const Bone& bone = model_->bones[b];
     if (!SetBone(static_cast<int>(b), &values[static_cast<std::size_t>(bone.first_value)],
                  bone.num_values)) {
       rotation_ = before;
+      values_ = values_before;
       return false;
     }
   }

@@ -31,6 +31,9 @@ class RobotState {
 
   const RobotModel& model() const { return *model_; }
   const Eigen::Isometry3d& pose() const { return X_WB_; }
+  // The bone values in use, flat in bone-map order (at rest: 0 for angles,
+  // (1, 0, 0, 0) for quaternions).
+  const std::vector<double>& bone_values() const { return values_; }
   // Node poses in the robot body frame B (after Update()).
   const std::vector<Eigen::Affine3d>& node_poses_B() const { return X_BN_; }
   Eigen::Affine3d node_pose_W(int node) const;
@@ -49,6 +52,7 @@ class RobotState {
   const RobotModel* model_;
   Eigen::Isometry3d X_WB_;
   std::vector<Eigen::Quaterniond> rotation_;  // per node, relative to its rest transform
+  std::vector<double> values_;                // the bone values that set rotation_
   std::vector<Eigen::Affine3d> X_BN_;
   std::vector<Eigen::Matrix<float, 3, 4>> skin_;  // per joint: X_BN * offset
   std::vector<bool> rigid_;                       // per joint: skin_ keeps lengths

@@ -5,8 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "bridge/lcm_link.h"
 #include "sandbox_msgs/range_t.hpp"
+#include "sandbox_msgs/robot_state_t.hpp"
 #include "scene/collision_world.h"
 #include "scene/level.h"
 #include "sensors/face_scanner.h"
@@ -61,6 +64,31 @@ scene::Level WingWith(testing::TempDir& dir, const std::string& sensors) {
       (std::filesystem::path(SANDBOX_SOURCE_DIR) / "assets/robots/generated/flying_wing.gltf").string();
   return scene::LoadLevel(dir.Write("level.toml", "[[robot]]\nname = \"W\"\nfile = \"" + wing +
                                                       "\"\nbones = [\"root\"]\n" + sensors));
+}
+
+TEST(RobotOutputsTest, StateEchoesThePoseAndTheBoneValuesInUse) {
+  const scene::Level level = scene::LoadLevel(testing::SampleLevel());
+  scene::RobotState wing(level.robots[0]);
+  std::vector<double> values(std::size_t(level.robots[0].num_values), 0.0);
+  for (std::size_t i = 0; i < values.size(); ++i) values[i] = 0.001 * double(i);
+  ASSERT_TRUE(wing.SetBones(values));
+  values[3] = std::nan("");
+  EXPECT_FALSE(wing.SetBones(values));  // rejected: the echo keeps the last good values
+  wing.Update();
+  LcmLink link("memq://");
+  LatestInput subscriber(link, "ELAHA/STATE");
+  RobotOutputs outputs(link, "ELAHA");
+  outputs.PublishState(wing, InputTag{7, 700}, 1000);
+  link.Drain();
+  const std::vector<std::uint8_t>* bytes = subscriber.TakeNewest();
+  ASSERT_NE(bytes, nullptr);
+  sandbox_msgs::robot_state_t message;
+  ASSERT_EQ(message.decode(bytes->data(), 0, int(bytes->size())), int(bytes->size()));
+  ASSERT_EQ(message.num_values, level.robots[0].num_values);
+  for (int i = 0; i < message.num_values; ++i) {
+    EXPECT_EQ(message.bone_values[std::size_t(i)], 0.001 * i) << i;
+  }
+  EXPECT_EQ(message.input_seq, 7);
 }
 
 TEST(RobotOutputsTest, TwoSensorsOfATypeNeedTheirOwnChannels) {

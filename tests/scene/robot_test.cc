@@ -189,6 +189,10 @@ TEST_F(RobotTest, BadRunTimeUpdatesAreRejectedCountedAndChangeNothing) {
   EXPECT_FALSE(state.SetPose(sheared));
   state.Update();
   EXPECT_TRUE(state.node_pose_W(arm.FindNode("tool")).isApprox(before));
+  // The values in use are the last good ones: bone 2 (one angle, like every arm bone) at 0.5.
+  std::vector<double> in_use(7, 0.0);
+  in_use[2] = 0.5;
+  EXPECT_EQ(state.bone_values(), in_use);
   const auto& rejected = state.rejected();
   EXPECT_EQ(rejected.at("non-finite bone value"), 2);
   EXPECT_EQ(rejected.at("bone index out of range"), 2);
@@ -204,10 +208,12 @@ TEST_F(RobotTest, QuaternionBonesRejectNonUnitQuaternions) {
                               (RobotsLevel().parent_path() / "generated/arm.gltf").string() +
                               "\"\nbones = [\"base\", \"link1\"]\n"));
   RobotState state(level.robots[0]);
+  EXPECT_EQ(state.bone_values(), std::vector<double>({1, 0, 0, 0, 1, 0, 0, 0}));  // at rest
   const double half_turn[4] = {0.0, 0.0, 0.0, 1.0};
   const double long_q[4] = {1.0, 1.0, 0.0, 0.0};
   EXPECT_TRUE(state.SetBone(1, half_turn, 4));
   EXPECT_FALSE(state.SetBone(1, long_q, 4));
+  EXPECT_EQ(state.bone_values(), std::vector<double>({1, 0, 0, 0, 0, 0, 0, 1}));
   EXPECT_EQ(state.rejected().at("non-unit bone quaternion"), 1);
   EXPECT_EQ(state.last_rejection(), "non-unit bone quaternion");
   state.Update();
