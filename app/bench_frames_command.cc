@@ -59,7 +59,8 @@ void Fly(double t, std::int64_t seq, scene::RobotState* robot) {
 }  // namespace
 
 int RunBenchFrames(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  const auto parsed = ParseArgs(args, "bench-frames", {"--frames", "--runs", "--out"}, {}, kUsage, err);
+  const auto parsed =
+      ParseArgs(args, "bench-frames", {"--frames", "--runs", "--out"}, {}, kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
     out << kUsage;
@@ -69,7 +70,8 @@ int RunBenchFrames(const std::vector<std::string>& args, std::ostream& out, std:
     auto whole = [&](const std::string& option, int fallback) {
       if (!parsed->values.count(option)) return fallback;
       const double v = ParseNumbers(parsed->Value(option), option).at(0);
-      if (!(v >= 1 && v <= 1e6 && v == std::floor(v))) throw CommandError(option + " must be a whole number from 1");
+      if (!(v >= 1 && v <= 1e6 && v == std::floor(v)))
+        throw CommandError(option + " must be a whole number from 1");
       return int(v);
     };
     const int frames = whole("--frames", 500), runs = whole("--runs", 3);
@@ -111,7 +113,8 @@ int RunBenchFrames(const std::vector<std::string>& args, std::ostream& out, std:
         << renderer->description() << "\n\n"
         << std::left << std::setw(18) << "case" << std::right << std::setw(10) << "mean ms"
         << std::setw(10) << "p50 ms" << std::setw(10) << "p99 ms" << std::setw(10) << "max ms"
-        << std::setw(10) << "fps" << std::setw(10) << "vs robot" << "  runs' means (ms)\n";
+        << std::setw(10) << "fps" << std::setw(10) << "vs robot"
+        << "  runs' means (ms)\n";
     double robot_only_mean = 0.0;  // the level's first case: the reference
     const int colors[3][3] = {{200, 80, 30}, {40, 160, 40}, {30, 60, 220}};
     for (const std::string level_name : {"empty", "sample"}) {
@@ -154,10 +157,12 @@ int RunBenchFrames(const std::vector<std::string>& args, std::ostream& out, std:
             link.Drain();
             if (i < 0) continue;
             durations.push_back(
-                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                    .count());
             csv << c.name() << ',' << run << ',' << i << ',' << durations.back() << '\n';
           }
-          run_means.push_back(std::accumulate(durations.begin(), durations.end(), 0.0) / double(frames));
+          run_means.push_back(std::accumulate(durations.begin(), durations.end(), 0.0) /
+                              double(frames));
           all.insert(all.end(), durations.begin(), durations.end());
           series.push_back({"run " + std::to_string(run + 1), durations, colors[run % 3][0],
                             colors[run % 3][1], colors[run % 3][2]});
@@ -174,9 +179,10 @@ int RunBenchFrames(const std::vector<std::string>& args, std::ostream& out, std:
             << 1e3 / mean << std::setw(9) << std::setprecision(2) << mean / robot_only_mean << "x  "
             << means.str() << "\n"
             << std::flush;
-        PlotFrameDurations(series, "bench-frames " + c.name() + ": frame duration, " +
-                                       std::to_string(runs) + " runs",
-                           0.0, (dir / (c.name() + ".png")).string());
+        PlotFrameDurations(
+            series,
+            "bench-frames " + c.name() + ": frame duration, " + std::to_string(runs) + " runs", 0.0,
+            (dir / (c.name() + ".png")).string());
       }
     }
     out << "\nframes.csv and one plot per case -> " << dir.string() << "\n";

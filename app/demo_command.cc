@@ -12,11 +12,10 @@
 #include <fstream>
 #include <iomanip>
 #include <memory>
-#include <sstream>
-#include <thread>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <thread>
 
 #include "app/command_line.h"
 #include "app/defaults.h"
@@ -73,14 +72,16 @@ pid_t StartFlyWing(double duration_s, const std::string& log_file) {
   posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
   std::ostringstream seconds;
   seconds << duration_s;
-  std::vector<std::string> argv_strings = {kFlyWingBinary, "--duration", seconds.str(), "--rate", "100"};
+  std::vector<std::string> argv_strings = {kFlyWingBinary, "--duration", seconds.str(), "--rate",
+                                           "100"};
   std::vector<char*> argv;
   for (std::string& s : argv_strings) argv.push_back(s.data());
   argv.push_back(nullptr);
   pid_t pid = -1;
   const int error = posix_spawn(&pid, kFlyWingBinary, &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
-  if (error != 0) throw CommandError(std::string("cannot start the example model ") + kFlyWingBinary);
+  if (error != 0)
+    throw CommandError(std::string("cannot start the example model ") + kFlyWingBinary);
   return pid;
 }
 
@@ -131,7 +132,8 @@ void WriteOverview(const std::filesystem::path& dir, const std::string& file) {
 }  // namespace
 
 int RunDemo(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  const auto parsed = ParseArgs(args, "demo", {"--duration", "--out"}, {"--in-process"}, kUsage, err);
+  const auto parsed =
+      ParseArgs(args, "demo", {"--duration", "--out"}, {"--in-process"}, kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
     out << kUsage;
@@ -145,7 +147,8 @@ int RunDemo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     const double duration_s = parsed->values.count("--duration")
                                   ? ParseNumbers(parsed->Value("--duration"), "--duration").at(0)
                                   : 20.0;
-    if (!(duration_s > 0.0 && duration_s <= 3600.0)) throw CommandError("--duration must be 0 to 3600 s");
+    if (!(duration_s > 0.0 && duration_s <= 3600.0))
+      throw CommandError("--duration must be 0 to 3600 s");
     const std::string out_dir = parsed->Value("--out", "sandbox-demo");
     bool in_process = parsed->flags.count("--in-process") > 0;
     if (!in_process && !InNamespace()) {
@@ -166,8 +169,8 @@ int RunDemo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     }
     std::ostringstream seconds;
     seconds << duration_s;
-    std::vector<std::string> run_args = {"--duration", seconds.str(), "--out", out_dir, "--frames",
-                                         "jpg,mp4", "--scans-every", "1"};
+    std::vector<std::string> run_args = {"--duration", seconds.str(), "--out",         out_dir,
+                                         "--frames",   "jpg,mp4",     "--scans-every", "1"};
     StatusListener status;
     RunHooks hooks;
     hooks.before_close = [&status](bridge::LcmLink&) { status.input.reset(); };

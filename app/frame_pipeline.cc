@@ -9,7 +9,6 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
-
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -86,7 +85,8 @@ void FramePipeline::RenderLoop() {
   try {
     renderer = sensors::MakeRenderer();
     renderer->SetLevel(level_, OpenCvTextureDecoder());
-    for (const std::string& warning : renderer->warnings()) std::cerr << "sandbox: warning: " << warning << "\n";
+    for (const std::string& warning : renderer->warnings())
+      std::cerr << "sandbox: warning: " << warning << "\n";
   } catch (const std::exception& e) {
     Fail(std::string("cannot render: ") + e.what());
   }
@@ -170,8 +170,9 @@ void FramePipeline::Write(const Encoded& item) {
       if (!video) {
         video = std::make_unique<Video>();
         file = (dir / (item.camera + "." + config_.video_format)).string();
-        const int fourcc = config_.video_format == "mp4" ? cv::VideoWriter::fourcc('m', 'p', '4', 'v')
-                                                         : cv::VideoWriter::fourcc('M', 'J', 'P', 'G');
+        const int fourcc = config_.video_format == "mp4"
+                               ? cv::VideoWriter::fourcc('m', 'p', '4', 'v')
+                               : cv::VideoWriter::fourcc('M', 'J', 'P', 'G');
         video->writer.open(file, cv::CAP_FFMPEG, fourcc, config_.video_fps,
                            cv::Size(item.frame.width, item.frame.height));
         if (!video->writer.isOpened()) throw std::runtime_error("cannot open the video " + file);

@@ -30,9 +30,9 @@
 namespace sandbox::app {
 
 struct FramePipelineConfig {
-  std::string out_dir;  // empty: nothing written (a live view only)
+  std::string out_dir;              // empty: nothing written (a live view only)
   std::string image_format{"jpg"};  // jpg, png, or empty: no image files
-  std::string video_format;        // mp4 (mp4v), avi (MJPG), or empty: no video
+  std::string video_format;         // mp4 (mp4v), avi (MJPG), or empty: no video
   std::string depth_format{"png"};  // png (16-bit millimetres), npy or exr (float32 metres)
   double video_fps{30.0};
   std::size_t queue_capacity{4};
@@ -53,9 +53,9 @@ struct RenderJob {
   std::vector<scene::RobotState> robots;
   std::vector<Eigen::Isometry3d> actor_poses;
   Eigen::Isometry3d robot_pose{Eigen::Isometry3d::Identity()};  // for the index
-  sensors::Overlay overlay;  // empty: none
-  bool write{true};          // to the output folder
-  bool show{false};          // to FramePipelineConfig::show (the live view)
+  sensors::Overlay overlay;                                     // empty: none
+  bool write{true};                                             // to the output folder
+  bool show{false};  // to FramePipelineConfig::show (the live view)
 };
 
 class FramePipeline {
@@ -100,13 +100,13 @@ class FramePipeline {
   std::deque<RenderJob> render_queue_;
   std::deque<Encoded> write_queue_;
   bool stopping_{false};
-  bool render_done_{false};  // the render thread has finished: the writer may stop
+  bool render_done_{false};   // the render thread has finished: the writer may stop
   bool render_ready_{false};  // the renderer has the level (or could not be made)
   std::atomic<std::int64_t> rendered_{0}, written_{0}, dropped_render_{0}, dropped_write_{0},
       failed_{0};
   std::string first_error_;
   struct Video;
-  std::map<std::string, std::unique_ptr<Video>> videos_;  // write thread only
+  std::map<std::string, std::unique_ptr<Video>> videos_;           // write thread only
   std::map<std::string, std::unique_ptr<std::ofstream>> indexes_;  // write thread only
   std::chrono::steady_clock::time_point retry_after_{};            // write thread only
   std::thread render_thread_, write_thread_;

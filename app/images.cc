@@ -4,11 +4,10 @@
 #include <cstdlib>
 #include <fstream>
 #include <mutex>
-#include <vector>
-#include <stdexcept>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <stdexcept>
+#include <vector>
 
 namespace sandbox::app {
 

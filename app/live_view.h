@@ -20,16 +20,26 @@
 
 namespace sandbox::app {
 
-enum class ViewKey { kNextCamera, kPanLeft, kPanRight, kTiltUp, kTiltDown, kZoomIn, kZoomOut,
-                     kToggleOverlay, kPause, kQuit };
+enum class ViewKey {
+  kNextCamera,
+  kPanLeft,
+  kPanRight,
+  kTiltUp,
+  kTiltDown,
+  kZoomIn,
+  kZoomOut,
+  kToggleOverlay,
+  kPause,
+  kQuit
+};
 
 // The key of a code from cv::waitKeyEx; nullopt for keys without a use.
 std::optional<ViewKey> KeyFromCode(int code);
 
 // What the keys have set.
 struct ViewControls {
-  int camera{0};                     // index of the active camera
-  sensors::TrailingCommand steer;    // added to the bridge's <ROBOT>/CAMERA command
+  int camera{0};                   // index of the active camera
+  sensors::TrailingCommand steer;  // added to the bridge's <ROBOT>/CAMERA command
   bool overlay{false};
   bool paused{false};
   bool quit{false};

@@ -9,8 +9,8 @@
 #include "app/command_line.h"
 #include "app/defaults.h"
 #include "app/images.h"
-#include "scene/level.h"
 #include "scene/collision_world.h"
+#include "scene/level.h"
 #include "sensors/cameras.h"
 #include "sensors/debug_overlay.h"
 #include "sensors/robot_sensors.h"
@@ -68,8 +68,8 @@ void BuildOverlay(const scene::Level& level, int robot_index, const scene::Robot
 
 int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   const auto parsed = ParseArgs(
-      args, "render", {"--camera", "--at", "--robot", "--bones", "--width", "--height", "--fov", "--out",
-                       "--stub"},
+      args, "render",
+      {"--camera", "--at", "--robot", "--bones", "--width", "--height", "--fov", "--out", "--stub"},
       {"--overlay"}, kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
@@ -95,20 +95,25 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
     };
     view.width = whole("--width", 640);
     view.height = whole("--height", 480);
-    view.fov_y_rad = (parsed->values.count("--fov") ? ParseNumbers(parsed->Value("--fov"), "--fov").at(0)
-                                                    : 60.0) * M_PI / 180.0;
+    view.fov_y_rad =
+        (parsed->values.count("--fov") ? ParseNumbers(parsed->Value("--fov"), "--fov").at(0)
+                                       : 60.0) *
+        M_PI / 180.0;
     const scene::Level level = scene::LoadLevel(parsed->level.value_or(kDefaultLevel));
     std::unique_ptr<scene::RobotState> robot;
     int robot_index = -1;
     if (!level.robots.empty()) {
-      const int index = parsed->Value("--robot").empty() ? 0 : level.FindRobot(parsed->Value("--robot"));
-      if (index < 0) throw CommandError("the level has no robot '" + parsed->Value("--robot") + "'");
+      const int index =
+          parsed->Value("--robot").empty() ? 0 : level.FindRobot(parsed->Value("--robot"));
+      if (index < 0)
+        throw CommandError("the level has no robot '" + parsed->Value("--robot") + "'");
       robot_index = index;
       robot = std::make_unique<scene::RobotState>(level.robots[std::size_t(index)]);
       if (camera != "fixed" && !robot->SetPose(X_at)) {
         throw CommandError("--at rejected: " + robot->last_rejection());
       }
-      if (!parsed->Value("--bones").empty()) ApplyBones(parsed->Value("--bones"), robot->model(), robot.get());
+      if (!parsed->Value("--bones").empty())
+        ApplyBones(parsed->Value("--bones"), robot->model(), robot.get());
       robot->Update();
     } else if (camera != "fixed") {
       throw CommandError("a " + camera + " camera needs a robot; the level declares none");
@@ -126,14 +131,16 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
     const auto start = std::chrono::steady_clock::now();
     std::unique_ptr<sensors::Renderer> renderer = sensors::MakeRenderer();
     renderer->SetLevel(level, OpenCvTextureDecoder());
-    for (const std::string& warning : renderer->warnings()) err << "sandbox render: warning: " << warning << "\n";
+    for (const std::string& warning : renderer->warnings())
+      err << "sandbox render: warning: " << warning << "\n";
     sensors::Frame frame;
     std::vector<const scene::RobotState*> robots;
     if (robot) robots.push_back(robot.get());
     sensors::Overlay overlay;
     if (parsed->flags.count("--overlay")) {
-      const double stub_m =
-          parsed->values.count("--stub") ? ParseNumbers(parsed->Value("--stub"), "--stub").at(0) : 0.0;
+      const double stub_m = parsed->values.count("--stub")
+                                ? ParseNumbers(parsed->Value("--stub"), "--stub").at(0)
+                                : 0.0;
       BuildOverlay(level, robot_index, robot.get(), stub_m, &overlay);
     }
     renderer->Render(view, {}, robots, {}, &frame, &overlay);

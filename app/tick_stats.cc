@@ -6,17 +6,16 @@
 #include <iomanip>
 #include <limits>
 #include <numeric>
-#include <stdexcept>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <stdexcept>
 
 namespace sandbox::app {
 
 double Quantile(std::vector<double> values, double q) {
   if (values.empty()) return 0.0;
-  const std::size_t rank =
-      std::min(values.size() - 1, std::size_t(std::ceil(q * double(values.size()))) - (q > 0 ? 1 : 0));
+  const std::size_t rank = std::min(
+      values.size() - 1, std::size_t(std::ceil(q * double(values.size()))) - (q > 0 ? 1 : 0));
   std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(rank), values.end());
   return values[rank];
 }
@@ -25,10 +24,10 @@ Histogram::Histogram() : bins_(1000 + 9900 + 9900 + 1, 0) {}
 
 std::size_t Histogram::Bin(double ms) {
   if (!(ms > 0)) return 0;
-  if (ms < 1.0) return std::size_t(ms * 1000.0);                       // 1 us
-  if (ms < 100.0) return 1000 + std::size_t((ms - 1.0) * 100.0);       // 10 us
-  if (ms < 10000.0) return 10900 + std::size_t(ms - 100.0);            // 1 ms
-  return 20800;                                                        // beyond 10 s
+  if (ms < 1.0) return std::size_t(ms * 1000.0);                  // 1 us
+  if (ms < 100.0) return 1000 + std::size_t((ms - 1.0) * 100.0);  // 10 us
+  if (ms < 10000.0) return 10900 + std::size_t(ms - 100.0);       // 1 ms
+  return 20800;                                                   // beyond 10 s
 }
 
 double Histogram::UpperEdge(std::size_t bin) {
@@ -69,12 +68,14 @@ void TickStats::Add(const TickRecord& record, bool overrun) {
   max_lateness_ms_ = std::max(max_lateness_ms_, record.lateness_ms);
   overruns_ += overrun;
   // The plot: blocks of ticks, halved in number when full.
-  partial_max_ = partial_count_ == 0 ? record.duration_ms : std::max(partial_max_, record.duration_ms);
+  partial_max_ =
+      partial_count_ == 0 ? record.duration_ms : std::max(partial_max_, record.duration_ms);
   if (++partial_count_ == block_) {
     plot_.push_back(partial_max_);
     partial_count_ = 0;
     if (plot_.size() == kMaxPlotPoints) {
-      for (std::size_t i = 0; i < plot_.size() / 2; ++i) plot_[i] = std::max(plot_[2 * i], plot_[2 * i + 1]);
+      for (std::size_t i = 0; i < plot_.size() / 2; ++i)
+        plot_[i] = std::max(plot_[2 * i], plot_[2 * i + 1]);
       plot_.resize(plot_.size() / 2);
       block_ *= 2;
     }
@@ -145,14 +146,18 @@ void PlotFrameDurations(const std::vector<PlotSeries>& series, const std::string
     all.insert(all.end(), s.values.begin(), s.values.end());
   }
   // The y axis reaches the largest value (a spike stays visible) or twice the period.
-  double y_max = std::max({all.empty() ? 1.0 : *std::max_element(all.begin(), all.end()),
-                           period_ms * 1.2, 1e-3});
+  double y_max = std::max(
+      {all.empty() ? 1.0 : *std::max_element(all.begin(), all.end()), period_ms * 1.2, 1e-3});
   const double y_step = NiceStep(y_max);
   y_max = std::ceil(y_max / y_step) * y_step;
   const double x_step = NiceStep(frames);
   const int plot_w = width - left - right, plot_h = height - top - bottom;
-  auto X = [&](double i) { return left + int(std::lround(i / std::max(frames - 1.0, 1.0) * plot_w)); };
-  auto Y = [&](double v) { return top + plot_h - int(std::lround(std::min(v, y_max) / y_max * plot_h)); };
+  auto X = [&](double i) {
+    return left + int(std::lround(i / std::max(frames - 1.0, 1.0) * plot_w));
+  };
+  auto Y = [&](double v) {
+    return top + plot_h - int(std::lround(std::min(v, y_max) / y_max * plot_h));
+  };
   const cv::Scalar grid(225, 225, 225), ink(40, 40, 40);
   const int font = cv::FONT_HERSHEY_SIMPLEX;
   for (double v = 0; v <= y_max + 1e-9; v += y_step) {
@@ -166,25 +171,29 @@ void PlotFrameDurations(const std::vector<PlotSeries>& series, const std::string
   cv::rectangle(image, {left, top}, {left + plot_w, top + plot_h}, ink, 1);
   if (period_ms > 0) {
     for (int x = left; x < left + plot_w; x += 12) {
-      cv::line(image, {x, Y(period_ms)}, {std::min(x + 6, left + plot_w), Y(period_ms)}, {0, 0, 220}, 1);
+      cv::line(image, {x, Y(period_ms)}, {std::min(x + 6, left + plot_w), Y(period_ms)},
+               {0, 0, 220}, 1);
     }
-    cv::putText(image, "period " + Label(period_ms, period_ms >= 1 ? 1.0 : 0.01) + " ms", {left + plot_w - 140, Y(period_ms) - 6},
-                font, 0.45, {0, 0, 220}, 1, cv::LINE_AA);
+    cv::putText(image, "period " + Label(period_ms, period_ms >= 1 ? 1.0 : 0.01) + " ms",
+                {left + plot_w - 140, Y(period_ms) - 6}, font, 0.45, {0, 0, 220}, 1, cv::LINE_AA);
   }
   for (const PlotSeries& s : series) {
     std::vector<cv::Point> points;
     for (std::size_t i = 0; i < s.values.size(); ++i) {
       points.push_back({X(double(i) * s.frames_per_value), Y(s.values[i])});
     }
-    if (points.size() >= 2) cv::polylines(image, points, false, cv::Scalar(s.b, s.g, s.r), 1, cv::LINE_AA);
+    if (points.size() >= 2)
+      cv::polylines(image, points, false, cv::Scalar(s.b, s.g, s.r), 1, cv::LINE_AA);
   }
   for (std::size_t k = 0; k < series.size(); ++k) {
     const int y = top + 18 + 18 * int(k);
-    cv::line(image, {left + 12, y - 4}, {left + 36, y - 4}, cv::Scalar(series[k].b, series[k].g, series[k].r), 2);
+    cv::line(image, {left + 12, y - 4}, {left + 36, y - 4},
+             cv::Scalar(series[k].b, series[k].g, series[k].r), 2);
     cv::putText(image, series[k].label, {left + 42, y}, font, 0.45, ink, 1, cv::LINE_AA);
   }
   cv::putText(image, title, {left, 26}, font, 0.6, ink, 1, cv::LINE_AA);
-  cv::putText(image, "frame", {left + plot_w / 2 - 20, height - 10}, font, 0.5, ink, 1, cv::LINE_AA);
+  cv::putText(image, "frame", {left + plot_w / 2 - 20, height - 10}, font, 0.5, ink, 1,
+              cv::LINE_AA);
   cv::putText(image, "ms", {8, top - 12}, font, 0.5, ink, 1, cv::LINE_AA);
   bool written = false;
   try {

@@ -73,9 +73,9 @@ class TickStats {
   Histogram durations_, lateness_;
   double sum_ms_{0}, max_ms_{0}, max_lateness_ms_{0};
   std::int64_t overruns_{0};
-  std::vector<double> plot_;      // completed blocks
-  std::int64_t block_{1};         // ticks per plot point
-  double partial_max_{0};         // the block being filled
+  std::vector<double> plot_;  // completed blocks
+  std::int64_t block_{1};     // ticks per plot point
+  double partial_max_{0};     // the block being filled
   std::int64_t partial_count_{0};
 };
 

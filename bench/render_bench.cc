@@ -18,14 +18,13 @@
 #include <deque>
 #include <filesystem>
 #include <mutex>
-#include <thread>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <thread>
 
 #include "bench/bench_levels.h"
-#include "scene/level.h"
 #include "scene/collision_world.h"
+#include "scene/level.h"
 #include "sensors/cameras.h"
 #include "sensors/debug_overlay.h"
 #include "sensors/face_scanner.h"
@@ -46,7 +45,8 @@ int main(int argc, char** argv) {
   }
   // 1. Chase camera, render thread + encoder thread.
   {
-    const scene::Level level = scene::LoadLevel(std::string(SANDBOX_SOURCE_DIR) + "/assets/sample/level.toml");
+    const scene::Level level =
+        scene::LoadLevel(std::string(SANDBOX_SOURCE_DIR) + "/assets/sample/level.toml");
     std::mutex mutex;
     std::condition_variable wake;
     std::deque<sensors::Frame> queue;
@@ -108,10 +108,11 @@ int main(int argc, char** argv) {
     done = true;
     wake.notify_one();
     encoder.join();
-    std::printf("chase 640x480, sample level + flying wing: %.1f frames/s rendered and JPEG-encoded "
-                "(%.1f rendered/s; render alone %.2f ms a frame = %.0f fps), %zu KB a JPEG; target 80\n",
-                encoded / elapsed, rendered / elapsed, 1e3 * render_only_s / double(rendered.load()),
-                double(rendered.load()) / render_only_s, bytes / 1024);
+    std::printf(
+        "chase 640x480, sample level + flying wing: %.1f frames/s rendered and JPEG-encoded "
+        "(%.1f rendered/s; render alone %.2f ms a frame = %.0f fps), %zu KB a JPEG; target 80\n",
+        encoded / elapsed, rendered / elapsed, 1e3 * render_only_s / double(rendered.load()),
+        double(rendered.load()) / render_only_s, bytes / 1024);
   }
   // 2. Render time against triangles.
   {
@@ -124,8 +125,8 @@ int main(int argc, char** argv) {
       scene::Level level;
       if (triangles > 0) {
         const int side = int(std::sqrt(triangles / 2.0));  // a square about the origin
-        level = scene::LoadLevel(bench::WriteTerrainLevel(dir, "terrain" + std::to_string(triangles),
-                                                          side, side, -side / 2, -side / 2));
+        level = scene::LoadLevel(bench::WriteTerrainLevel(
+            dir, "terrain" + std::to_string(triangles), side, side, -side / 2, -side / 2));
         renderer->SetLevel(level, {});
       } else {
         renderer->SetLevel(level, {});
@@ -138,28 +139,32 @@ int main(int argc, char** argv) {
         for (int i = 0; i < 21; ++i) {
           const auto start = Clock::now();
           renderer->Render(view, {}, {}, {}, &frame);
-          if (i > 0) ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+          if (i > 0)
+            ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
         }
         return bench::Median(ms);
       };
       // All of the terrain in view.
-      const double median = median_ms(sensors::LookAt(Eigen::Vector3d(-200, -200, 150), Eigen::Vector3d(0, 0, 0)));
+      const double median =
+          median_ms(sensors::LookAt(Eigen::Vector3d(-200, -200, 150), Eigen::Vector3d(0, 0, 0)));
       if (triangles == 0) empty_ms = median;
       std::printf("%-12d %12.2f %14.2f %7.1fx\n", int(level.num_triangles()), median, empty_ms,
                   median / empty_ms);
       if (triangles == 1000000) {
         // From the middle along the ground: about a sixth of the terrain in the
         // frustum, the rest culled by 128 m cells.
-        const double ground = median_ms(sensors::LookAt(Eigen::Vector3d(0, 0, 10), Eigen::Vector3d(100, 0, 0)));
-        std::printf("%-12s %12.2f %14s %7.2fx of seeing it all (culling)\n", "1M, ground", ground, "",
-                    ground / median);
+        const double ground =
+            median_ms(sensors::LookAt(Eigen::Vector3d(0, 0, 10), Eigen::Vector3d(100, 0, 0)));
+        std::printf("%-12s %12.2f %14s %7.2fx of seeing it all (culling)\n", "1M, ground", ground,
+                    "", ground / median);
       }
     }
     fs::remove_all(dir);
   }
   // 3. The overlay's cost.
   {
-    const scene::Level level = scene::LoadLevel(std::string(SANDBOX_SOURCE_DIR) + "/assets/sample/level.toml");
+    const scene::Level level =
+        scene::LoadLevel(std::string(SANDBOX_SOURCE_DIR) + "/assets/sample/level.toml");
     const scene::CollisionWorld world(level);
     sensors::RayCaster caster;
     sensors::FaceScannerConfig config;
@@ -186,14 +191,18 @@ int main(int argc, char** argv) {
       for (int i = 0; i < 21; ++i) {
         const auto start = Clock::now();
         renderer->Render(view, {}, {&wing}, {}, &frame, overlay);
-        if (i > 0) ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+        if (i > 0)
+          ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
       }
       return bench::Median(ms);
     };
     const double plain = median_ms(nullptr);
-    std::printf("\noverlay, trailing 640x480, %zu samples: plain %.2f ms", points.points_W.size(), plain);
-    for (const auto& [name, overlay] : {std::pair<const char*, const sensors::Overlay*>{"points", &points},
-                                        {"0.5 m stubs", &stubs}, {"whole rays", &rays}}) {
+    std::printf("\noverlay, trailing 640x480, %zu samples: plain %.2f ms", points.points_W.size(),
+                plain);
+    for (const auto& [name, overlay] :
+         {std::pair<const char*, const sensors::Overlay*>{"points", &points},
+          {"0.5 m stubs", &stubs},
+          {"whole rays", &rays}}) {
       const double ms = median_ms(overlay);
       std::printf(", %s %.2f ms (%.2fx)", name, ms, ms / plain);
     }

@@ -77,7 +77,8 @@ LogReader::LogReader(const std::string& path) : path_(path) {
   if (std::fread(sync, 1, 4, file_) != 4 || BigEndian(sync, 4) != kLogSync) {
     std::fclose(file_);
     file_ = nullptr;
-    throw std::runtime_error("'" + path + "' is not an LCM log (it does not start with the sync word "
+    throw std::runtime_error("'" + path +
+                             "' is not an LCM log (it does not start with the sync word "
                              "0xEDA1DA01)");
   }
   std::fseek(file_, 0, SEEK_SET);
@@ -100,7 +101,8 @@ bool LogReader::Next(std::string* channel, std::vector<std::uint8_t>* data, std:
   if (got < sizeof(header)) return stop("truncated inside an event header");
   if (BigEndian(header, 4) != kLogSync) return stop("corrupt (no sync word)");
   const std::int64_t event_utime = std::int64_t(BigEndian(header + 12, 8));
-  const std::uint64_t channel_length = BigEndian(header + 20, 4), data_length = BigEndian(header + 24, 4);
+  const std::uint64_t channel_length = BigEndian(header + 20, 4),
+                      data_length = BigEndian(header + 24, 4);
   if (channel_length == 0 || channel_length > 256) return stop("corrupt (channel name length)");
   const std::int64_t needed = 28 + std::int64_t(channel_length + data_length);
   if (offset_ + needed > size_) {

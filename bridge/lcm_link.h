@@ -3,10 +3,10 @@
 // Threads: everything here belongs to the loop thread.
 
 #include <cstdint>
+#include <cstdio>
 #include <deque>
 #include <map>
 #include <memory>
-#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -66,7 +66,7 @@ class LogReader {
   ~LogReader();
   // The next event, or false at the end of the file or of its valid part.
   bool Next(std::string* channel, std::vector<std::uint8_t>* data, std::int64_t* utime);
-  double fraction_read() const;  // 0 .. 1
+  double fraction_read() const;                    // 0 .. 1
   std::int64_t events() const { return events_; }  // read so far
   // Empty after a clean end; otherwise where and why reading stopped, e.g.
   // "truncated: event 1201 at byte 120345 of 120400 needs 88 bytes".

@@ -144,8 +144,7 @@ void RobotOutputs::PublishRange(const std::string& sensor, const sensors::RangeR
   Send(channel.empty() ? "RANGE" : channel, message);
 }
 
-void RobotOutputs::PublishState(const scene::RobotState& state,
-                                const InputTag& input,
+void RobotOutputs::PublishState(const scene::RobotState& state, const InputTag& input,
                                 std::int64_t now_utime) {
   sandbox_msgs::robot_state_t message{};
   Stamp(now_utime, seq_++, input, &message);

@@ -261,7 +261,8 @@ SensorSpec ParseSensor(const fs::path& file, const toml::table& table, int index
   if (const auto channel = read.String("channel")) {
     if (kind == "camera") read.Fail(read.Find("channel"), "a camera publishes no channel");
     if (channel->empty() || channel->find_first_of(" \t\n") != std::string::npos) {
-      read.Fail(read.Find("channel"), "'channel' must be a name without spaces, got '" + *channel + "'");
+      read.Fail(read.Find("channel"),
+                "'channel' must be a name without spaces, got '" + *channel + "'");
     }
     sensor.channel = *channel;
   }
@@ -271,8 +272,8 @@ SensorSpec ParseSensor(const fs::path& file, const toml::table& table, int index
   }
   // The rest, as given.
   sensor.settings = ReadSettings(file, table, read,
-                                 {"name", "type", "mount", "position", "rpy_deg", "rate_hz", "channel",
-                                  "quaternion_wxyz", "scale", "up", "unit_scale"},
+                                 {"name", "type", "mount", "position", "rpy_deg", "rate_hz",
+                                  "channel", "quaternion_wxyz", "scale", "up", "unit_scale"},
                                  kind + " '" + sensor.name + "'");
   return sensor;
 }
@@ -330,9 +331,9 @@ RobotSpec ParseRobot(const fs::path& file, const toml::table& table, int index) 
     }
   }
   // Sensors and cameras: mounted, named, typed; their own settings as given.
-  for (const auto& [key, types] :
-       {std::pair<std::string, std::vector<std::string>>{"sensor", {"face", "ground", "lidar", "ray"}},
-        {"camera", {"chase", "trailing", "payload", "fixed"}}}) {
+  for (const auto& [key, types] : {std::pair<std::string, std::vector<std::string>>{
+                                       "sensor", {"face", "ground", "lidar", "ray"}},
+                                   {"camera", {"chase", "trailing", "payload", "fixed"}}}) {
     const toml::node* tables = read.Find(key);
     if (tables == nullptr) continue;
     const toml::array* array = tables->as_array();
@@ -344,7 +345,8 @@ RobotSpec ParseRobot(const fs::path& file, const toml::table& table, int index) 
     for (const toml::node& item : *array) {
       SensorSpec spec = ParseSensor(file, *item.as_table(), ++table_index, key, types);
       if (!names.insert(spec.name).second) {
-        TableReader(file, *item.as_table(), "").Fail(nullptr, "duplicate " + key + " name '" + spec.name + "'");
+        TableReader(file, *item.as_table(), "")
+            .Fail(nullptr, "duplicate " + key + " name '" + spec.name + "'");
       }
       (key == "sensor" ? robot.sensors : robot.cameras).push_back(std::move(spec));
     }

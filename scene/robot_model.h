@@ -36,8 +36,8 @@ struct SensorSpec {
   int mount_node{-1};  // resolved by LoadRobotModel; -1: the body frame
   Eigen::Isometry3d X_MS{Eigen::Isometry3d::Identity()};  // sensor in its mount's frame
   double rate_hz{0.0};                                    // 0: every tick
-  std::string channel;  // its output channel after "<ROBOT>/"; empty: the type's own
-  SettingsTable settings;                                 // the type's own settings, as given
+  std::string channel;     // its output channel after "<ROBOT>/"; empty: the type's own
+  SettingsTable settings;  // the type's own settings, as given
 
   // "level.toml:12: sensor 'scanner': " for messages.
   std::string Where() const { return settings.Where(); }
@@ -55,7 +55,7 @@ struct RobotSpec {
   std::map<std::string, std::vector<Eigen::Vector3d>> bone_axes;  // per-bone overrides
   std::vector<SensorSpec> sensors;
   std::vector<SensorSpec> cameras;  // [[robot.camera]]: chase, trailing, payload, fixed
-  SettingsTable bridge;  // [robot.bridge]: how the bridge connects it (bridge/ reads it)
+  SettingsTable bridge;             // [robot.bridge]: how the bridge connects it (bridge/ reads it)
   int line{0};
 };
 

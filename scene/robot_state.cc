@@ -20,7 +20,8 @@ RobotState::RobotState(const RobotModel& model)
       rigid_(model.joints.size()) {
   values_.assign(static_cast<std::size_t>(model.num_values), 0.0);
   for (const Bone& bone : model.bones) {
-    if (bone.rotation == BoneRotation::kQuaternion) values_[static_cast<std::size_t>(bone.first_value)] = 1.0;
+    if (bone.rotation == BoneRotation::kQuaternion)
+      values_[static_cast<std::size_t>(bone.first_value)] = 1.0;
   }
   for (const SkinnedMesh& mesh : model.meshes) {
     positions_B_.emplace_back(mesh.bind.positions_A.size());

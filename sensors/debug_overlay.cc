@@ -17,8 +17,9 @@ void AddFaceScan(const FaceScan& scan, double stub_m, Overlay* overlay) {
       }
       const Eigen::Vector3d back = origin_W - p_W;
       const double length = back.norm();
-      overlay->AddLine(p_W, length > 1e-9 ? Eigen::Vector3d(p_W + back * std::min(1.0, stub_m / length)) : p_W,
-                       rgb);
+      overlay->AddLine(
+          p_W, length > 1e-9 ? Eigen::Vector3d(p_W + back * std::min(1.0, stub_m / length)) : p_W,
+          rgb);
     }
   }
 }
@@ -29,8 +30,8 @@ void AddBoneFrames(const scene::RobotState& state, double axis_m, Overlay* overl
     const Eigen::Isometry3d X_WN =
         state.pose() * scene::RigidPart(state.node_poses_B()[std::size_t(bone.node)]);
     for (int k = 0; k < 3; ++k) {
-      overlay->AddLine(X_WN.translation(), X_WN * Eigen::Vector3d(axis_m * Eigen::Vector3d::Unit(k)),
-                       axis_rgb[k]);
+      overlay->AddLine(X_WN.translation(),
+                       X_WN * Eigen::Vector3d(axis_m * Eigen::Vector3d::Unit(k)), axis_rgb[k]);
     }
   }
 }

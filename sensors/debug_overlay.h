@@ -4,9 +4,8 @@
 // rays, each bone's frame as three axis stubs (x red, y green, z blue), and
 // actors' bounding boxes.
 
-#include <vector>
-
 #include <Eigen/Geometry>
+#include <vector>
 
 #include "scene/level.h"
 #include "scene/robot_state.h"

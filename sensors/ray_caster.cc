@@ -1,8 +1,7 @@
 #include "sensors/ray_caster.h"
 
-#include <chrono>
-
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -372,7 +371,8 @@ void RayCaster::WorkerLoop() {
     // loop), then sleep, so that a 100 Hz loop does not keep a core busy.
     const auto spin_until = std::chrono::steady_clock::now() + std::chrono::microseconds(200);
     while (generation_.load(std::memory_order_acquire) == seen &&
-           !stop_.load(std::memory_order_relaxed) && std::chrono::steady_clock::now() < spin_until) {
+           !stop_.load(std::memory_order_relaxed) &&
+           std::chrono::steady_clock::now() < spin_until) {
       std::this_thread::yield();
     }
     if (generation_.load(std::memory_order_acquire) == seen) {

@@ -1,15 +1,15 @@
 #include "sensors/renderer.h"
 
 #define GL_GLEXT_PROTOTYPES
-#include <GL/osmesa.h>
 #include <GL/gl.h>
 #include <GL/glext.h>
+#include <GL/osmesa.h>
 
 #include <cmath>
 #include <limits>
 #include <map>
-#include <tuple>
 #include <stdexcept>
+#include <tuple>
 
 namespace sandbox::sensors {
 namespace {
@@ -113,7 +113,8 @@ GpuMesh Upload(const std::vector<Eigen::Vector3f>& positions,
   mesh.index_count = GLsizei(indices.size());
   glGenVertexArrays(1, &mesh.vao);
   glBindVertexArray(mesh.vao);
-  auto attribute = [&](GLuint* buffer, GLuint location, int size, const void* data, std::size_t bytes) {
+  auto attribute = [&](GLuint* buffer, GLuint location, int size, const void* data,
+                       std::size_t bytes) {
     glGenBuffers(1, buffer);
     glBindBuffer(GL_ARRAY_BUFFER, *buffer);
     glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(bytes), data, usage);
@@ -130,7 +131,8 @@ GpuMesh Upload(const std::vector<Eigen::Vector3f>& positions,
   }
   glGenBuffers(1, &mesh.indices);
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, mesh.indices);
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * 4), indices.data(), GL_STATIC_DRAW);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * 4), indices.data(),
+               GL_STATIC_DRAW);
   glBindVertexArray(0);
   return mesh;
 }
@@ -171,11 +173,20 @@ Eigen::Matrix4f Relative(const Eigen::Affine3d& X, const Eigen::Vector3d& camera
 class OsMesaRenderer : public Renderer {
  public:
   OsMesaRenderer() {
-    const int attributes[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 24, OSMESA_PROFILE,
-                              OSMESA_CORE_PROFILE, OSMESA_CONTEXT_MAJOR_VERSION, 4,
-                              OSMESA_CONTEXT_MINOR_VERSION, 5, 0};
+    const int attributes[] = {OSMESA_FORMAT,
+                              OSMESA_RGBA,
+                              OSMESA_DEPTH_BITS,
+                              24,
+                              OSMESA_PROFILE,
+                              OSMESA_CORE_PROFILE,
+                              OSMESA_CONTEXT_MAJOR_VERSION,
+                              4,
+                              OSMESA_CONTEXT_MINOR_VERSION,
+                              5,
+                              0};
     context_ = OSMesaCreateContextAttribs(attributes, nullptr);
-    if (context_ == nullptr) throw std::runtime_error("Renderer: cannot create an OSMesa GL 4.5 context");
+    if (context_ == nullptr)
+      throw std::runtime_error("Renderer: cannot create an OSMesa GL 4.5 context");
     backing_.resize(4);
     if (!OSMesaMakeCurrent(context_, backing_.data(), GL_UNSIGNED_BYTE, 1, 1)) {
       throw std::runtime_error("Renderer: cannot make the OSMesa context current");
@@ -188,9 +199,9 @@ class OsMesaRenderer : public Renderer {
     glGenVertexArrays(1, &overlay_vao_);
     glGenBuffers(2, overlay_buffers_);
     auto location = [&](const char* name) { return glGetUniformLocation(program_, name); };
-    uniforms_ = {location("model"), location("view_proj"), location("base_color"),
+    uniforms_ = {location("model"),       location("view_proj"),    location("base_color"),
                  location("has_texture"), location("base_texture"), location("sun"),
-                 location("sky"), location("fog")};
+                 location("sky"),         location("fog")};
   }
   ~OsMesaRenderer() override { OSMesaDestroyContext(context_); }
 
@@ -255,7 +266,8 @@ class OsMesaRenderer : public Renderer {
     R_EyeCam << 0, -1, 0, 0, 0, 1, -1, 0, 0;  // camera x forward, y left, z up -> GL eye
     Eigen::Matrix4d view_rotation = Eigen::Matrix4d::Identity();
     view_rotation.topLeftCorner<3, 3>() = R_EyeCam * view.X_WC.linear().transpose();
-    const double f = 1.0 / std::tan(0.5 * view.fov_y_rad), aspect = double(view.width) / view.height;
+    const double f = 1.0 / std::tan(0.5 * view.fov_y_rad),
+                 aspect = double(view.width) / view.height;
     const double n = view.near_m, fa = view.far_m;
     Eigen::Matrix4d projection = Eigen::Matrix4d::Zero();
     projection(0, 0) = f / aspect;
@@ -273,11 +285,13 @@ class OsMesaRenderer : public Renderer {
 
     // Opaque first, then the translucent (water) on top. Static chunks outside
     // the view are skipped.
-    const Eigen::Matrix4f static_model = Relative(Eigen::Affine3d(Eigen::Translation3d(origin_)), camera);
+    const Eigen::Matrix4f static_model =
+        Relative(Eigen::Affine3d(Eigen::Translation3d(origin_)), camera);
     const Eigen::Matrix4f static_clip = view_proj * static_model;
     for (const bool translucent : {false, true}) {
       for (const auto& [bounds, mesh] : static_meshes_) {
-        if (IsTranslucent(mesh.material) != translucent || !InFrustum(static_clip, bounds)) continue;
+        if (IsTranslucent(mesh.material) != translucent || !InFrustum(static_clip, bounds))
+          continue;
         Draw(mesh, static_model);
       }
       for (const auto& [actor, mesh] : actor_meshes_) {
@@ -322,10 +336,12 @@ class OsMesaRenderer : public Renderer {
     frame->rgb.resize(std::size_t(w) * h * 3);
     frame->depth_m.resize(std::size_t(w) * h);
     for (int y = 0; y < h; ++y) {
-      const std::size_t src = std::size_t(h - 1 - y) * std::size_t(w), dst = std::size_t(y) * std::size_t(w);
+      const std::size_t src = std::size_t(h - 1 - y) * std::size_t(w),
+                        dst = std::size_t(y) * std::size_t(w);
       for (int x = 0; x < w; ++x) {
-        for (int c = 0; c < 3; ++c) frame->rgb[3 * (dst + std::size_t(x)) + std::size_t(c)] =
-            pixels_[4 * (src + std::size_t(x)) + std::size_t(c)];
+        for (int c = 0; c < 3; ++c)
+          frame->rgb[3 * (dst + std::size_t(x)) + std::size_t(c)] =
+              pixels_[4 * (src + std::size_t(x)) + std::size_t(c)];
         const double d = depth_[src + std::size_t(x)];
         frame->depth_m[dst + std::size_t(x)] =
             d >= 1.0 ? std::numeric_limits<float>::infinity()
@@ -353,10 +369,12 @@ class OsMesaRenderer : public Renderer {
         for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
           Eigen::Vector3d p[3];
           for (int k = 0; k < 3; ++k) {
-            p[k] = actor.X_WA * mesh.positions_A[mesh.indices[t + std::size_t(k)]].cast<double>() - origin_;
+            p[k] = actor.X_WA * mesh.positions_A[mesh.indices[t + std::size_t(k)]].cast<double>() -
+                   origin_;
           }
           const Eigen::Vector3d c = (p[0] + p[1] + p[2]) / 3.0;
-          const std::tuple<int, long, long> key{mesh.material, std::lround(std::floor(c.x() / kChunkCell_m)),
+          const std::tuple<int, long, long> key{mesh.material,
+                                                std::lround(std::floor(c.x() / kChunkCell_m)),
                                                 std::lround(std::floor(c.y() / kChunkCell_m))};
           StaticChunk& chunk = chunks[key];
           std::vector<std::int64_t>& map = copied[key];
@@ -368,8 +386,9 @@ class OsMesaRenderer : public Renderer {
               map[v] = std::int64_t(chunk.positions.size());
               chunk.positions.push_back(p[k].cast<float>());
               chunk.normals.push_back((R * mesh.normals_A[v].cast<double>()).cast<float>());
-              chunk.uvs.push_back(mesh.uvs.size() == mesh.positions_A.size() ? mesh.uvs[v]
-                                                                            : Eigen::Vector2f::Zero());
+              chunk.uvs.push_back(mesh.uvs.size() == mesh.positions_A.size()
+                                      ? mesh.uvs[v]
+                                      : Eigen::Vector2f::Zero());
               chunk.bounds.extend(chunk.positions.back());
             }
             chunk.indices.push_back(std::uint32_t(map[v]));
@@ -379,8 +398,9 @@ class OsMesaRenderer : public Renderer {
     }
     for (auto& [key, chunk] : chunks) {
       if (!chunk.any_uvs) chunk.uvs.clear();
-      static_meshes_.push_back({chunk.bounds, Upload(chunk.positions, chunk.normals, chunk.uvs,
-                                                     chunk.indices, std::get<0>(key), GL_STATIC_DRAW)});
+      static_meshes_.push_back(
+          {chunk.bounds, Upload(chunk.positions, chunk.normals, chunk.uvs, chunk.indices,
+                                std::get<0>(key), GL_STATIC_DRAW)});
     }
   }
 
@@ -474,7 +494,7 @@ class OsMesaRenderer : public Renderer {
   } uniforms_{};
   int width_{0}, height_{0};
   const scene::Level* level_{nullptr};
-  Eigen::Vector3d origin_{Eigen::Vector3d::Zero()};                 // of the static chunks
+  Eigen::Vector3d origin_{Eigen::Vector3d::Zero()};  // of the static chunks
   std::vector<std::pair<Eigen::AlignedBox3f, GpuMesh>> static_meshes_;
   std::vector<std::pair<int, GpuMesh>> actor_meshes_;  // movable actors'
   std::map<const scene::RobotModel*, std::vector<GpuMesh>> robot_meshes_;

@@ -7,13 +7,12 @@
 // Threads: a Renderer and everything it renders belong to one thread (the
 // render thread); make it there.
 
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "scene/level.h"
 #include "scene/robot_state.h"

@@ -33,12 +33,12 @@ struct MountedSensor {
 struct MountedCamera {
   scene::SensorSpec spec;  // name, type (chase, trailing, payload, fixed), mount, X_MS, rate
   int robot{-1};
-  CameraView view;         // size, field of view, clipping; the pose is set per frame
+  CameraView view;  // size, field of view, clipping; the pose is set per frame
   ChaseConfig chase;
   double trailing_distance_m{25.0};
   double trailing_height_m{8.0};
-  bool depth{false};       // payload cameras: also a depth image
-  bool overlay{false};     // the debug overlay (scanner samples, bone frames, actor bounds)
+  bool depth{false};           // payload cameras: also a depth image
+  bool overlay{false};         // the debug overlay (scanner samples, bone frames, actor bounds)
   double overlay_stub_m{0.0};  // scanner samples as points (0) or stubs this long
 
   // The camera pose for a robot state (fixed cameras: their own pose; chase

@@ -7,10 +7,9 @@
 
 #include <filesystem>
 #include <fstream>
-#include <regex>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
+#include <regex>
 
 #include "tests/app/run_sandbox.h"
 #include "tests/test_util.h"

@@ -10,7 +10,6 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
-
 #include <opencv2/imgcodecs.hpp>
 
 #include "tests/test_util.h"
@@ -38,10 +37,10 @@ TEST(DepthFileTest, PngHoldsRoundedMillimetresAndZeroWhereNothingOrTooFar) {
   ASSERT_EQ(png.rows, 2);
   EXPECT_EQ(png.at<std::uint16_t>(0, 0), 1235);  // 1.2345 m, rounded
   EXPECT_EQ(png.at<std::uint16_t>(0, 1), 2000);
-  EXPECT_EQ(png.at<std::uint16_t>(0, 2), 0);      // sky
+  EXPECT_EQ(png.at<std::uint16_t>(0, 2), 0);  // sky
   EXPECT_EQ(png.at<std::uint16_t>(1, 0), 500);
   EXPECT_EQ(png.at<std::uint16_t>(1, 1), 65000);
-  EXPECT_EQ(png.at<std::uint16_t>(1, 2), 0);      // beyond 65.535 m
+  EXPECT_EQ(png.at<std::uint16_t>(1, 2), 0);  // beyond 65.535 m
 }
 
 TEST(DepthFileTest, NpyIsFloat32MetresInRowsAsNumpyReadsIt) {
@@ -69,7 +68,8 @@ TEST(DepthFileTest, NpyIsFloat32MetresInRowsAsNumpyReadsIt) {
   ASSERT_EQ(bytes.size(), data_start + 6 * 4);
   for (std::size_t i = 0; i < 6; ++i) {
     std::uint32_t bits = 0;  // little-endian float32
-    for (int b = 3; b >= 0; --b) bits = bits << 8 | std::uint8_t(bytes[data_start + 4 * i + std::size_t(b)]);
+    for (int b = 3; b >= 0; --b)
+      bits = bits << 8 | std::uint8_t(bytes[data_start + 4 * i + std::size_t(b)]);
     float value;
     std::memcpy(&value, &bits, 4);
     EXPECT_EQ(value, frame.depth_m[i]) << i;
@@ -102,7 +102,8 @@ TEST(DepthFileTest, ExrIsOneFloat32ChannelOfMetres) {
   ASSERT_EQ(exr.type(), CV_32FC1);
   ASSERT_EQ(exr.cols, 3);
   ASSERT_EQ(exr.rows, 2);
-  for (int i = 0; i < 6; ++i) EXPECT_EQ(exr.at<float>(i / 3, i % 3), frame.depth_m[std::size_t(i)]) << i;
+  for (int i = 0; i < 6; ++i)
+    EXPECT_EQ(exr.at<float>(i / 3, i % 3), frame.depth_m[std::size_t(i)]) << i;
 }
 
 }  // namespace

@@ -4,11 +4,11 @@
 // is not an LCM log refused.
 
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <lcm/lcm-cpp.hpp>
 #include <sstream>
 
 #include "sandbox_msgs/robot_pose_t.hpp"

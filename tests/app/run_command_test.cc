@@ -6,11 +6,10 @@
 
 #include <filesystem>
 #include <fstream>
-#include <regex>
-#include <sstream>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
+#include <regex>
+#include <sstream>
 
 #include "tests/app/run_sandbox.h"
 #include "tests/test_util.h"
@@ -49,7 +48,8 @@ TEST(RunCommandTest, CamerasWriteIndexedFramesAtTheirRatesWithDepth) {
   ASSERT_EQ(run.exit_code, 0) << run.out;
   std::smatch counts;
   ASSERT_TRUE(std::regex_search(
-      run.out, counts, std::regex(R"(frames: (\d+) rendered, (\d+) written, (\d+) dropped, (\d+) failed)")))
+      run.out, counts,
+      std::regex(R"(frames: (\d+) rendered, (\d+) written, (\d+) dropped, (\d+) failed)")))
       << run.out;
   const long rendered = std::stol(counts[1]), written = std::stol(counts[2]);
   EXPECT_EQ(std::stol(counts[4]), 0) << run.out;
@@ -65,9 +65,9 @@ TEST(RunCommandTest, CamerasWriteIndexedFramesAtTheirRatesWithDepth) {
     bool depth;
   };
   long indexed = 0;
-  for (const Camera& camera : {Camera{"chase", 640, 480, 30.0, false},
-                               Camera{"trailing", 640, 480, 30.0, false},
-                               Camera{"belly", 320, 240, 10.0, true}}) {
+  for (const Camera& camera :
+       {Camera{"chase", 640, 480, 30.0, false}, Camera{"trailing", 640, 480, 30.0, false},
+        Camera{"belly", 320, 240, 10.0, true}}) {
     const std::vector<IndexRow> rows = ReadIndex(dir.path() / (std::string(camera.name) + ".csv"));
     ASSERT_FALSE(rows.empty()) << camera.name;
     indexed += long(rows.size());
@@ -100,8 +100,10 @@ TEST(RunCommandTest, CamerasWriteIndexedFramesAtTheirRatesWithDepth) {
 TEST(RunCommandTest, SlowTicksAreFollowedAtOnceWithoutBunchingAndStatisticsAreWritten) {
   sandbox::testing::TempDir dir;
   // Ticks 50-52 take 40 ms each: four periods.
-  const auto run = RunSandbox("run --duration 1.5 --lcm-url memq:// --frames none --stall "
-                              "50:40,51:40,52:40 --out " + dir.path().string());
+  const auto run = RunSandbox(
+      "run --duration 1.5 --lcm-url memq:// --frames none --stall "
+      "50:40,51:40,52:40 --out " +
+      dir.path().string());
   ASSERT_EQ(run.exit_code, 0) << run.out;
   std::ifstream csv(dir.path() / "ticks.csv");
   std::string line;
@@ -122,7 +124,9 @@ TEST(RunCommandTest, SlowTicksAreFollowedAtOnceWithoutBunchingAndStatisticsAreWr
   for (int i = 50; i <= 52; ++i) EXPECT_GE(duration[std::size_t(i)], 40.0) << i;
   // Each slow tick is followed at once (no wait: it is already late) ...
   for (int i = 51; i <= 53; ++i) {
-    EXPECT_NEAR(start[std::size_t(i)], start[std::size_t(i - 1)] + duration[std::size_t(i - 1)] / 1e3, 2e-3) << i;
+    EXPECT_NEAR(start[std::size_t(i)],
+                start[std::size_t(i - 1)] + duration[std::size_t(i - 1)] / 1e3, 2e-3)
+        << i;
   }
   // ... and then the loop keeps its period from there: no burst of ticks to catch up.
   for (std::size_t i = 54; i + 1 < start.size(); ++i) {
@@ -131,7 +135,9 @@ TEST(RunCommandTest, SlowTicksAreFollowedAtOnceWithoutBunchingAndStatisticsAreWr
   // The summary agrees with the file: the longest tick and the overruns.
   const double longest = *std::max_element(duration.begin(), duration.end());
   std::smatch max;
-  ASSERT_TRUE(std::regex_search(run.out, max, std::regex(R"(tick duration: p50 [0-9.]+ ms, p99 [0-9.]+ ms, max ([0-9.]+) ms)")))
+  ASSERT_TRUE(std::regex_search(
+      run.out, max,
+      std::regex(R"(tick duration: p50 [0-9.]+ ms, p99 [0-9.]+ ms, max ([0-9.]+) ms)")))
       << run.out;
   EXPECT_NEAR(std::stod(max[1]), longest, 2e-3);
   EXPECT_NE(run.out.find(std::to_string(start.size()) + " ticks in"), std::string::npos) << run.out;
@@ -175,7 +181,8 @@ TEST(RunCommandTest, BadFrameOptionsFailClearly) {
       RunSandbox("run --duration 0.1 --lcm-url memq:// --frames gif --out " + dir.path().string());
   EXPECT_NE(gif.exit_code, 0);
   EXPECT_NE(gif.out.find("--frames must be jpg, png, mp4 or avi (or a list like jpg,mp4, or none), "
-                         "got 'gif'"), std::string::npos)
+                         "got 'gif'"),
+            std::string::npos)
       << gif.out;
   const auto two = RunSandbox("run --duration 0.1 --lcm-url memq:// --frames jpg,png --out " +
                               dir.path().string());
@@ -199,7 +206,8 @@ TEST(RunCommandTest, BadFrameOptionsFailClearly) {
   const auto tiff =
       RunSandbox("run --duration 0.1 --lcm-url memq:// --depth tiff --out " + dir.path().string());
   EXPECT_NE(tiff.exit_code, 0);
-  EXPECT_NE(tiff.out.find("--depth must be png, npy or exr, got 'tiff'"), std::string::npos) << tiff.out;
+  EXPECT_NE(tiff.out.find("--depth must be png, npy or exr, got 'tiff'"), std::string::npos)
+      << tiff.out;
   const std::string file = (dir.path() / "not_a_folder").string();
   std::ofstream(file) << "x";
   const auto blocked = RunSandbox("run --duration 0.1 --lcm-url memq:// --out " + file);

@@ -61,7 +61,8 @@ TEST(RobotOutputsTest, RangeReadingArrivesOnItsChannelWithItsSensorAndInput) {
 // The sample level's wing with extra [[robot.sensor]] tables appended.
 scene::Level WingWith(testing::TempDir& dir, const std::string& sensors) {
   const std::string wing =
-      (std::filesystem::path(SANDBOX_SOURCE_DIR) / "assets/robots/generated/flying_wing.gltf").string();
+      (std::filesystem::path(SANDBOX_SOURCE_DIR) / "assets/robots/generated/flying_wing.gltf")
+          .string();
   return scene::LoadLevel(dir.Write("level.toml", "[[robot]]\nname = \"W\"\nfile = \"" + wing +
                                                       "\"\nbones = [\"root\"]\n" + sensors));
 }
@@ -93,8 +94,9 @@ TEST(RobotOutputsTest, StateEchoesThePoseAndTheBoneValuesInUse) {
 
 TEST(RobotOutputsTest, TwoSensorsOfATypeNeedTheirOwnChannels) {
   testing::TempDir dir;
-  const std::string face = "[[robot.sensor]]\nname = \"nose\"\ntype = \"face\"\n"
-                           "[[robot.sensor]]\nname = \"tail\"\ntype = \"face\"\n";
+  const std::string face =
+      "[[robot.sensor]]\nname = \"nose\"\ntype = \"face\"\n"
+      "[[robot.sensor]]\nname = \"tail\"\ntype = \"face\"\n";
   try {
     CheckOutputChannels(WingWith(dir, face));
     ADD_FAILURE() << "two face scanners on one channel were accepted";
@@ -106,9 +108,10 @@ TEST(RobotOutputsTest, TwoSensorsOfATypeNeedTheirOwnChannels) {
         << message;
   }
   // With a channel of its own the second scanner publishes there.
-  const scene::Level level = WingWith(dir, face + "channel = \"SCAN_FACE_TAIL\"\n"
-                                                  "[[robot.sensor]]\nname = \"a1\"\ntype = \"ray\"\n"
-                                                  "[[robot.sensor]]\nname = \"a2\"\ntype = \"ray\"\n");
+  const scene::Level level = WingWith(dir, face +
+                                               "channel = \"SCAN_FACE_TAIL\"\n"
+                                               "[[robot.sensor]]\nname = \"a1\"\ntype = \"ray\"\n"
+                                               "[[robot.sensor]]\nname = \"a2\"\ntype = \"ray\"\n");
   EXPECT_NO_THROW(CheckOutputChannels(level));  // range sensors share RANGE: they say their names
   EXPECT_EQ(OutputChannel(level.robots[0].sensors[1]), "SCAN_FACE_TAIL");
   LcmLink link("memq://");
@@ -131,15 +134,17 @@ TEST(RobotOutputsTest, ChannelMistakesAreNamed) {
     WingWith(dir, "[[robot.camera]]\nname = \"c\"\ntype = \"chase\"\nchannel = \"CAM\"\n");
     ADD_FAILURE() << "a camera channel was accepted";
   } catch (const scene::LevelError& error) {
-    EXPECT_NE(std::string(error.what()).find("camera 'c': a camera publishes no channel"), std::string::npos)
+    EXPECT_NE(std::string(error.what()).find("camera 'c': a camera publishes no channel"),
+              std::string::npos)
         << error.what();
   }
   try {
     WingWith(dir, "[[robot.sensor]]\nname = \"s\"\ntype = \"face\"\nchannel = \"MY SCAN\"\n");
     ADD_FAILURE() << "a channel with a space was accepted";
   } catch (const scene::LevelError& error) {
-    EXPECT_NE(std::string(error.what()).find("'channel' must be a name without spaces, got 'MY SCAN'"),
-              std::string::npos)
+    EXPECT_NE(
+        std::string(error.what()).find("'channel' must be a name without spaces, got 'MY SCAN'"),
+        std::string::npos)
         << error.what();
   }
 }

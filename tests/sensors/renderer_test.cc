@@ -1,5 +1,6 @@
 // The OSMesa renderer and the cameras: colours, depth against the ray caster,
-// textures (a generated quad, CesiumMan's embedded texture), the bent wing's silhouette, the chase camera's aim and lag.
+// textures (a generated quad, CesiumMan's embedded texture), the bent wing's silhouette, the chase
+// camera's aim and lag.
 
 #include "sensors/renderer.h"
 
@@ -7,8 +8,8 @@
 
 #include <cmath>
 #include <fstream>
-#include <set>
 #include <opencv2/imgcodecs.hpp>
+#include <set>
 
 #include "app/images.h"
 #include "scene/collision_world.h"
@@ -84,7 +85,8 @@ TEST_F(RendererTest, DepthAgreesWithTheRayCaster) {
   for (int row = 4; row < view.height; row += 37) {
     for (int column = 4; column < view.width; column += 41) {
       // The ray through the pixel centre, in the camera frame (x forward).
-      const Vector3d d_C(1.0, -(column + 0.5 - 0.5 * view.width) / f, -(row + 0.5 - 0.5 * view.height) / f);
+      const Vector3d d_C(1.0, -(column + 0.5 - 0.5 * view.width) / f,
+                         -(row + 0.5 - 0.5 * view.height) / f);
       rays.start.emplace_back(0.f, 0.f, 0.f);
       rays.direction.push_back((view.X_WC.linear() * d_C.normalized()).cast<float>());
       rays.length_m.push_back(2000.f);
@@ -96,12 +98,14 @@ TEST_F(RendererTest, DepthAgreesWithTheRayCaster) {
   int compared = 0;
   for (std::size_t i = 0; i < pixels.size(); ++i) {
     const auto [column, row] = pixels[i];
-    const float depth = frame.depth_m[std::size_t(row) * std::size_t(view.width) + std::size_t(column)];
+    const float depth =
+        frame.depth_m[std::size_t(row) * std::size_t(view.width) + std::size_t(column)];
     if (hits.body[i] == RayHits::kNoHit) {
       EXPECT_TRUE(std::isinf(depth)) << column << ", " << row;
       continue;
     }
-    const Vector3d d_C(1.0, -(column + 0.5 - 0.5 * view.width) / f, -(row + 0.5 - 0.5 * view.height) / f);
+    const Vector3d d_C(1.0, -(column + 0.5 - 0.5 * view.width) / f,
+                       -(row + 0.5 - 0.5 * view.height) / f);
     const double expected = hits.distance_m[i] / d_C.norm();  // along the optical axis
     EXPECT_NEAR(depth, expected, 0.02 + 1e-3 * expected) << column << ", " << row;
     ++compared;
@@ -136,19 +140,23 @@ TEST_F(RendererTest, OverlayMarksEachScannedSampleInItsColourWithoutTouchingDept
     const Eigen::Vector2d pixel = Project(view, overlay.points_W[i]);
     const double along = (view.X_WC.inverse() * overlay.points_W[i]).x();
     const int column = int(std::floor(pixel.x())), row = int(std::floor(pixel.y()));
-    if (along <= 0 || column < 2 || row < 2 || column >= view.width - 2 || row >= view.height - 2) continue;
-    const float depth = plain.depth_m[std::size_t(row) * std::size_t(view.width) + std::size_t(column)];
+    if (along <= 0 || column < 2 || row < 2 || column >= view.width - 2 || row >= view.height - 2)
+      continue;
+    const float depth =
+        plain.depth_m[std::size_t(row) * std::size_t(view.width) + std::size_t(column)];
     if (along > depth * 1.001 + 0.05) continue;  // behind the terrain: hidden
     const bool occupied = overlay.point_rgb[i].x() > 0.5f;
     const std::uint8_t* rgb = Pixel(marked, column, row);
-    const bool red = rgb[0] > 200 && rgb[1] < 80, green = rgb[1] > 180 && rgb[0] < 80;
+    const bool red = rgb[0] > 200 && rgb[1]<80, green = rgb[1]> 180 && rgb[0] < 80;
     ++checked[occupied];
     right[occupied] += occupied ? red : green;
   }
   EXPECT_GT(checked[0], 500);
   EXPECT_GT(checked[1], 200);
-  EXPECT_GT(right[0], 0.95 * checked[0]) << right[0] << " of " << checked[0] << " free samples green";
-  EXPECT_GT(right[1], 0.95 * checked[1]) << right[1] << " of " << checked[1] << " occupied samples red";
+  EXPECT_GT(right[0], 0.95 * checked[0])
+      << right[0] << " of " << checked[0] << " free samples green";
+  EXPECT_GT(right[1], 0.95 * checked[1])
+      << right[1] << " of " << checked[1] << " occupied samples red";
 }
 
 TEST(DebugOverlayTest, ActorBoundsFollowTheActorAndStubsPointBackAlongTheRay) {
@@ -166,7 +174,8 @@ TEST(DebugOverlayTest, ActorBoundsFollowTheActorAndStubsPointBackAlongTheRay) {
   for (const Vector3d& p : overlay.lines_W) box.extend(p);
   EXPECT_TRUE(box.min().isApprox(Vector3d(8, -1, 0), 1e-9)) << box.min().transpose();
   EXPECT_TRUE(box.max().isApprox(Vector3d(12, 1, 3), 1e-9)) << box.max().transpose();
-  for (std::size_t i = 0; i < overlay.lines_W.size(); i += 2) {  // each edge along one axis, full length
+  for (std::size_t i = 0; i < overlay.lines_W.size();
+       i += 2) {  // each edge along one axis, full length
     const Vector3d edge = (overlay.lines_W[i + 1] - overlay.lines_W[i]).cwiseAbs();
     EXPECT_EQ((edge.array() > 1e-9).count(), 1);
   }
@@ -195,7 +204,7 @@ TEST(DebugOverlayTest, ActorBoundsFollowTheActorAndStubsPointBackAlongTheRay) {
 TEST(RendererTextureTest, TextureColoursShow) {
   // A square with a two-colour texture: red on the left half, blue on the right.
   testing::TempDir dir;
-  cv::Mat texture(8, 16, CV_8UC3, cv::Scalar(255, 0, 0));   // BGR blue
+  cv::Mat texture(8, 16, CV_8UC3, cv::Scalar(255, 0, 0));      // BGR blue
   texture(cv::Rect(0, 0, 8, 8)).setTo(cv::Scalar(0, 0, 255));  // left half red
   ASSERT_TRUE(cv::imwrite((dir.path() / "check.png").string(), texture));
   dir.Write("square.mtl", "newmtl check\nKd 1 1 1\nmap_Kd check.png\n");
@@ -212,7 +221,8 @@ TEST(RendererTextureTest, TextureColoursShow) {
   Frame frame;
   renderer->Render(view, {}, {}, {}, &frame);
   // Seen from -x the square's +y edge (u = 0, the red half) is on the image's left.
-  const Eigen::Vector2d left = Project(view, Vector3d(0, 0.5, 0)), right = Project(view, Vector3d(0, -0.5, 0));
+  const Eigen::Vector2d left = Project(view, Vector3d(0, 0.5, 0)),
+                        right = Project(view, Vector3d(0, -0.5, 0));
   const std::uint8_t* l = Pixel(frame, int(left.x()), int(left.y()));
   const std::uint8_t* r = Pixel(frame, int(right.x()), int(right.y()));
   EXPECT_GT(l[0], 3 * l[2]) << int(l[0]) << " " << int(l[1]) << " " << int(l[2]);
@@ -238,8 +248,8 @@ TEST(RendererTextureTest, CesiumManShowsItsEmbeddedTextureColours) {
   const std::string file = std::string(SANDBOX_SHARED_ASSETS) + "/cesium-man/CesiumMan.glb";
   if (!std::ifstream(file).good()) GTEST_SKIP() << "no " << file << " (shared assets absent)";
   testing::TempDir dir;
-  const scene::Level level =
-      scene::LoadLevel(dir.Write("level.toml", "[[actor]]\nname = \"man\"\nfile = \"" + file + "\"\n"));
+  const scene::Level level = scene::LoadLevel(
+      dir.Write("level.toml", "[[actor]]\nname = \"man\"\nfile = \"" + file + "\"\n"));
   ASSERT_EQ(level.textures.size(), 1u);
   // The texture's own colours, decoded here from the file's bytes.
   const scene::EmbeddedTexture& embedded = level.textures[0];
@@ -269,8 +279,8 @@ TEST(RendererTextureTest, CesiumManShowsItsEmbeddedTextureColours) {
   // render has the one base colour.
   const RenderSettings sky;
   auto is_sky = [&](const std::uint8_t* p) {
-    return std::abs(p[0] - 255 * sky.sky_rgb.x()) < 3 && std::abs(p[1] - 255 * sky.sky_rgb.y()) < 3 &&
-           std::abs(p[2] - 255 * sky.sky_rgb.z()) < 3;
+    return std::abs(p[0] - 255 * sky.sky_rgb.x()) < 3 &&
+           std::abs(p[1] - 255 * sky.sky_rgb.y()) < 3 && std::abs(p[2] - 255 * sky.sky_rgb.z()) < 3;
   };
   auto near_texture = [&](int bin) {
     for (int dr = -1; dr <= 1; ++dr) {
@@ -321,7 +331,8 @@ TEST(RendererWingTest, BendingMovesTheSilhouetteToTheAnalyticTip) {
   // The analytic right tip: ten joints 0.6 then 1.2 m out along -y, each rolled 4.5 degrees.
   Isometry3d X = Isometry3d(Eigen::Translation3d(0, 0, 60));
   for (int k = 1; k <= 10; ++k) {
-    X = X * Eigen::Translation3d(0, k == 1 ? -0.6 : -1.2, 0) * Eigen::AngleAxisd(roll, Vector3d::UnitX());
+    X = X * Eigen::Translation3d(0, k == 1 ? -0.6 : -1.2, 0) *
+        Eigen::AngleAxisd(roll, Vector3d::UnitX());
   }
   const Vector3d tip = X * Vector3d(-0.15, -0.6, 0.0);  // half an element inside the tip
   const Eigen::Vector2d px = Project(view, tip);
@@ -330,7 +341,7 @@ TEST(RendererWingTest, BendingMovesTheSilhouetteToTheAnalyticTip) {
     const std::uint8_t* p = Pixel(frame, int(px.x()), int(px.y()));
     return std::abs(p[0] - 255 * sky.sky_rgb[0]) < 3 && std::abs(p[2] - 255 * sky.sky_rgb[2]) < 3;
   };
-  EXPECT_FALSE(is_sky(frame_bent)) << px.transpose();  // the bent tip is drawn there
+  EXPECT_FALSE(is_sky(frame_bent)) << px.transpose();     // the bent tip is drawn there
   EXPECT_TRUE(is_sky(frame_straight)) << px.transpose();  // the straight wing is not
 }
 
@@ -358,7 +369,8 @@ TEST(CameraTest, ChaseCameraAimsAtTheRobotAndFollowsWithoutOvershoot) {
   const Isometry3d panned = TrailingPose(X_WB, 25, 8, {M_PI / 2, 0.0, 1.0});
   EXPECT_NEAR((straight.translation() - X_WB.translation()).norm(),
               (panned.translation() - X_WB.translation()).norm(), 1e-9);
-  EXPECT_GT(TrailingPose(X_WB, 25, 8, {0.0, 0.3, 1.0}).translation().z(), straight.translation().z());
+  EXPECT_GT(TrailingPose(X_WB, 25, 8, {0.0, 0.3, 1.0}).translation().z(),
+            straight.translation().z());
   // Zoom 2 doubles every off-centre offset in the image.
   CameraView wide;
   wide.X_WC = Isometry3d::Identity();  // looking along +x
@@ -366,7 +378,8 @@ TEST(CameraTest, ChaseCameraAimsAtTheRobotAndFollowsWithoutOvershoot) {
   zoomed.fov_y_rad = ZoomedFov(wide.fov_y_rad, 2.0);
   const Vector3d p(100, 7, -5);
   const Eigen::Vector2d centre_px(320, 240);
-  EXPECT_TRUE((Project(zoomed, p) - centre_px).isApprox(2.0 * (Project(wide, p) - centre_px), 1e-9));
+  EXPECT_TRUE(
+      (Project(zoomed, p) - centre_px).isApprox(2.0 * (Project(wide, p) - centre_px), 1e-9));
   EXPECT_NEAR(ZoomedFov(M_PI / 2, 2.0), 2.0 * std::atan(0.5), 1e-12);
 }
 

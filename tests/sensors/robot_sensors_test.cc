@@ -123,16 +123,18 @@ TEST(RobotSensorsTest, CameraMistakesNameTheCameraAndField) {
             "link1, link2, link3, link4, link5, link6, tool)");
   EXPECT_EQ(CameraError("type = \"chase\"\nwidth = 0\n"),
             "level.toml:6: camera 'c': resolution must be 1 to 8192 pixels a side, got 0 x 480");
-  EXPECT_EQ(CameraError("type = \"chase\"\nheight = 100000\n"),
-            "level.toml:6: camera 'c': resolution must be 1 to 8192 pixels a side, got 640 x 100000");
+  EXPECT_EQ(
+      CameraError("type = \"chase\"\nheight = 100000\n"),
+      "level.toml:6: camera 'c': resolution must be 1 to 8192 pixels a side, got 640 x 100000");
   EXPECT_EQ(CameraError("type = \"chase\"\nfov_deg = 180\n"),
             "level.toml:6: camera 'c': field of view must be between 0 and 180 degrees");
   EXPECT_EQ(CameraError("type = \"trailing\"\noverlay_stub_m = -1\n"),
             "level.toml:6: camera 'c': overlay_stub_m must be 0 (points) to 100 m");
   EXPECT_EQ(CameraError("type = \"chase\"\nzoom = 2\n"),
             "level.toml:9: camera 'c': unknown key 'zoom' for a chase camera");
-  EXPECT_EQ(CameraError("type = \"drone\"\n"),
-            "level.toml:8: camera 'c': 'type' must be chase, trailing, payload or fixed, got 'drone'");
+  EXPECT_EQ(
+      CameraError("type = \"drone\"\n"),
+      "level.toml:8: camera 'c': 'type' must be chase, trailing, payload or fixed, got 'drone'");
   EXPECT_EQ(CameraError("type = \"payload\"\nmount = \"link6\"\noverlay = true\n"), "no error");
 }
 

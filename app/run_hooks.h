@@ -1,0 +1,19 @@
+#pragma once
+// In-process additions to `sandbox run`'s loop (the demo's fallback pilot and
+// its heartbeat listener). Both run on the loop thread.
+
+#include <functional>
+
+#include "bridge/lcm_link.h"
+
+namespace sandbox::app {
+
+struct RunHooks {
+  // Called at the start of each tick, before the inputs are drained, with the
+  // seconds since the loop started.
+  std::function<void(bridge::LcmLink& link, double wall_s)> before_tick;
+  // Called before the link closes: let go of what before_tick subscribed.
+  std::function<void(bridge::LcmLink& link)> before_close;
+};
+
+}  // namespace sandbox::app

@@ -1,0 +1,101 @@
+#include "app/run_options.h"
+
+#include <sstream>
+
+#include "app/defaults.h"
+
+namespace sandbox::app {
+namespace {
+
+// --frames: at most one image and one video format, or none.
+void ParseFrames(const std::string& text, FramePipelineConfig* config) {
+  config->image_format.clear();
+  config->video_format.clear();
+  if (text == "none") return;
+  std::stringstream list(text);
+  std::string format;
+  while (std::getline(list, format, ',')) {
+    std::string& slot = format == "jpg" || format == "png"   ? config->image_format
+                        : format == "mp4" || format == "avi" ? config->video_format
+                                                             : format;
+    if (&slot == &format) {
+      throw CommandError(
+          "--frames must be jpg, png, mp4 or avi (or a list like jpg,mp4, or none), "
+          "got '" +
+          format + "'");
+    }
+    if (!slot.empty()) throw CommandError("--frames: one image and one video format at most");
+    slot = format;
+  }
+  if (config->image_format.empty() && config->video_format.empty()) {
+    throw CommandError("--frames: nothing to write in '" + text + "' (none writes no frames)");
+  }
+}
+
+// --stall "TICK:MS,...": milliseconds to sleep inside given ticks.
+std::map<std::int64_t, double> ParseStalls(const std::string& text) {
+  std::map<std::int64_t, double> stalls;
+  std::stringstream list(text);
+  std::string item;
+  while (std::getline(list, item, ',')) {
+    const std::size_t colon = item.find(':');
+    std::vector<double> values;
+    if (colon != std::string::npos) {
+      values = ParseNumbers(item.substr(0, colon) + "," + item.substr(colon + 1), "--stall");
+    }
+    if (values.size() != 2 || values[0] < 0 || values[1] < 0) {
+      throw CommandError("--stall wants TICK:MS items, got '" + item + "'");
+    }
+    stalls[std::int64_t(values[0])] = values[1];
+  }
+  return stalls;
+}
+
+}  // namespace
+
+const std::set<std::string> kRunValueOptions = {
+    "--rate",   "--duration", "--lcm-url",     "--replay", "--record",  "--out",
+    "--frames", "--depth",    "--scans-every", "--stall",  "--realtime"};
+const std::set<std::string> kRunFlags = {"--lockstep", "--view"};
+
+RunOptions ParseRunOptions(const ParsedArgs& args) {
+  RunOptions options;
+  options.level = args.level.value_or(kDefaultLevel);
+  auto number = [&](const std::string& option, double fallback) {
+    return args.values.count(option) ? ParseNumbers(args.Value(option), option).at(0) : fallback;
+  };
+  if (args.Value("--rate") == "max") {
+    options.rate_hz = 0.0;
+  } else {
+    options.rate_hz = number("--rate", 100.0);
+    if (!(options.rate_hz > 0.0)) throw CommandError("--rate must be positive or max");
+  }
+  options.duration_s = number("--duration", -1.0);
+  options.lcm_url = args.Value("--lcm-url");
+  options.replay_file = args.Value("--replay");
+  options.lockstep = options.replay() || args.flags.count("--lockstep") > 0;
+  options.record_file = args.Value("--record");
+  options.out_dir = args.Value("--out");
+  ParseFrames(args.Value("--frames", "jpg"), &options.frames);
+  options.frames.depth_format = args.Value("--depth", "png");
+  if (options.frames.depth_format != "png" && options.frames.depth_format != "npy" &&
+      options.frames.depth_format != "exr") {
+    throw CommandError("--depth must be png, npy or exr, got '" + options.frames.depth_format +
+                       "'");
+  }
+  options.scans_every_s = number("--scans-every", 0.0);
+  if (args.values.count("--scans-every") &&
+      (options.out_dir.empty() || !(options.scans_every_s > 0.0))) {
+    throw CommandError("--scans-every needs --out and a positive number of seconds");
+  }
+  options.view = args.flags.count("--view") > 0;
+  const std::string realtime = args.Value("--realtime", "auto");
+  if (realtime != "auto" && realtime != "off") {
+    throw CommandError("--realtime must be auto or off, got '" + realtime + "'");
+  }
+  options.realtime = realtime == "auto";
+  options.stalls_ms = ParseStalls(args.Value("--stall"));
+  return options;
+}
+
+}  // namespace sandbox::app

@@ -1,0 +1,40 @@
+#pragma once
+// What `sandbox run` is asked to do, as values: its command line parsed and
+// checked. ParseRunOptions throws CommandError naming the option.
+
+#include <cstdint>
+#include <map>
+#include <set>
+#include <string>
+
+#include "app/command_line.h"
+#include "app/frame_pipeline.h"
+
+namespace sandbox::app {
+
+struct RunOptions {
+  std::string level;           // a scene file or manifest
+  double rate_hz{100.0};       // 0: free running (--rate max)
+  double duration_s{-1.0};     // < 0: until stopped
+  std::string lcm_url;         // empty: LCM's default
+  bool lockstep{false};        // one pose message a tick (a replay is always lock-step)
+  std::string replay_file;     // an LCM log read instead of the network
+  std::string record_file;     // every output written to an LCM log
+  std::string out_dir;         // statistics, frames and scans; empty: none
+  FramePipelineConfig frames;  // image, video and depth formats (out_dir set later)
+  double scans_every_s{0.0};   // 0: no scan files
+  bool view{false};            // the live view
+  bool realtime{true};         // ask for SCHED_FIFO
+  std::map<std::int64_t, double> stalls_ms;  // test aid: tick -> extra milliseconds
+
+  bool free_running() const { return rate_hz == 0.0; }
+  bool replay() const { return !replay_file.empty(); }
+};
+
+// The value options and flags `sandbox run` takes.
+extern const std::set<std::string> kRunValueOptions, kRunFlags;
+
+// Throws CommandError for a bad value or combination.
+RunOptions ParseRunOptions(const ParsedArgs& args);
+
+}  // namespace sandbox::app

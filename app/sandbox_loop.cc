@@ -1,0 +1,510 @@
+#include "app/sandbox_loop.h"
+
+#include <pthread.h>
+#include <sched.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <iomanip>
+#include <sstream>
+#include <thread>
+#include <variant>
+
+#include "app/command_line.h"
+#include "sensors/debug_overlay.h"
+#include "sensors/range_sensor.h"
+
+namespace sandbox::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::atomic<bool> stop_requested{false};
+void OnSignal(int) { stop_requested = true; }
+
+std::int64_t NowUtime() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+std::string Format(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+// SCHED_FIFO for the calling thread (threads it starts later inherit it; the
+// caster's workers and the frame threads, started earlier, do not). False
+// when not permitted.
+bool RaiseToRealTime() {
+  sched_param param{};
+  param.sched_priority = 10;  // above every normal thread, below the kernel's own
+  return pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
+}
+
+// Back to normal priority, however the loop ends.
+struct NormalPriorityAtExit {
+  ~NormalPriorityAtExit() {
+    sched_param param{};
+    pthread_setschedparam(pthread_self(), SCHED_OTHER, &param);
+  }
+};
+
+// The robots' sensors, once their output channels are known not to collide.
+std::vector<sensors::MountedSensor> CheckedSensors(const scene::Level& level) {
+  std::vector<sensors::MountedSensor> mounted = sensors::MakeRobotSensors(level);
+  bridge::CheckOutputChannels(level);
+  return mounted;
+}
+
+// Creates the output folder (and its scans/); returns the statistics file, or "".
+std::string PrepareOutDir(const RunOptions& options) {
+  if (options.out_dir.empty()) return "";
+  const std::filesystem::path dir = options.out_dir;
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error || !std::filesystem::is_directory(dir)) {
+    throw CommandError("cannot create the output folder '" + options.out_dir + "'");
+  }
+  if (options.scans_every_s > 0.0) std::filesystem::create_directories(dir / "scans", error);
+  return (dir / "ticks.csv").string();
+}
+
+}  // namespace
+
+std::vector<bridge::ChannelStatus> SandboxLoop::RobotRun::Channels(std::int64_t now_utime) const {
+  std::vector<bridge::ChannelStatus> channels;
+  for (const bridge::LatestInput* in :
+       {&inputs->pose(), &inputs->bones(), &inputs->actors(), &inputs->camera()}) {
+    // Camera commands come when someone steers: never stale.
+    const bool stale = in != &inputs->camera() && in->Stale(now_utime, config.stale_after_s);
+    channels.push_back({in->channel(), in->received(), in->superseded(), in->rejected(), stale,
+                        in->last_reject_reason()});
+  }
+  for (const bridge::UdpLatest* socket :
+       {net_fdm ? &net_fdm->socket() : nullptr, doubles ? &doubles->socket() : nullptr}) {
+    if (socket == nullptr) continue;
+    channels.push_back({socket->name(), socket->received(), socket->superseded(),
+                        socket->rejected(), false, socket->last_reject_reason()});
+  }
+  return channels;
+}
+
+SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream& out,
+                         std::ostream& err)
+    : options_(options),
+      hooks_(std::move(hooks)),
+      out_(out),
+      err_(err),
+      level_(scene::LoadLevel(options.level)),
+      mounted_(CheckedSensors(level_)),
+      cameras_(sensors::MakeRobotCameras(level_)),
+      world_(level_),
+      log_(options.replay() ? std::make_unique<bridge::LogReader>(options.replay_file) : nullptr),
+      // A replay feeds its inputs through an in-process link: nothing on the network.
+      link_(options.replay() ? "memq://" : options.lcm_url),
+      reject_log_(&err),
+      stats_(PrepareOutDir(options)) {
+  if (!options_.record_file.empty()) link_.RecordTo(options_.record_file);
+  robots_.resize(level_.robots.size());
+  for (std::size_t r = 0; r < level_.robots.size(); ++r) {
+    RobotRun& robot = robots_[r];
+    robot.config = bridge::RobotBridgeConfig::FromModel(level_.robots[r]);
+    robot.state = std::make_unique<scene::RobotState>(level_.robots[r]);
+    robot.inputs = std::make_unique<bridge::RobotInputs>(link_, level_, int(r), robot.config);
+    robot.outputs = std::make_unique<bridge::RobotOutputs>(
+        link_, robot.config.channel_prefix,
+        robot.config.state_in_pose_convention ? robot.config.pose : bridge::Translation{});
+    robot.inputs->set_log(&reject_log_);
+    robot.inputs->set_lockstep(options_.lockstep);
+    if (robot.config.net_fdm_port > 0) {
+      robot.net_fdm = std::make_unique<bridge::NetFdmInput>(robot.config);
+      robot.net_fdm->set_log(&reject_log_);
+    }
+    if (robot.config.udp_doubles_port > 0) {
+      robot.doubles = std::make_unique<bridge::DoublesInput>(robot.config, level_.robots[r]);
+      robot.doubles->set_log(&reject_log_);
+    }
+  }
+  for (const sensors::MountedSensor& m : mounted_) sensor_runs_.push_back({&m, 0.0, {}});
+  for (const sensors::MountedCamera& camera : cameras_) {
+    camera_runs_.push_back({&camera, sensors::ChaseCamera(camera.chase)});
+  }
+  // Cameras: rendered off the loop, into the output folder and/or the live view.
+  if (options_.view) {
+    if (cameras_.empty()) throw CommandError("--view: the level declares no [[robot.camera]]");
+    live_view_ = std::make_unique<LiveView>("sandbox: " + level_.name);
+  }
+  write_frames_ = !options_.out_dir.empty() && !cameras_.empty() &&
+                  (!options_.frames.image_format.empty() || !options_.frames.video_format.empty());
+  if (write_frames_ || live_view_) {
+    FramePipelineConfig config = options_.frames;
+    config.out_dir = write_frames_ ? options_.out_dir : "";
+    config.lossless = options_.lockstep;
+    if (live_view_) {
+      config.show = [this](const std::string& camera, const sensors::Frame& frame) {
+        live_view_->Show(frame, camera);
+      };
+    }
+    frames_ = std::make_unique<FramePipeline>(level_, config);
+  }
+}
+
+SandboxLoop::~SandboxLoop() {
+  if (hooks_.before_close) hooks_.before_close(link_);
+}
+
+bool SandboxLoop::has_pose() const {
+  for (const RobotRun& robot : robots_) {
+    if (robot.inputs->HasPose()) return true;
+  }
+  return false;
+}
+
+void SandboxLoop::Run() {
+  // The loop thread at real-time priority when allowed (and when it sleeps
+  // between ticks): the kernel then wakes it at once, whatever else runs.
+  std::string priority;
+  const NormalPriorityAtExit restore_priority;
+  if (options_.realtime && !options_.free_running()) {
+    priority = RaiseToRealTime() ? ", real-time priority"
+                                 : ", normal priority (real-time needs CAP_SYS_NICE or ulimit -r)";
+  }
+  const std::string pace = options_.lockstep         ? std::string("lock-step")
+                           : options_.free_running() ? std::string("free running")
+                                                     : Format(options_.rate_hz) + " Hz";
+  out_ << "sandbox run: " << level_.name << ", " << level_.robots.size() << " robots, "
+       << mounted_.size() << " sensors, "
+       << (options_.replay() ? "replaying " + options_.replay_file : pace + ", LCM " + link_.url())
+       << priority << "\n"
+       << std::flush;
+  stop_requested = false;
+  std::signal(SIGINT, OnSignal);
+  std::signal(SIGTERM, OnSignal);
+
+  const bool paced = !options_.lockstep && !options_.free_running();
+  const auto period = std::chrono::duration<double>(paced ? 1.0 / options_.rate_hz : 0.0);
+  const auto start = Clock::now();
+  auto deadline = start;
+  while (!stop_requested) {
+    const double wall_s = std::chrono::duration<double>(Clock::now() - start).count();
+    if (options_.duration_s >= 0.0 && wall_s >= options_.duration_s) break;
+    if (options_.lockstep) {
+      bool wait = false;
+      if (!NextLockstepInput(wall_s, &wait)) break;
+      if (wait) continue;
+    }
+    const auto tick_start = Clock::now();
+    TickRecord record;
+    record.tick = tick_;
+    record.start_s = std::chrono::duration<double>(tick_start - start).count();
+    record.lateness_ms =
+        paced ? std::chrono::duration<double, std::milli>(tick_start - deadline).count() : 0.0;
+    const std::int64_t rays_before = caster_.rays_cast();
+    if (live_view_) {
+      for (const ViewKey key : live_view_->TakeKeys()) controls_.Apply(key, int(cameras_.size()));
+      if (controls_.quit) break;
+      if (controls_.paused) {  // the world holds still; inputs keep only their newest
+        link_.Drain();
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        deadline = Clock::now();
+        continue;
+      }
+    }
+    if (hooks_.before_tick) hooks_.before_tick(link_, wall_s);
+    // 1-2. Inputs applied; 3-4. sensors that are due, their outputs, the state.
+    std::int64_t now = NowUtime();
+    const double t = ApplyInputs(wall_s, &now, &record);
+    RunDueSensors(t, now);
+    for (RobotRun& robot : robots_) robot.outputs->PublishState(*robot.state, robot.input, now);
+    WriteDueScans(t);
+    // 5. Cameras that are due: jobs for the render thread (copies, no waiting).
+    SubmitDueFrames(t, &record);
+    PublishStatusIfDue(t, now);
+    if (const auto stall = options_.stalls_ms.find(tick_); stall != options_.stalls_ms.end()) {
+      std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(stall->second));
+    }
+    ++tick_;
+    // 6. Record the tick; wait for the next. A late tick starts the next at
+    // once and the deadlines restart from there: no catching up.
+    const auto tick_end = Clock::now();
+    record.duration_ms = std::chrono::duration<double, std::milli>(tick_end - tick_start).count();
+    record.rays = caster_.rays_cast() - rays_before;
+    bool overrun = false;
+    if (paced) {
+      deadline += std::chrono::duration_cast<Clock::duration>(period);
+      if (tick_end > deadline) {
+        overrun = true;
+        deadline = tick_end;
+      } else {
+        std::this_thread::sleep_until(deadline);
+      }
+    }
+    stats_.Add(record, overrun);
+  }
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+  if (frames_) frames_->Finish();  // queues drained, videos and indexes closed
+  scan_files_.Finish();
+  PrintSummary(std::chrono::duration<double>(Clock::now() - start).count());
+}
+
+bool SandboxLoop::NextLockstepInput(double wall_s, bool* wait) {
+  *wait = false;
+  if (!log_) {  // from the network: wait for a pose message
+    link_.Drain();
+    if (!has_pose()) {
+      link_.Wait(100);
+      *wait = true;
+    }
+    return true;
+  }
+  std::string channel;
+  std::vector<std::uint8_t> data;
+  std::int64_t utime = 0;
+  while (!has_pose() && log_->Next(&channel, &data, &utime)) {
+    link_.Inject(channel, data.data(), unsigned(data.size()));
+    link_.Drain();
+  }
+  if (!has_pose()) return false;  // the log has ended
+  if (wall_s >= next_progress_s_) {
+    next_progress_s_ = wall_s + 0.25;
+    const double done = log_->fraction_read();
+    err_ << "\rreplay: " << std::setw(3) << int(100 * done) << "% | " << tick_ << " ticks | "
+         << std::setprecision(0) << std::fixed << (wall_s > 0 ? double(tick_) / wall_s : 0.0)
+         << " ticks/s | " << (done > 0 ? wall_s * (1 - done) / done : 0.0) << " s left  "
+         << std::defaultfloat << std::setprecision(6) << std::flush;
+  }
+  return true;
+}
+
+double SandboxLoop::ApplyInputs(double wall_s, std::int64_t* now_utime, TickRecord* record) {
+  // The newest message per channel (lock-step: the next pose), applied.
+  if (!options_.lockstep) link_.Drain();
+  for (std::size_t r = 0; r < robots_.size(); ++r) {
+    RobotRun& robot = robots_[r];
+    const bridge::RobotInputs::Applied applied =
+        options_.lockstep ? robot.inputs->ApplyNext(robot.state.get(), &world_)
+                          : robot.inputs->Apply(robot.state.get(), &world_);
+    record->inputs +=
+        int(applied.pose) + int(applied.bones) + int(applied.actors) + int(applied.camera);
+    if (options_.lockstep && applied.pose) {
+      // Lock-step time is input time: the outputs depend on the inputs alone.
+      if (first_input_utime_ < 0) first_input_utime_ = applied.pose_utime;
+      *now_utime = applied.pose_utime;
+    }
+    if (applied.pose) robot.input = {applied.pose_seq, applied.pose_utime};
+    bool moved = applied.pose || applied.bones;
+    if (robot.net_fdm && robot.net_fdm->Apply(robot.state.get())) {
+      moved = true;
+      ++record->inputs;
+      robot.input = {robot.net_fdm->socket().received(), *now_utime};
+    }
+    if (robot.doubles && robot.doubles->Apply(robot.state.get())) {
+      moved = true;
+      ++record->inputs;
+      robot.input = {robot.doubles->socket().received(), *now_utime};
+    }
+    if (moved) {
+      robot.state->Update();
+      world_.UpdateRobot(int(r), *robot.state);
+    }
+  }
+  link_.set_record_utime(*now_utime);
+  return options_.lockstep
+             ? double(*now_utime - std::max<std::int64_t>(first_input_utime_, 0)) * 1e-6
+             : wall_s;
+}
+
+void SandboxLoop::RunDueSensors(double t, std::int64_t now_utime) {
+  for (SensorRun& run : sensor_runs_) {
+    if (t < run.next_due_s) continue;
+    const double rate = run.mounted->spec.rate_hz;
+    run.next_due_s = rate > 0.0 ? std::max(run.next_due_s + 1.0 / rate, t) : t;
+    RobotRun& robot = robots_[std::size_t(run.mounted->robot)];
+    sensors::RayFilter filter;
+    filter.ignore_robot = run.mounted->robot;
+    const Eigen::Isometry3d X_WS = run.mounted->Pose(*robot.state);
+    const std::string& channel = run.mounted->spec.channel;
+    if (const auto* face = std::get_if<sensors::FaceScannerConfig>(&run.mounted->config)) {
+      const sensors::FaceScanner scanner(*face);
+      if (run.face_scan.n == 0) run.face_scan = scanner.EmptyScan();
+      scanner.Scan(world_, caster_, filter, X_WS, tick_, &run.face_scan);
+      robot.outputs->PublishFaces(run.face_scan, tick_, robot.input, now_utime, channel);
+    } else if (const auto* ground =
+                   std::get_if<sensors::GroundScannerConfig>(&run.mounted->config)) {
+      sensors::HeightMap map;
+      sensors::GroundScanner(*ground).Scan(world_, caster_, filter, X_WS.translation(), &map);
+      robot.outputs->PublishGround(map, robot.input, now_utime, channel);
+    } else if (const auto* lidar = std::get_if<sensors::LidarConfig>(&run.mounted->config)) {
+      sensors::LidarScan scan;
+      sensors::Lidar(*lidar).Sweep(world_, caster_, filter, X_WS, X_WS, &scan);
+      robot.outputs->PublishLidar(scan, robot.input, now_utime, channel);
+    } else if (const auto* ray = std::get_if<sensors::RangeSensorConfig>(&run.mounted->config)) {
+      robot.outputs->PublishRange(run.mounted->spec.name,
+                                  sensors::MeasureRange(*ray, world_, caster_, filter, X_WS),
+                                  robot.input, now_utime, channel);
+    }
+  }
+}
+
+void SandboxLoop::WriteDueScans(double t) {
+  if (options_.scans_every_s <= 0.0 || t < next_scan_file_s_) return;
+  next_scan_file_s_ = std::max(next_scan_file_s_ + options_.scans_every_s, t);
+  for (const SensorRun& run : sensor_runs_) {
+    if (run.face_scan.n == 0) continue;
+    std::ostringstream name;
+    name << run.mounted->spec.name << "_" << std::setw(6) << std::setfill('0') << tick_ << ".ply";
+    scan_files_.Submit(run.face_scan,
+                       (std::filesystem::path(options_.out_dir) / "scans" / name.str()).string());
+  }
+}
+
+void SandboxLoop::SubmitDueFrames(double t, TickRecord* record) {
+  // The live view's camera: the one the keys chose, or the bridge's.
+  for (const RobotRun& robot : robots_) {
+    const std::string& name = robot.inputs->active_camera();
+    if (name.empty() || name == last_active_camera_) continue;
+    last_active_camera_ = name;
+    for (std::size_t c = 0; c < cameras_.size(); ++c) {
+      if (cameras_[c].spec.name == name) controls_.camera = int(c);
+    }
+  }
+  for (CameraRun& run : camera_runs_) {
+    const bool active = live_view_ && &run == &camera_runs_[std::size_t(controls_.camera)];
+    const double dt = run.last_s < 0.0 ? 0.0 : t - run.last_s;
+    run.last_s = t;
+    const RobotRun& robot = robots_[std::size_t(run.camera->robot)];
+    sensors::CameraView view = run.camera->view;
+    sensors::TrailingCommand steer = robot.inputs->trailing();  // from <ROBOT>/CAMERA
+    steer.pan_rad += controls_.steer.pan_rad;                   // and the keys
+    steer.tilt_rad += controls_.steer.tilt_rad;
+    steer.zoom *= controls_.steer.zoom;
+    view.X_WC =
+        run.camera->Pose(*robot.state, &run.chase, steer, dt);  // the chase lag advances every tick
+    if (run.camera->spec.type == "trailing")
+      view.fov_y_rad = sensors::ZoomedFov(view.fov_y_rad, steer.zoom);
+    if (!frames_ || (!write_frames_ && !active) || t < run.next_due_s) continue;
+    const double rate = run.camera->spec.rate_hz > 0.0 ? run.camera->spec.rate_hz : 30.0;
+    run.next_due_s = std::max(run.next_due_s + 1.0 / rate, t);
+    RenderJob job;
+    job.camera = run.camera->spec.name;
+    job.tick = tick_;
+    job.time_s = t;
+    job.view = view;
+    job.depth = run.camera->depth;
+    job.write = write_frames_;
+    job.show = active;
+    for (const RobotRun& r : robots_) job.robots.push_back(*r.state);
+    for (std::size_t a = 0; a < level_.actors.size(); ++a)
+      job.actor_poses.push_back(world_.actor_pose(int(a)));
+    job.robot_pose = robot.state->pose();
+    if (run.camera->overlay != (active && controls_.overlay)) {  // 'o' flips the view's
+      for (const SensorRun& sensor : sensor_runs_) {
+        if (sensor.mounted->robot == run.camera->robot) {
+          sensors::AddFaceScan(sensor.face_scan, run.camera->overlay_stub_m, &job.overlay);
+        }
+      }
+      sensors::AddBoneFrames(*robot.state, 1.0, &job.overlay);
+      sensors::AddActorBounds(level_, job.actor_poses, false, &job.overlay);
+    }
+    frames_->Submit(std::move(job));
+    ++record->frames;
+  }
+}
+
+void SandboxLoop::PublishStatusIfDue(double t, std::int64_t now_utime) {
+  if (t < next_status_s_) return;
+  next_status_s_ = t + 1.0;
+  const double rate_now = t > 0.0 ? double(tick_) / t : 0.0;
+  for (RobotRun& robot : robots_) {
+    robot.outputs->PublishStatus(rate_now, tick_, stats_.overruns(), robot.Channels(now_utime),
+                                 now_utime);
+  }
+}
+
+void SandboxLoop::PrintSummary(double elapsed_s) {
+  if (log_) {
+    err_ << "\rreplay: " << (log_->stopped_early().empty() ? "100% | " : "") << tick_ << " ticks"
+         << std::string(30, ' ') << "\n";
+    if (!log_->stopped_early().empty()) {
+      err_ << "sandbox run: the log '" << options_.replay_file << "' is " << log_->stopped_early()
+           << "; the " << log_->events() << " events before it were replayed\n";
+    } else if (tick_ == 0) {
+      err_ << "sandbox run: the log '" << options_.replay_file << "' has " << log_->events()
+           << " events but no pose message for this level's robots\n";
+    }
+  }
+  const StatsSummary summary = stats_.Summary();
+  out_ << "sandbox run: " << tick_ << " ticks in " << std::fixed << std::setprecision(2)
+       << elapsed_s << " s (" << (elapsed_s > 0 ? double(tick_) / elapsed_s : 0.0)
+       << " Hz), mean tick " << std::setprecision(3) << summary.mean_ms << " ms, "
+       << summary.overruns << " overruns\n";
+  out_ << "  tick duration: p50 " << summary.p50_ms << " ms, p99 " << summary.p99_ms << " ms, max "
+       << summary.max_ms << " ms\n";
+  const bool paced = !options_.lockstep && !options_.free_running();
+  if (paced) {
+    out_ << "  tick lateness: p50 " << summary.lateness_p50_ms << " ms, p99 "
+         << summary.lateness_p99_ms << " ms, max " << summary.lateness_max_ms << " ms\n";
+  }
+  if (!options_.out_dir.empty()) {
+    // Files that cannot be finished (a full disk) are reported; the run's results stand.
+    const std::filesystem::path dir = options_.out_dir;
+    const std::string mode = options_.free_running() ? std::string("free running")
+                             : options_.lockstep     ? std::string("lock-step")
+                                                     : Format(options_.rate_hz) + " Hz";
+    PlotSeries series{
+        stats_.ticks_per_point() == 1
+            ? std::string("tick duration")
+            : "longest of each " + std::to_string(stats_.ticks_per_point()) + " ticks",
+        stats_.PlotPoints()};
+    series.frames_per_value = double(stats_.ticks_per_point());
+    try {
+      PlotFrameDurations({series}, level_.name + ": " + std::to_string(tick_) + " ticks, " + mode,
+                         paced ? 1e3 / options_.rate_hz : 0.0, (dir / "ticks.png").string());
+    } catch (const std::exception& error) {
+      err_ << "sandbox run: warning: " << error.what() << "\n";
+    }
+    if (!stats_.Flush()) {
+      err_ << "sandbox run: warning: " << (dir / "ticks.csv").string()
+           << " is incomplete (cannot write)\n";
+    }
+    out_ << "  statistics: " << (dir / "ticks.csv").string() << ", " << (dir / "ticks.png").string()
+         << "\n";
+    if (options_.scans_every_s > 0.0) {
+      out_ << "  scans: " << scan_files_.written() << " PLY files written, "
+           << scan_files_.dropped() << " dropped, " << scan_files_.failed() << " failed"
+           << (scan_files_.failed() > 0 ? " (" + scan_files_.error() + ")" : "") << " -> "
+           << (dir / "scans").string() << "\n";
+    }
+  }
+  if (live_view_) {
+    out_ << "  live view: " << live_view_->shown() << " frames shown, last camera "
+         << cameras_[std::size_t(controls_.camera)].spec.name
+         << (controls_.overlay ? ", overlay toggled" : "")
+         << (controls_.quit ? ", quit by key" : "") << "\n";
+  }
+  if (frames_ && write_frames_) {
+    out_ << "  frames: " << frames_->rendered() << " rendered, " << frames_->written()
+         << " written, " << frames_->dropped() << " dropped, " << frames_->failed() << " failed"
+         << (frames_->failed() > 0 ? " (" + frames_->error() + ")" : "") << " -> "
+         << options_.out_dir << "\n";
+  }
+  for (const RobotRun& robot : robots_) {
+    if (!robot.inputs->active_camera().empty()) {
+      out_ << "  " << robot.config.channel_prefix
+           << " active camera: " << robot.inputs->active_camera() << "\n";
+    }
+    for (const bridge::ChannelStatus& channel : robot.Channels(NowUtime())) {
+      out_ << "  " << channel.channel << ": " << channel.received << " received, "
+           << channel.superseded << " superseded, " << channel.rejected << " rejected"
+           << (channel.rejected > 0 ? " (last: " + channel.last_reject_reason + ")" : "") << "\n";
+    }
+  }
+}
+
+}  // namespace sandbox::app

@@ -1,0 +1,117 @@
+#pragma once
+// The loop of `sandbox run` (../shared/DESIGN.md, "One tick of the loop"):
+// each tick drains the inputs (the newest message per channel; in lock-step
+// the next pose), applies poses, bones and placements, runs the sensors that
+// are due and publishes their outputs and the robot state, hands the cameras
+// that are due to the render thread, publishes the status heartbeat once a
+// second, and records the tick. A late tick is followed at once by the next;
+// ticks are never bunched to catch up.
+//
+// Threads: everything here runs on the loop thread (the caller of Run). It
+// starts the render and encoder threads (FramePipeline), the scan-file writer
+// and the live view's window thread, and takes real-time priority for itself
+// when asked and allowed.
+
+#include <memory>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "app/frame_pipeline.h"
+#include "app/live_view.h"
+#include "app/run_hooks.h"
+#include "app/run_options.h"
+#include "app/scan_files.h"
+#include "app/tick_stats.h"
+#include "bridge/lcm_link.h"
+#include "bridge/outputs.h"
+#include "bridge/reject_log.h"
+#include "bridge/robot_inputs.h"
+#include "bridge/udp_inputs.h"
+#include "scene/collision_world.h"
+#include "scene/level.h"
+#include "sensors/robot_sensors.h"
+
+namespace sandbox::app {
+
+class SandboxLoop {
+ public:
+  // Loads the level and opens what the options ask for (LCM, the log, the
+  // output folder, the frame threads, the window). Throws scene::LevelError
+  // for the level, std::runtime_error (CommandError) for the rest.
+  SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream& out, std::ostream& err);
+  ~SandboxLoop();
+  SandboxLoop(const SandboxLoop&) = delete;
+  SandboxLoop& operator=(const SandboxLoop&) = delete;
+
+  // Runs until the duration ends, a replayed log ends, SIGINT/SIGTERM or the
+  // live view's q; then finishes the files and prints the summary to `out`.
+  void Run();
+
+ private:
+  // A robot with its state, inputs and outputs.
+  struct RobotRun {
+    bridge::RobotBridgeConfig config;
+    std::unique_ptr<scene::RobotState> state;
+    std::unique_ptr<bridge::RobotInputs> inputs;
+    std::unique_ptr<bridge::NetFdmInput> net_fdm;
+    std::unique_ptr<bridge::DoublesInput> doubles;
+    std::unique_ptr<bridge::RobotOutputs> outputs;
+    bridge::InputTag input;  // the input the outputs are tagged with
+
+    // Every input's counters: the LCM channels, then the UDP sockets.
+    std::vector<bridge::ChannelStatus> Channels(std::int64_t now_utime) const;
+  };
+  struct SensorRun {
+    const sensors::MountedSensor* mounted;
+    double next_due_s{0.0};
+    sensors::FaceScan face_scan;  // the latest, faces as last scanned
+  };
+  struct CameraRun {
+    const sensors::MountedCamera* camera;
+    sensors::ChaseCamera chase;
+    double next_due_s{0.0}, last_s{-1.0};
+  };
+
+  // Lock-step: makes the next pose available (reading the replayed log up to
+  // it). False: stop (the log has ended); *wait: nothing yet, try again.
+  bool NextLockstepInput(double wall_s, bool* wait);
+  // Applies the inputs; returns the tick's time (input time in lock-step) and
+  // sets *now_utime to the time stamp outputs carry.
+  double ApplyInputs(double wall_s, std::int64_t* now_utime, TickRecord* record);
+  void RunDueSensors(double t, std::int64_t now_utime);
+  void WriteDueScans(double t);
+  void SubmitDueFrames(double t, TickRecord* record);
+  void PublishStatusIfDue(double t, std::int64_t now_utime);
+  void PrintSummary(double elapsed_s);
+  bool has_pose() const;
+
+  const RunOptions options_;
+  const RunHooks hooks_;
+  std::ostream& out_;
+  std::ostream& err_;
+  const scene::Level level_;
+  const std::vector<sensors::MountedSensor> mounted_;
+  const std::vector<sensors::MountedCamera> cameras_;
+  scene::CollisionWorld world_;
+  std::unique_ptr<bridge::LogReader> log_;
+  bridge::LcmLink link_;
+  sensors::RayCaster caster_;
+  bridge::RejectLog reject_log_;
+  std::vector<RobotRun> robots_;
+  std::vector<SensorRun> sensor_runs_;
+  std::vector<CameraRun> camera_runs_;
+  ScanFileWriter scan_files_;
+  TickStats stats_;
+  std::unique_ptr<LiveView> live_view_;  // before frames_: frames_ calls into it
+  ViewControls controls_;
+  std::string last_active_camera_;
+  bool write_frames_{false};
+  std::unique_ptr<FramePipeline> frames_;
+
+  std::int64_t tick_{0};
+  std::int64_t first_input_utime_{-1};
+  double next_status_s_{0.0}, next_progress_s_{0.0}, next_scan_file_s_{0.0};
+};
+
+}  // namespace sandbox::app
