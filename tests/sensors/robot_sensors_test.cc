@@ -62,20 +62,28 @@ TEST(RobotSensorsTest, ASensorOnABoneMovesWithTheBone) {
   EXPECT_TRUE(X_WS.linear().isApprox(X.linear(), 1e-6));
 }
 
-std::string Error(const std::string& sensor_table) {
+// The error an arm robot with one more [[robot.<kind>]] table (named "s" for
+// a sensor, "c" for a camera) gives, from "level.toml" on; "no error" if none.
+std::string ErrorOf(const std::string& kind, const std::string& table) {
   testing::TempDir dir;
   const std::string arm = (Robots().parent_path() / "generated/arm.gltf").string();
   const auto file = dir.Write("level.toml", "[[robot]]\nname = \"r\"\nfile = \"" + arm +
-                                                "\"\nbones = [\"base\", \"link1\"]\n\n" +
-                                                "[[robot.sensor]]\nname = \"s\"\n" + sensor_table);
+                                                "\"\nbones = [\"base\", \"link1\"]\n\n[[robot." +
+                                                kind + "]]\nname = \"" +
+                                                (kind == "sensor" ? "s" : "c") + "\"\n" + table);
   try {
-    MakeRobotSensors(scene::LoadLevel(file));
+    const scene::Level level = scene::LoadLevel(file);
+    if (kind == "sensor") MakeRobotSensors(level);
+    if (kind == "camera") MakeRobotCameras(level);
   } catch (const scene::LevelError& error) {
     const std::string message = error.what();
     return message.substr(message.find("level.toml"));
   }
   return "no error";
 }
+
+std::string Error(const std::string& sensor_table) { return ErrorOf("sensor", sensor_table); }
+std::string CameraError(const std::string& camera_table) { return ErrorOf("camera", camera_table); }
 
 TEST(RobotSensorsTest, MistakesNameTheSensorAndField) {
   EXPECT_EQ(Error("type = \"face\"\nmount = \"elbow\"\n"),
@@ -100,21 +108,6 @@ TEST(RobotSensorsTest, MistakesNameTheSensorAndField) {
             "level.toml:9: sensor 's': 'range_m' must be finite, got nan");
   EXPECT_EQ(Error("type = \"ray\"\nrate_hz = -1\n"),
             "level.toml:9: sensor 's': 'rate_hz' must be positive");
-}
-
-std::string CameraError(const std::string& camera_table) {
-  testing::TempDir dir;
-  const std::string arm = (Robots().parent_path() / "generated/arm.gltf").string();
-  const auto file = dir.Write("level.toml", "[[robot]]\nname = \"r\"\nfile = \"" + arm +
-                                                "\"\nbones = [\"base\", \"link1\"]\n\n" +
-                                                "[[robot.camera]]\nname = \"c\"\n" + camera_table);
-  try {
-    MakeRobotCameras(scene::LoadLevel(file));
-  } catch (const scene::LevelError& error) {
-    const std::string message = error.what();
-    return message.substr(message.find("level.toml"));
-  }
-  return "no error";
 }
 
 TEST(RobotSensorsTest, CameraMistakesNameTheCameraAndField) {
