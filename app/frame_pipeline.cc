@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -109,7 +110,7 @@ void FramePipeline::RenderLoop() {
       ++failed_;
       continue;
     }
-    Encoded item{job.camera, job.tick, job.time_s, job.depth, {}, job.robot_pose};
+    Encoded item{job.camera, job.tick, job.time_s, job.depth, {}, job.robot_pose, job.view};
     std::vector<const scene::RobotState*> robots;
     for (const scene::RobotState& state : job.robots) robots.push_back(&state);
     try {
@@ -198,12 +199,22 @@ void FramePipeline::Write(const Encoded& item) {
     std::unique_ptr<std::ofstream>& index = indexes_[item.camera];
     if (!index) {
       index = std::make_unique<std::ofstream>(dir / (item.camera + ".csv"));
-      *index << "tick,time_s,file,x,y,z,qw,qx,qy,qz\n" << std::setprecision(10);
+      *index << "tick,time_s,file,x,y,z,qw,qx,qy,qz,cam_x,cam_y,cam_z,cam_qw,cam_qx,cam_qy,cam_qz,"
+                "fx,fy,cx,cy\n"
+             << std::setprecision(10);
     }
-    const Eigen::Vector3d p = item.robot_pose.translation();
-    const Eigen::Quaterniond q(item.robot_pose.linear());
-    *index << item.tick << "," << item.time_s << "," << file << "," << p.x() << "," << p.y() << ","
-           << p.z() << "," << q.w() << "," << q.x() << "," << q.y() << "," << q.z() << "\n";
+    for (const Eigen::Isometry3d* X : {&item.robot_pose, &item.view.X_WC}) {
+      const Eigen::Vector3d p = X->translation();
+      const Eigen::Quaterniond q(X->linear());
+      if (X == &item.robot_pose) *index << item.tick << "," << item.time_s << "," << file;
+      *index << "," << p.x() << "," << p.y() << "," << p.z() << "," << q.w() << "," << q.x() << ","
+             << q.y() << "," << q.z();
+    }
+    // Square pixels: one focal length from the vertical field of view; pixel
+    // centres at whole coordinates, as OpenCV's camera matrix has them.
+    const double f = 0.5 * item.view.height / std::tan(0.5 * item.view.fov_y_rad);
+    *index << "," << f << "," << f << "," << 0.5 * item.view.width - 0.5 << ","
+           << 0.5 * item.view.height - 0.5 << "\n";
     ++written_;
   } catch (const std::exception& e) {
     Fail(e.what());

@@ -7,7 +7,10 @@
 // Files: DIR/<camera>_<tick>.jpg (or .png) and/or one DIR/<camera>.mp4 (or
 // .avi) per camera; DIR/<camera>_<tick>_depth.png (16-bit millimetres),
 // _depth.npy or _depth.exr (float32 metres); DIR/<camera>.csv indexing every
-// frame: tick, time_s, file (the image, else the video), robot pose.
+// frame: tick, time_s, file (the image, else the video), the robot pose, the
+// camera pose X_WC (x forward, y left, z up) and the pinhole intrinsics in
+// pixels (fx = fy, cx, cy; image x to the right, y down, pixel centres at
+// whole coordinates as in OpenCV's camera matrix).
 
 #include <atomic>
 #include <chrono>
@@ -87,6 +90,7 @@ class FramePipeline {
     bool depth;
     sensors::Frame frame;
     Eigen::Isometry3d robot_pose;
+    sensors::CameraView view;
   };
   void RenderLoop();
   void WriteLoop();

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -11,6 +13,8 @@
 #include <regex>
 #include <sstream>
 
+#include "assets/generators/sample_terrain.h"
+#include "scene/level.h"
 #include "tests/app/run_sandbox.h"
 #include "tests/test_util.h"
 
@@ -22,21 +26,38 @@ struct IndexRow {
   long tick;
   double time_s;
   std::string file;
+  Eigen::Isometry3d X_WB, X_WC;  // robot and camera poses
+  double fx, fy, cx, cy;
 };
+
+Eigen::Isometry3d Pose(const std::vector<double>& v, std::size_t at) {  // x y z qw qx qy qz
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.translation() = Eigen::Vector3d(v[at], v[at + 1], v[at + 2]);
+  X.linear() = Eigen::Quaterniond(v[at + 3], v[at + 4], v[at + 5], v[at + 6]).toRotationMatrix();
+  return X;
+}
 
 std::vector<IndexRow> ReadIndex(const std::filesystem::path& csv) {
   std::ifstream in(csv);
   std::string line;
   std::getline(in, line);
-  EXPECT_EQ(line, "tick,time_s,file,x,y,z,qw,qx,qy,qz") << csv;
+  EXPECT_EQ(line,
+            "tick,time_s,file,x,y,z,qw,qx,qy,qz,cam_x,cam_y,cam_z,cam_qw,cam_qx,cam_qy,cam_qz,"
+            "fx,fy,cx,cy")
+      << csv;
   std::vector<IndexRow> rows;
   while (std::getline(in, line)) {
     std::stringstream cells(line);
-    std::string tick, time, file;
+    std::string tick, time, file, cell;
     std::getline(cells, tick, ',');
     std::getline(cells, time, ',');
     std::getline(cells, file, ',');
-    rows.push_back({std::stol(tick), std::stod(time), file});
+    std::vector<double> v;
+    while (std::getline(cells, cell, ',')) v.push_back(std::stod(cell));
+    EXPECT_EQ(v.size(), 18u) << line;
+    if (v.size() != 18u) break;
+    rows.push_back({std::stol(tick), std::stod(time), file, Pose(v, 0), Pose(v, 7), v[14], v[15],
+                    v[16], v[17]});
   }
   return rows;
 }
@@ -95,6 +116,59 @@ TEST(RunCommandTest, CamerasWriteIndexedFramesAtTheirRatesWithDepth) {
     }
   }
   EXPECT_EQ(indexed, written);
+}
+
+TEST(RunCommandTest, PayloadDepthBackProjectsOntoTheTerrainThroughTheIndexedPoseAndIntrinsics) {
+  sandbox::testing::TempDir dir;
+  const auto run =
+      RunSandbox("run --duration 0.3 --lcm-url memq:// --frames png --out " + dir.path().string());
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  const std::vector<IndexRow> rows = ReadIndex(dir.path() / "belly.csv");
+  ASSERT_FALSE(rows.empty());
+  const IndexRow& row = rows[0];
+  // The belly camera: 320 x 240, 70 degrees vertically.
+  EXPECT_NEAR(row.fy, 120.0 / std::tan(35.0 * M_PI / 180.0), 1e-6);
+  EXPECT_EQ(row.fx, row.fy);
+  EXPECT_EQ(row.cx, 159.5);
+  EXPECT_EQ(row.cy, 119.5);
+  // Pitched 60 degrees down on the body (the robot at its spawn pose, level).
+  EXPECT_TRUE(row.X_WC.translation().isApprox(row.X_WB.translation(), 1e-9));
+  EXPECT_NEAR((row.X_WC.linear() * Eigen::Vector3d::UnitX()).z(), -std::sin(M_PI / 3), 1e-6);
+  const cv::Mat depth =
+      cv::imread((dir.path() / (row.file.substr(0, row.file.size() - 4) + "_depth.png")).string(),
+                 cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(depth.type(), CV_16UC1);
+  // Every sampled pixel's point lies on the terrain or the lake's water (z = 6 m),
+  // whichever is higher: the analytic surface, not the renderer's or the caster's.
+  // Points within the boxes of the compact objects (wall, tower, boulder, gate)
+  // are left out; the scattered rocks may take a few.
+  const sandbox::scene::Level level = sandbox::scene::LoadLevel(sandbox::testing::SampleLevel());
+  auto on_an_object = [&](const Eigen::Vector3d& p_W) {
+    for (const sandbox::scene::Actor& actor : level.actors) {
+      Eigen::AlignedBox3d box = actor.bounds_W;
+      if (box.sizes().head<2>().maxCoeff() > 50.0) continue;  // terrain, water, rocks
+      box.extend(box.min() - Eigen::Vector3d::Constant(0.1))
+          .extend(box.max() + Eigen::Vector3d::Constant(0.1));
+      if (box.contains(p_W)) return true;
+    }
+    return false;
+  };
+  int on_surface = 0, sampled = 0;
+  for (int v = 5; v < depth.rows; v += 23) {
+    for (int u = 5; u < depth.cols; u += 29) {
+      const double d = depth.at<std::uint16_t>(v, u) * 1e-3;
+      if (d == 0) continue;
+      const Eigen::Vector3d p_C(d, -(u - row.cx) / row.fx * d, -(v - row.cy) / row.fy * d);
+      const Eigen::Vector3d p_W = row.X_WC * p_C;
+      if (on_an_object(p_W)) continue;
+      const double surface = std::max(sandbox::assets::sample::TerrainHeight(p_W.x(), p_W.y()),
+                                      sandbox::assets::sample::kWaterLevel_m);
+      ++sampled;
+      on_surface += std::abs(p_W.z() - surface) < 0.03;
+    }
+  }
+  EXPECT_GT(sampled, 80);
+  EXPECT_GE(on_surface, sampled * 97 / 100) << on_surface << " of " << sampled;
 }
 
 TEST(RunCommandTest, SlowTicksAreFollowedAtOnceWithoutBunchingAndStatisticsAreWritten) {
