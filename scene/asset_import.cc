@@ -162,6 +162,15 @@ Material ConvertMaterial(const aiScene& scene, const aiMaterial& in, const fs::p
     out.base_color = {color.r, color.g, color.b, 1.0f};
     if (in.Get(AI_MATKEY_OPACITY, opacity) == AI_SUCCESS) out.base_color.w() = opacity;
   }
+  // Lightmaps: embedded only ("*N"); the Quake 3 importer files them under
+  // texture index 1 of the lightmap type.
+  for (unsigned index = 0; index < 2 && out.lightmap_texture_embedded < 0; ++index) {
+    aiString lightmap;
+    if (in.GetTexture(aiTextureType_LIGHTMAP, index, &lightmap) == AI_SUCCESS &&
+        lightmap.C_Str()[0] == '*') {
+      out.lightmap_texture_embedded = std::atoi(lightmap.C_Str() + 1);
+    }
+  }
   aiString texture;
   if (in.GetTexture(aiTextureType_BASE_COLOR, 0, &texture) == AI_SUCCESS ||
       in.GetTexture(aiTextureType_DIFFUSE, 0, &texture) == AI_SUCCESS) {
@@ -221,6 +230,12 @@ Mesh ConvertMesh(const aiMesh& in, std::size_t* non_triangles) {
     out.uvs.resize(in.mNumVertices);
     for (unsigned v = 0; v < in.mNumVertices; ++v) {
       out.uvs[v] = {in.mTextureCoords[0][v].x, in.mTextureCoords[0][v].y};
+    }
+  }
+  if (in.HasTextureCoords(1)) {
+    out.lightmap_uvs.resize(in.mNumVertices);
+    for (unsigned v = 0; v < in.mNumVertices; ++v) {
+      out.lightmap_uvs[v] = {in.mTextureCoords[1][v].x, in.mTextureCoords[1][v].y};
     }
   }
   out.indices.reserve(std::size_t{in.mNumFaces} * 3);

@@ -104,6 +104,7 @@ int AppendMaterials(std::vector<Material> materials, std::vector<EmbeddedTexture
     if (material.base_color_texture_embedded >= 0) {
       material.base_color_texture_embedded += texture_base;
     }
+    if (material.lightmap_texture_embedded >= 0) material.lightmap_texture_embedded += texture_base;
     level->materials.push_back(std::move(material));
   }
   for (EmbeddedTexture& texture : textures) level->textures.push_back(std::move(texture));

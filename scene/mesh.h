@@ -28,6 +28,9 @@ struct Material {
   // folder) or an index into Level::textures; empty path and -1 when none.
   std::string base_color_texture_path;
   int base_color_texture_embedded{-1};
+  // Baked lighting (Quake 3 maps): an index into Level::textures multiplying
+  // the lit colour, read with Mesh::lightmap_uvs; -1 when none.
+  int lightmap_texture_embedded{-1};
 };
 
 // An indexed triangle mesh in its actor's frame A (metres, Z up).
@@ -36,6 +39,7 @@ struct Mesh {
   std::vector<Eigen::Vector3f> positions_A;
   std::vector<Eigen::Vector3f> normals_A;  // unit, one per vertex
   std::vector<Eigen::Vector2f> uvs;        // empty when the asset has none
+  std::vector<Eigen::Vector2f> lightmap_uvs;  // the second UV set; empty when none
   std::vector<std::uint32_t> indices;      // three per triangle, counter-clockwise
   int material{-1};                        // index into Level::materials, -1: default
 

@@ -18,15 +18,18 @@ const char* kVertexShader = R"(#version 450 core
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec2 uv;
+layout(location = 3) in vec2 lightmap_uv;
 uniform mat4 model;       // object to camera-centred world (world axes, origin at the camera)
 uniform mat4 view_proj;   // camera-centred world to clip
 out vec3 world_normal;
 out vec2 tex_uv;
+out vec2 baked_uv;
 out float distance_m;
 void main() {
   vec4 p = model * vec4(position, 1.0);
   world_normal = mat3(model) * normal;
   tex_uv = uv;
+  baked_uv = lightmap_uv;
   distance_m = length(p.xyz);
   gl_Position = view_proj * p;
 }
@@ -35,8 +38,11 @@ void main() {
 const char* kFragmentShader = R"(#version 450 core
 in vec3 world_normal;
 in vec2 tex_uv;
+in vec2 baked_uv;
 in float distance_m;
 uniform vec4 base_color;
+uniform bool has_lightmap;        // baked lighting replaces the sun (Quake 3 maps)
+uniform sampler2D lightmap;
 uniform bool has_texture;
 uniform sampler2D base_texture;
 uniform vec3 sun;
@@ -48,7 +54,9 @@ void main() {
   if (has_texture) albedo *= texture(base_texture, tex_uv);
   vec3 n = normalize(world_normal);
   float light = 0.35 + 0.65 * abs(dot(n, sun));  // two-sided: thin surfaces lit from both sides
-  vec3 lit = albedo.rgb * light;
+  // Quake 3 stores lightmaps at half brightness (its "overbright" bit).
+  vec3 lit = has_lightmap ? albedo.rgb * min(2.0 * texture(lightmap, baked_uv).rgb, vec3(1.0))
+                          : albedo.rgb * light;
   float f = clamp((distance_m - fog.x) / max(fog.y - fog.x, 1e-3), 0.0, 1.0);
   color = vec4(mix(lit, sky, f), albedo.a);
 }
@@ -100,13 +108,14 @@ GLuint Link(const char* vertex, const char* fragment) {
 
 // A mesh on the GPU.
 struct GpuMesh {
-  GLuint vao{0}, positions{0}, normals{0}, uvs{0}, indices{0};
+  GLuint vao{0}, positions{0}, normals{0}, uvs{0}, lightmap_uvs{0}, indices{0};
   GLsizei index_count{0};
   int material{-1};
 };
 
 GpuMesh Upload(const std::vector<Eigen::Vector3f>& positions,
                const std::vector<Eigen::Vector3f>& normals, const std::vector<Eigen::Vector2f>& uvs,
+               const std::vector<Eigen::Vector2f>& lightmap_uvs,
                const std::vector<std::uint32_t>& indices, int material, GLenum usage) {
   GpuMesh mesh;
   mesh.material = material;
@@ -129,6 +138,12 @@ GpuMesh Upload(const std::vector<Eigen::Vector3f>& positions,
     glDisableVertexAttribArray(2);
     glVertexAttrib2f(2, 0.f, 0.f);
   }
+  if (lightmap_uvs.size() == positions.size()) {
+    attribute(&mesh.lightmap_uvs, 3, 2, lightmap_uvs.data(), lightmap_uvs.size() * 8);
+  } else {
+    glDisableVertexAttribArray(3);
+    glVertexAttrib2f(3, 0.f, 0.f);
+  }
   glGenBuffers(1, &mesh.indices);
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, mesh.indices);
   glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * 4), indices.data(),
@@ -142,10 +157,10 @@ GpuMesh Upload(const std::vector<Eigen::Vector3f>& positions,
 // floats keep their precision in large levels.
 struct StaticChunk {
   std::vector<Eigen::Vector3f> positions, normals;
-  std::vector<Eigen::Vector2f> uvs;
+  std::vector<Eigen::Vector2f> uvs, lightmap_uvs;
   std::vector<std::uint32_t> indices;
   Eigen::AlignedBox3f bounds;
-  bool any_uvs{false};
+  bool any_uvs{false}, any_lightmap_uvs{false};
 };
 constexpr double kChunkCell_m = 128.0;
 
@@ -201,7 +216,8 @@ class OsMesaRenderer : public Renderer {
     auto location = [&](const char* name) { return glGetUniformLocation(program_, name); };
     uniforms_ = {location("model"),       location("view_proj"),    location("base_color"),
                  location("has_texture"), location("base_texture"), location("sun"),
-                 location("sky"),         location("fog")};
+                 location("sky"),         location("fog"),          location("has_lightmap"),
+                 location("lightmap")};
   }
   ~OsMesaRenderer() override { OSMesaDestroyContext(context_); }
 
@@ -212,7 +228,8 @@ class OsMesaRenderer : public Renderer {
       if (!level.actors[a].movable) continue;  // merged above
       for (const scene::Mesh& mesh : level.actors[a].meshes) {
         actor_meshes_.push_back({int(a), Upload(mesh.positions_A, mesh.normals_A, mesh.uvs,
-                                                mesh.indices, mesh.material, GL_STATIC_DRAW)});
+                                                mesh.lightmap_uvs, mesh.indices, mesh.material,
+                                                GL_STATIC_DRAW)});
       }
     }
     // Textures: decoded once, by the decoder the app gives.
@@ -220,28 +237,31 @@ class OsMesaRenderer : public Renderer {
       const scene::Material& material = level.materials[m];
       const bool embedded = material.base_color_texture_embedded >= 0 &&
                             material.base_color_texture_embedded < int(level.textures.size());
-      if (!embedded && material.base_color_texture_path.empty()) continue;
-      RgbaImage image;
-      const scene::EmbeddedTexture* texture =
-          embedded ? &level.textures[std::size_t(material.base_color_texture_embedded)] : nullptr;
-      if (!decoder || !decoder(texture, material.base_color_texture_path, &image) ||
-          image.width <= 0 || image.height <= 0) {
-        warnings_.push_back("material '" + material.name + "': texture " +
-                            (embedded ? "(embedded)" : material.base_color_texture_path) +
-                            " cannot be read; drawn with its base colour");
-        continue;
+      if (embedded || !material.base_color_texture_path.empty()) {
+        RgbaImage image;
+        const scene::EmbeddedTexture* texture =
+            embedded ? &level.textures[std::size_t(material.base_color_texture_embedded)] : nullptr;
+        if (decoder && decoder(texture, material.base_color_texture_path, &image) &&
+            image.width > 0 && image.height > 0) {
+          textures_[int(m)] = UploadTexture(image, GL_REPEAT);
+        } else {
+          warnings_.push_back("material '" + material.name + "': texture " +
+                              (embedded ? "(embedded)" : material.base_color_texture_path) +
+                              " cannot be read; drawn with its base colour");
+        }
       }
-      GLuint id = 0;
-      glGenTextures(1, &id);
-      glBindTexture(GL_TEXTURE_2D, id);
-      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, image.width, image.height, 0, GL_RGBA,
-                   GL_UNSIGNED_BYTE, image.rgba.data());
-      glGenerateMipmap(GL_TEXTURE_2D);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
-      textures_[int(m)] = id;
+      if (material.lightmap_texture_embedded >= 0 &&
+          material.lightmap_texture_embedded < int(level.textures.size())) {
+        RgbaImage image;
+        if (decoder &&
+            decoder(&level.textures[std::size_t(material.lightmap_texture_embedded)], "", &image) &&
+            image.width > 0 && image.height > 0) {
+          lightmaps_[int(m)] = UploadTexture(image, GL_CLAMP_TO_EDGE);
+        } else {
+          warnings_.push_back("material '" + material.name +
+                              "': its lightmap cannot be read; lit by the sun instead");
+        }
+      }
     }
   }
 
@@ -282,6 +302,7 @@ class OsMesaRenderer : public Renderer {
     glUniform3f(uniforms_.sky, settings.sky_rgb.x(), settings.sky_rgb.y(), settings.sky_rgb.z());
     glUniform2f(uniforms_.fog, settings.fog_start_m, settings.fog_end_m);
     glUniform1i(uniforms_.base_texture, 0);
+    glUniform1i(uniforms_.lightmap, 1);
 
     // Opaque first, then the translucent (water) on top. Static chunks outside
     // the view are skipped.
@@ -310,7 +331,8 @@ class OsMesaRenderer : public Renderer {
       for (std::size_t m = 0; m < model.meshes.size(); ++m) {
         if (meshes.size() <= m) {
           meshes.push_back(Upload(state.positions_B(int(m)), state.normals_B(int(m)),
-                                  model.meshes[m].bind.uvs, model.meshes[m].bind.indices,
+                                  model.meshes[m].bind.uvs, model.meshes[m].bind.lightmap_uvs,
+                                  model.meshes[m].bind.indices,
                                   model.meshes[m].bind.material, GL_DYNAMIC_DRAW));
         } else {
           glBindBuffer(GL_ARRAY_BUFFER, meshes[m].positions);
@@ -379,16 +401,19 @@ class OsMesaRenderer : public Renderer {
           StaticChunk& chunk = chunks[key];
           std::vector<std::int64_t>& map = copied[key];
           if (map.empty()) map.assign(mesh.positions_A.size(), -1);
-          chunk.any_uvs = chunk.any_uvs || mesh.uvs.size() == mesh.positions_A.size();
+          const bool has_uvs = mesh.uvs.size() == mesh.positions_A.size();
+          const bool has_lightmap_uvs = mesh.lightmap_uvs.size() == mesh.positions_A.size();
+          chunk.any_uvs = chunk.any_uvs || has_uvs;
+          chunk.any_lightmap_uvs = chunk.any_lightmap_uvs || has_lightmap_uvs;
           for (int k = 0; k < 3; ++k) {
             const std::uint32_t v = mesh.indices[t + std::size_t(k)];
             if (map[v] < 0) {
               map[v] = std::int64_t(chunk.positions.size());
               chunk.positions.push_back(p[k].cast<float>());
               chunk.normals.push_back((R * mesh.normals_A[v].cast<double>()).cast<float>());
-              chunk.uvs.push_back(mesh.uvs.size() == mesh.positions_A.size()
-                                      ? mesh.uvs[v]
-                                      : Eigen::Vector2f::Zero());
+              chunk.uvs.push_back(has_uvs ? mesh.uvs[v] : Eigen::Vector2f::Zero());
+              chunk.lightmap_uvs.push_back(has_lightmap_uvs ? mesh.lightmap_uvs[v]
+                                                            : Eigen::Vector2f::Zero());
               chunk.bounds.extend(chunk.positions.back());
             }
             chunk.indices.push_back(std::uint32_t(map[v]));
@@ -398,15 +423,31 @@ class OsMesaRenderer : public Renderer {
     }
     for (auto& [key, chunk] : chunks) {
       if (!chunk.any_uvs) chunk.uvs.clear();
-      static_meshes_.push_back(
-          {chunk.bounds, Upload(chunk.positions, chunk.normals, chunk.uvs, chunk.indices,
-                                std::get<0>(key), GL_STATIC_DRAW)});
+      if (!chunk.any_lightmap_uvs) chunk.lightmap_uvs.clear();
+      static_meshes_.push_back({chunk.bounds, Upload(chunk.positions, chunk.normals, chunk.uvs,
+                                                     chunk.lightmap_uvs, chunk.indices,
+                                                     std::get<0>(key), GL_STATIC_DRAW)});
     }
   }
 
   bool IsTranslucent(int material) const {
     return material >= 0 && material < int(level_->materials.size()) &&
            level_->materials[std::size_t(material)].base_color.w() < 0.999f;
+  }
+
+  // An RGBA8 texture with mipmaps.
+  static GLuint UploadTexture(const RgbaImage& image, GLint wrap) {
+    GLuint id = 0;
+    glGenTextures(1, &id);
+    glBindTexture(GL_TEXTURE_2D, id);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, image.width, image.height, 0, GL_RGBA,
+                 GL_UNSIGNED_BYTE, image.rgba.data());
+    glGenerateMipmap(GL_TEXTURE_2D);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wrap);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wrap);
+    return id;
   }
 
   void Draw(const GpuMesh& mesh, const Eigen::Matrix4f& model) {
@@ -421,6 +462,13 @@ class OsMesaRenderer : public Renderer {
     if (texture != textures_.end()) {
       glActiveTexture(GL_TEXTURE0);
       glBindTexture(GL_TEXTURE_2D, texture->second);
+    }
+    const auto lightmap = lightmaps_.find(mesh.material);
+    glUniform1i(uniforms_.has_lightmap, lightmap != lightmaps_.end() && mesh.lightmap_uvs != 0);
+    if (lightmap != lightmaps_.end()) {
+      glActiveTexture(GL_TEXTURE1);
+      glBindTexture(GL_TEXTURE_2D, lightmap->second);
+      glActiveTexture(GL_TEXTURE0);
     }
     glBindVertexArray(mesh.vao);
     glDrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
@@ -490,7 +538,8 @@ class OsMesaRenderer : public Renderer {
   GLint overlay_view_proj_{-1};
   std::vector<Eigen::Vector3f> overlay_positions_, overlay_colors_;
   struct {
-    GLint model, view_proj, base_color, has_texture, base_texture, sun, sky, fog;
+    GLint model, view_proj, base_color, has_texture, base_texture, sun, sky, fog, has_lightmap,
+        lightmap;
   } uniforms_{};
   int width_{0}, height_{0};
   const scene::Level* level_{nullptr};
@@ -498,7 +547,8 @@ class OsMesaRenderer : public Renderer {
   std::vector<std::pair<Eigen::AlignedBox3f, GpuMesh>> static_meshes_;
   std::vector<std::pair<int, GpuMesh>> actor_meshes_;  // movable actors'
   std::map<const scene::RobotModel*, std::vector<GpuMesh>> robot_meshes_;
-  std::map<int, GLuint> textures_;
+  std::map<int, GLuint> textures_;   // by material
+  std::map<int, GLuint> lightmaps_;  // by material
   std::vector<std::string> warnings_;
   std::vector<std::uint8_t> pixels_;
   std::vector<float> depth_;

@@ -311,6 +311,70 @@ TEST(RendererTextureTest, CesiumManShowsItsEmbeddedTextureColours) {
   EXPECT_LE(plain_bins.size(), 3u);
 }
 
+TEST(RendererTextureTest, Quake3MapShowsItsBakedLightmapColours) {
+  const std::string file = std::string(SANDBOX_SHARED_ASSETS) + "/q3-de4th-run1/de4th_run1.pk3";
+  if (!std::ifstream(file).good()) GTEST_SKIP() << "no " << file << " (shared assets absent)";
+  scene::Level level = scene::LoadLevel(file);
+  // The lightmaps' own colours (raw RGBA texels from the file, 2x overbright
+  // as Quake 3 applies them), where no channel clips.
+  std::set<int> lightmap_bins;
+  int lit_materials = 0;
+  for (const scene::Material& material : level.materials) {
+    if (material.lightmap_texture_embedded < 0) continue;
+    ++lit_materials;
+    const scene::EmbeddedTexture& lightmap =
+        level.textures[std::size_t(material.lightmap_texture_embedded)];
+    ASSERT_GT(lightmap.height, 0);  // raw texels
+    for (std::size_t i = 0; i + 3 < lightmap.bytes.size(); i += 4) {
+      const int r = 2 * lightmap.bytes[i], g = 2 * lightmap.bytes[i + 1],
+                b = 2 * lightmap.bytes[i + 2];
+      if (std::max({r, g, b}) < 250) lightmap_bins.insert(ChromaBin(r, g, b));
+    }
+  }
+  EXPECT_GT(lit_materials, 30);
+  // The jump pad's orange glow, seen from across the room.
+  CameraView view;
+  view.X_WC = Isometry3d(Eigen::Translation3d(-20, 0, 40)) *
+              Eigen::AngleAxisd(10 * M_PI / 180, Vector3d::UnitY());
+  Frame baked, plain;
+  auto renderer = MakeRenderer();
+  renderer->SetLevel(level, app::OpenCvTextureDecoder());
+  renderer->Render(view, {}, {}, {}, &baked);
+  for (scene::Material& material : level.materials) material.lightmap_texture_embedded = -1;
+  auto unlit = MakeRenderer();
+  unlit->SetLevel(level, app::OpenCvTextureDecoder());
+  unlit->Render(view, {}, {}, {}, &plain);
+  // Coloured pixels (a channel 40 above another, none clipped) come from the
+  // lightmaps, whose colours they keep; without lightmaps white surfaces
+  // under the sun give none.
+  int coloured = 0, matching = 0, coloured_plain = 0;
+  for (int row = 0; row < view.height; ++row) {
+    for (int column = 0; column < view.width; ++column) {
+      for (const Frame* frame : {&baked, &plain}) {
+        const std::uint8_t* p = Pixel(*frame, column, row);
+        const int high = std::max({p[0], p[1], p[2]}), low = std::min({p[0], p[1], p[2]});
+        if (high - low < 40 || high >= 250) continue;
+        if (frame == &plain) {
+          ++coloured_plain;
+          continue;
+        }
+        const int bin = ChromaBin(p[0], p[1], p[2]);
+        if (bin < 0) continue;
+        ++coloured;
+        bool near = false;
+        for (int dr = -1; dr <= 1 && !near; ++dr) {
+          for (int dg = -1; dg <= 1 && !near; ++dg)
+            near = lightmap_bins.count(bin + 64 * dr + dg) > 0;
+        }
+        matching += near;
+      }
+    }
+  }
+  EXPECT_GT(coloured, 2000);
+  EXPECT_GT(matching, 0.95 * coloured) << matching << " of " << coloured;
+  EXPECT_EQ(coloured_plain, 0);
+}
+
 TEST(RendererWingTest, BendingMovesTheSilhouetteToTheAnalyticTip) {
   const scene::Level level = scene::LoadLevel(testing::SampleLevel());
   auto renderer = MakeRenderer();
