@@ -98,24 +98,6 @@ LiveView::LiveView(const std::string& title) : title_(title) {
         "--view needs a display: DISPLAY is not set (headless runs write "
         "frames with --out instead)");
   }
-  // The window is made on its thread; wait for it to say whether it could.
-  thread_ = std::thread([this] { WindowLoop(); });
-  for (;;) {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (opened_ || !open_error_.empty()) break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  if (!open_error_.empty()) {
-    thread_.join();
-    throw std::runtime_error("--view: cannot open a window: " + open_error_);
-  }
-}
-
-LiveView::~LiveView() {
-  stop_ = true;
-  if (thread_.joinable()) thread_.join();
 }
 
 void LiveView::Show(const sensors::Frame& frame, const std::string& caption) {
@@ -132,20 +114,14 @@ std::vector<ViewKey> LiveView::TakeKeys() {
   return keys;
 }
 
-void LiveView::WindowLoop() {
+void LiveView::RunWindow(const std::atomic<bool>& stop) {
   try {
     cv::namedWindow(title_, cv::WINDOW_AUTOSIZE);
   } catch (const cv::Exception& e) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    open_error_ = e.what();
-    return;
-  }
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    opened_ = true;
+    throw std::runtime_error(std::string("--view: cannot open a window: ") + e.what());
   }
   cv::Mat bgr;
-  while (!stop_) {
+  while (!stop) {
     sensors::Frame frame;
     std::string caption;
     {

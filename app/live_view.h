@@ -1,7 +1,8 @@
 #pragma once
 // The live view (`sandbox run --view`): a window (OpenCV highgui) showing the
-// active camera, and the keys pressed in it. The window belongs to its own
-// thread; Show and TakeKeys never wait, so the loop keeps its rate.
+// active camera, and the keys pressed in it. The window runs on the main
+// thread (Debian's highgui is Qt, whose windows belong there) while the loop
+// runs on another; Show and TakeKeys never wait, so the loop keeps its rate.
 //
 // Keys: c or Tab next camera; a/d (or left/right) pan and w/s (or up/down)
 // tilt the trailing camera; + and - zoom; o the debug overlay; space or p
@@ -12,7 +13,6 @@
 #include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "sensors/cameras.h"
@@ -51,21 +51,24 @@ struct ViewControls {
 
 class LiveView {
  public:
-  // Opens the window. Throws std::runtime_error when there is no display
-  // (neither DISPLAY nor WAYLAND_DISPLAY set) or the window cannot be made.
+  // Throws std::runtime_error when there is no display (neither DISPLAY nor
+  // WAYLAND_DISPLAY set). The window opens in RunWindow.
   explicit LiveView(const std::string& title);
-  ~LiveView();
   LiveView(const LiveView&) = delete;
   LiveView& operator=(const LiveView&) = delete;
 
+  // Main thread: opens the window and shows frames and collects keys until
+  // `stop` is set, then closes it. Throws std::runtime_error when the window
+  // cannot be made.
+  void RunWindow(const std::atomic<bool>& stop);
+
   // Any thread: the newest frame replaces one not yet shown.
   void Show(const sensors::Frame& frame, const std::string& caption);
-  // The keys pressed since the last call, in order.
+  // Any thread: the keys pressed since the last call, in order.
   std::vector<ViewKey> TakeKeys();
   std::int64_t shown() const { return shown_; }
 
  private:
-  void WindowLoop();
 
   std::string title_;
   std::mutex mutex_;
@@ -73,11 +76,7 @@ class LiveView {
   std::string pending_caption_;
   bool has_pending_{false};
   std::vector<ViewKey> keys_;
-  std::string open_error_;
-  bool opened_{false};
-  std::atomic<bool> stop_{false};
   std::atomic<std::int64_t> shown_{0};
-  std::thread thread_;
 };
 
 }  // namespace sandbox::app

@@ -1,5 +1,9 @@
 #include "app/run_command.h"
 
+#include <atomic>
+#include <exception>
+#include <thread>
+
 #include "app/command_line.h"
 #include "app/run_options.h"
 #include "app/sandbox_loop.h"
@@ -48,7 +52,31 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   }
   try {
     SandboxLoop loop(ParseRunOptions(*parsed), hooks, out, err);
-    loop.Run();
+    LiveView* view = loop.live_view();
+    if (view == nullptr) {
+      loop.Run();
+      return 0;
+    }
+    // The window on this (the main) thread, the loop on another.
+    std::atomic<bool> done{false};
+    std::exception_ptr failure;
+    std::thread loop_thread([&] {
+      try {
+        loop.Run();
+      } catch (...) {
+        failure = std::current_exception();
+      }
+      done = true;
+    });
+    try {
+      view->RunWindow(done);
+    } catch (...) {
+      SandboxLoop::RequestStop();
+      loop_thread.join();
+      throw;
+    }
+    loop_thread.join();
+    if (failure) std::rethrow_exception(failure);
     return 0;
   } catch (const std::exception& error) {  // scene::LevelError, CommandError, LCM, files
     err << "sandbox run: " << error.what() << "\n";

@@ -158,6 +158,8 @@ SandboxLoop::~SandboxLoop() {
   if (hooks_.before_close) hooks_.before_close(link_);
 }
 
+void SandboxLoop::RequestStop() { stop_requested = true; }
+
 bool SandboxLoop::has_pose() const {
   for (const RobotRun& robot : robots_) {
     if (robot.inputs->HasPose()) return true;

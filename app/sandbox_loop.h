@@ -8,9 +8,9 @@
 // ticks are never bunched to catch up.
 //
 // Threads: everything here runs on the loop thread (the caller of Run). It
-// starts the render and encoder threads (FramePipeline), the scan-file writer
-// and the live view's window thread, and takes real-time priority for itself
-// when asked and allowed.
+// starts the render and encoder threads (FramePipeline) and the scan-file
+// writer, and takes real-time priority for itself when asked and allowed. The
+// live view's window is run by the caller on the main thread.
 
 #include <memory>
 #include <ostream>
@@ -44,9 +44,14 @@ class SandboxLoop {
   SandboxLoop(const SandboxLoop&) = delete;
   SandboxLoop& operator=(const SandboxLoop&) = delete;
 
-  // Runs until the duration ends, a replayed log ends, SIGINT/SIGTERM or the
-  // live view's q; then finishes the files and prints the summary to `out`.
+  // Runs until the duration ends, a replayed log ends, SIGINT/SIGTERM, the
+  // live view's q or RequestStop(); then finishes the files and prints the
+  // summary to `out`.
   void Run();
+  // Any thread: ends Run() after the current tick.
+  static void RequestStop();
+  // The live view when asked for (its window is the caller's to run), or null.
+  LiveView* live_view() { return live_view_.get(); }
 
  private:
   // A robot with its state, inputs and outputs.
