@@ -69,7 +69,6 @@ class LiveView {
   std::int64_t shown() const { return shown_; }
 
  private:
-
   std::string title_;
   std::mutex mutex_;
   sensors::Frame pending_;

@@ -109,6 +109,7 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
       link_(options.replay() ? "memq://" : options.lcm_url),
       reject_log_(&err),
       stats_(PrepareOutDir(options)) {
+  stop_requested = false;  // from here on RequestStop() and signals end Run()
   if (!options_.record_file.empty()) link_.RecordTo(options_.record_file);
   robots_.resize(level_.robots.size());
   for (std::size_t r = 0; r < level_.robots.size(); ++r) {
@@ -184,7 +185,6 @@ void SandboxLoop::Run() {
        << (options_.replay() ? "replaying " + options_.replay_file : pace + ", LCM " + link_.url())
        << priority << "\n"
        << std::flush;
-  stop_requested = false;
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
 

@@ -37,11 +37,11 @@ struct Material {
 // `positions_A` is tightly packed (12 bytes a vertex) so Bullet reads it in place.
 struct Mesh {
   std::vector<Eigen::Vector3f> positions_A;
-  std::vector<Eigen::Vector3f> normals_A;  // unit, one per vertex
-  std::vector<Eigen::Vector2f> uvs;        // empty when the asset has none
+  std::vector<Eigen::Vector3f> normals_A;     // unit, one per vertex
+  std::vector<Eigen::Vector2f> uvs;           // empty when the asset has none
   std::vector<Eigen::Vector2f> lightmap_uvs;  // the second UV set; empty when none
-  std::vector<std::uint32_t> indices;      // three per triangle, counter-clockwise
-  int material{-1};                        // index into Level::materials, -1: default
+  std::vector<std::uint32_t> indices;         // three per triangle, counter-clockwise
+  int material{-1};                           // index into Level::materials, -1: default
 
   std::size_t num_triangles() const { return indices.size() / 3; }
 };

@@ -227,9 +227,9 @@ class OsMesaRenderer : public Renderer {
     for (std::size_t a = 0; a < level.actors.size(); ++a) {
       if (!level.actors[a].movable) continue;  // merged above
       for (const scene::Mesh& mesh : level.actors[a].meshes) {
-        actor_meshes_.push_back({int(a), Upload(mesh.positions_A, mesh.normals_A, mesh.uvs,
-                                                mesh.lightmap_uvs, mesh.indices, mesh.material,
-                                                GL_STATIC_DRAW)});
+        actor_meshes_.push_back(
+            {int(a), Upload(mesh.positions_A, mesh.normals_A, mesh.uvs, mesh.lightmap_uvs,
+                            mesh.indices, mesh.material, GL_STATIC_DRAW)});
       }
     }
     // Textures: decoded once, by the decoder the app gives.
@@ -332,8 +332,8 @@ class OsMesaRenderer : public Renderer {
         if (meshes.size() <= m) {
           meshes.push_back(Upload(state.positions_B(int(m)), state.normals_B(int(m)),
                                   model.meshes[m].bind.uvs, model.meshes[m].bind.lightmap_uvs,
-                                  model.meshes[m].bind.indices,
-                                  model.meshes[m].bind.material, GL_DYNAMIC_DRAW));
+                                  model.meshes[m].bind.indices, model.meshes[m].bind.material,
+                                  GL_DYNAMIC_DRAW));
         } else {
           glBindBuffer(GL_ARRAY_BUFFER, meshes[m].positions);
           glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(state.positions_B(int(m)).size() * 12),
@@ -424,9 +424,9 @@ class OsMesaRenderer : public Renderer {
     for (auto& [key, chunk] : chunks) {
       if (!chunk.any_uvs) chunk.uvs.clear();
       if (!chunk.any_lightmap_uvs) chunk.lightmap_uvs.clear();
-      static_meshes_.push_back({chunk.bounds, Upload(chunk.positions, chunk.normals, chunk.uvs,
-                                                     chunk.lightmap_uvs, chunk.indices,
-                                                     std::get<0>(key), GL_STATIC_DRAW)});
+      static_meshes_.push_back(
+          {chunk.bounds, Upload(chunk.positions, chunk.normals, chunk.uvs, chunk.lightmap_uvs,
+                                chunk.indices, std::get<0>(key), GL_STATIC_DRAW)});
     }
   }
 
