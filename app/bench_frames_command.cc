@@ -76,11 +76,7 @@ int RunBenchFrames(const std::vector<std::string>& args, std::ostream& out, std:
     };
     const int frames = whole("--frames", 500), runs = whole("--runs", 3);
     const std::filesystem::path dir = parsed->Value("--out", "bench-frames");
-    std::error_code error;
-    std::filesystem::create_directories(dir, error);
-    if (error || !std::filesystem::is_directory(dir)) {
-      throw CommandError("cannot create the output folder '" + dir.string() + "'");
-    }
+    CreateOutputFolder(dir.string());
     std::ofstream csv(dir / "frames.csv");
     csv << "case,run,frame,duration_ms\n" << std::fixed << std::setprecision(4);
 

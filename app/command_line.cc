@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <sstream>
 
 #include "scene/frames.h"
@@ -69,6 +70,14 @@ Eigen::Isometry3d ParsePose(const std::string& text, const std::string& option) 
                                                  v[5] * scene::kDegToRad);
   }
   return X;
+}
+
+void CreateOutputFolder(const std::string& path) {
+  std::error_code error;
+  std::filesystem::create_directories(path, error);
+  if (error || !std::filesystem::is_directory(path)) {
+    throw CommandError("cannot create the output folder '" + path + "'");
+  }
 }
 
 }  // namespace sandbox::app

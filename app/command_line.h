@@ -37,6 +37,10 @@ std::optional<ParsedArgs> ParseArgs(const std::vector<std::string>& args,
 // "1,2.5,-3" as numbers; throws CommandError "OPTION: 'x' is not a finite number".
 std::vector<double> ParseNumbers(const std::string& text, const std::string& option);
 
+// Creates `path` and its parents unless they exist; throws CommandError
+// "cannot create the output folder 'path'".
+void CreateOutputFolder(const std::string& path);
+
 // "X,Y,Z" or "X,Y,Z,ROLL,PITCH,YAW" (metres, degrees) as a pose; throws CommandError.
 Eigen::Isometry3d ParsePose(const std::string& text, const std::string& option);
 

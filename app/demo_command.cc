@@ -162,11 +162,7 @@ int RunDemo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       }
       in_process = true;
     }
-    std::error_code error;
-    std::filesystem::create_directories(out_dir, error);
-    if (error || !std::filesystem::is_directory(out_dir)) {
-      throw CommandError("cannot create the output folder '" + out_dir + "'");
-    }
+    CreateOutputFolder(out_dir);
     std::ostringstream seconds;
     seconds << duration_s;
     std::vector<std::string> run_args = {"--duration", seconds.str(), "--out",         out_dir,
@@ -182,10 +178,7 @@ int RunDemo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
         status.Poll(link);
         sandbox_msgs::robot_pose_t pose;
         sandbox_msgs::bone_values_t bones;
-        const std::int64_t utime = std::chrono::duration_cast<std::chrono::microseconds>(
-                                       std::chrono::system_clock::now().time_since_epoch())
-                                       .count();
-        bridge::ExampleFlight(wall_s, seq++, utime, &pose, &bones);
+        bridge::ExampleFlight(wall_s, seq++, bridge::NowUtime(), &pose, &bones);
         std::vector<std::uint8_t> bytes(std::size_t(pose.getEncodedSize()));
         pose.encode(bytes.data(), 0, int(bytes.size()));
         link.Inject("ELAHA/POSE", bytes.data(), unsigned(bytes.size()));

@@ -13,6 +13,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "app/command_line.h"
 #include "app/images.h"
 
 namespace sandbox::app {
@@ -30,11 +31,7 @@ struct FramePipeline::Video {
 
 FramePipeline::FramePipeline(const scene::Level& level, const FramePipelineConfig& config)
     : level_(level), config_(config) {
-  std::error_code error;
-  if (!config_.out_dir.empty()) std::filesystem::create_directories(config_.out_dir, error);
-  if (!config_.out_dir.empty() && (error || !std::filesystem::is_directory(config_.out_dir))) {
-    throw std::runtime_error("cannot create the output folder '" + config_.out_dir + "'");
-  }
+  if (!config_.out_dir.empty()) CreateOutputFolder(config_.out_dir);
   render_thread_ = std::thread([this] { RenderLoop(); });
   write_thread_ = std::thread([this] { WriteLoop(); });
   // The context and the level's upload (tens of ms to seconds) before the

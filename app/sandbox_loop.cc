@@ -25,12 +25,6 @@ using Clock = std::chrono::steady_clock;
 std::atomic<bool> stop_requested{false};
 void OnSignal(int) { stop_requested = true; }
 
-std::int64_t NowUtime() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
 std::string Format(double value) {
   std::ostringstream out;
   out << value;
@@ -65,12 +59,8 @@ std::vector<sensors::MountedSensor> CheckedSensors(const scene::Level& level) {
 std::string PrepareOutDir(const RunOptions& options) {
   if (options.out_dir.empty()) return "";
   const std::filesystem::path dir = options.out_dir;
-  std::error_code error;
-  std::filesystem::create_directories(dir, error);
-  if (error || !std::filesystem::is_directory(dir)) {
-    throw CommandError("cannot create the output folder '" + options.out_dir + "'");
-  }
-  if (options.scans_every_s > 0.0) std::filesystem::create_directories(dir / "scans", error);
+  CreateOutputFolder(dir.string());
+  if (options.scans_every_s > 0.0) CreateOutputFolder((dir / "scans").string());
   return (dir / "ticks.csv").string();
 }
 
@@ -219,7 +209,7 @@ void SandboxLoop::Run() {
     }
     if (hooks_.before_tick) hooks_.before_tick(link_, wall_s);
     // 1-2. Inputs applied; 3-4. sensors that are due, their outputs, the state.
-    std::int64_t now = NowUtime();
+    std::int64_t now = bridge::NowUtime();
     const double t = ApplyInputs(wall_s, &now, &record);
     RunDueSensors(t, now);
     for (RobotRun& robot : robots_) robot.outputs->PublishState(*robot.state, robot.input, now);
@@ -501,7 +491,7 @@ void SandboxLoop::PrintSummary(double elapsed_s) {
       out_ << "  " << robot.config.channel_prefix
            << " active camera: " << robot.inputs->active_camera() << "\n";
     }
-    for (const bridge::ChannelStatus& channel : robot.Channels(NowUtime())) {
+    for (const bridge::ChannelStatus& channel : robot.Channels(bridge::NowUtime())) {
       out_ << "  " << channel.channel << ": " << channel.received << " received, "
            << channel.superseded << " superseded, " << channel.rejected << " rejected"
            << (channel.rejected > 0 ? " (last: " + channel.last_reject_reason + ")" : "") << "\n";

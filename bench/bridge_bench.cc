@@ -33,11 +33,7 @@ using Clock = std::chrono::steady_clock;
 
 const char* kGroup = "udpm://239.255.76.67:7667?ttl=0";
 
-std::int64_t NowUtime() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
+using bridge::NowUtime;
 
 // A full scan of the sample level from above the valley.
 sensors::FaceScan FullScan() {

@@ -1,12 +1,19 @@
 #include "bridge/lcm_link.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <stdexcept>
 
 #include "bridge/lcm_link_impl.h"
 
 namespace sandbox::bridge {
+
+std::int64_t NowUtime() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
 
 std::string WithReceiveBuffer(const std::string& url) {
   const bool multicast = url.empty() || url.rfind("udpm://", 0) == 0;

@@ -14,6 +14,9 @@
 
 namespace sandbox::bridge {
 
+// Now as LCM messages stamp it: wall-clock microseconds since the epoch.
+std::int64_t NowUtime();
+
 // A subscriber URL with a receive buffer big enough for 250 KB messages:
 // UDP multicast URLs ("udpm://...", and LCM's default, the empty URL) get
 // recv_buf_size=4194304 unless they set one; others are returned as they are.
