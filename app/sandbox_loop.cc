@@ -121,7 +121,18 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
       robot.doubles->set_log(&reject_log_);
     }
   }
-  for (const sensors::MountedSensor& m : mounted_) sensor_runs_.push_back({&m, 0.0, {}});
+  for (const sensors::MountedSensor& m : mounted_) {
+    SensorRun run{&m, {}, 0.0, {}};
+    if (const auto* face = std::get_if<sensors::FaceScannerConfig>(&m.config)) {
+      run.sensor.emplace<sensors::FaceScanner>(*face);
+      run.face_scan = std::get<sensors::FaceScanner>(run.sensor).EmptyScan();
+    } else if (const auto* ground = std::get_if<sensors::GroundScannerConfig>(&m.config)) {
+      run.sensor.emplace<sensors::GroundScanner>(*ground);
+    } else if (const auto* lidar = std::get_if<sensors::LidarConfig>(&m.config)) {
+      run.sensor.emplace<sensors::Lidar>(*lidar);
+    }
+    sensor_runs_.push_back(std::move(run));
+  }
   for (const sensors::MountedCamera& camera : cameras_) {
     camera_runs_.push_back({&camera, sensors::ChaseCamera(camera.chase)});
   }
@@ -322,19 +333,16 @@ void SandboxLoop::RunDueSensors(double t, std::int64_t now_utime) {
     filter.ignore_robot = run.mounted->robot;
     const Eigen::Isometry3d X_WS = run.mounted->Pose(*robot.state);
     const std::string& channel = run.mounted->spec.channel;
-    if (const auto* face = std::get_if<sensors::FaceScannerConfig>(&run.mounted->config)) {
-      const sensors::FaceScanner scanner(*face);
-      if (run.face_scan.n == 0) run.face_scan = scanner.EmptyScan();
-      scanner.Scan(world_, caster_, filter, X_WS, tick_, &run.face_scan);
+    if (const auto* scanner = std::get_if<sensors::FaceScanner>(&run.sensor)) {
+      scanner->Scan(world_, caster_, filter, X_WS, tick_, &run.face_scan);
       robot.outputs->PublishFaces(run.face_scan, tick_, robot.input, now_utime, channel);
-    } else if (const auto* ground =
-                   std::get_if<sensors::GroundScannerConfig>(&run.mounted->config)) {
+    } else if (const auto* ground = std::get_if<sensors::GroundScanner>(&run.sensor)) {
       sensors::HeightMap map;
-      sensors::GroundScanner(*ground).Scan(world_, caster_, filter, X_WS.translation(), &map);
+      ground->Scan(world_, caster_, filter, X_WS.translation(), &map);
       robot.outputs->PublishGround(map, robot.input, now_utime, channel);
-    } else if (const auto* lidar = std::get_if<sensors::LidarConfig>(&run.mounted->config)) {
+    } else if (const auto* lidar = std::get_if<sensors::Lidar>(&run.sensor)) {
       sensors::LidarScan scan;
-      sensors::Lidar(*lidar).Sweep(world_, caster_, filter, X_WS, X_WS, &scan);
+      lidar->Sweep(world_, caster_, filter, X_WS, X_WS, &scan);
       robot.outputs->PublishLidar(scan, robot.input, now_utime, channel);
     } else if (const auto* ray = std::get_if<sensors::RangeSensorConfig>(&run.mounted->config)) {
       robot.outputs->PublishRange(run.mounted->spec.name,

@@ -15,6 +15,7 @@
 #include <memory>
 #include <ostream>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "app/frame_pipeline.h"
@@ -69,6 +70,9 @@ class SandboxLoop {
   };
   struct SensorRun {
     const sensors::MountedSensor* mounted;
+    // The sensor, made once from its config (range sensors use the config itself).
+    std::variant<std::monostate, sensors::FaceScanner, sensors::GroundScanner, sensors::Lidar>
+        sensor;
     double next_due_s{0.0};
     sensors::FaceScan face_scan;  // the latest, faces as last scanned
   };
