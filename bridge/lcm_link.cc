@@ -1,11 +1,16 @@
 #include "bridge/lcm_link.h"
 
+#include <sys/stat.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <stdexcept>
 
 #include "bridge/lcm_link_impl.h"
+#include "scene/files.h"
 
 namespace sandbox::bridge {
 
@@ -22,44 +27,17 @@ std::string WithReceiveBuffer(const std::string& url) {
   return base + (base.find('?') == std::string::npos ? "?" : "&") + "recv_buf_size=4194304";
 }
 
-LcmLink::LcmLink(const std::string& url)
-    : url_(WithReceiveBuffer(url)), impl_(std::make_unique<Impl>(url_)) {
-  if (!impl_->lcm.good()) throw std::runtime_error("LcmLink: cannot open LCM URL '" + url_ + "'");
-}
-
-LcmLink::~LcmLink() = default;
-
-int LcmLink::Drain() {
-  int handled = 0;
-  while (impl_->lcm.handleTimeout(0) > 0) ++handled;
-  return handled;
-}
-
-bool LcmLink::Publish(const std::string& channel, const void* data, unsigned size) {
-  if (impl_->record) {
-    lcm::LogEvent event;
-    event.eventnum = 0;
-    event.timestamp = record_utime_;
-    event.channel = channel;
-    event.datalen = static_cast<std::int32_t>(size);
-    event.data = const_cast<void*>(data);
-    impl_->record->writeEvent(&event);
+std::string Printable(const std::string& text, std::size_t max_chars) {
+  std::string out;
+  out.reserve(std::min(text.size(), max_chars));
+  for (const char c : text) {
+    if (out.size() == max_chars) {
+      out.replace(max_chars - 3, 3, "...");
+      break;
+    }
+    out += c >= 0x20 && c < 0x7f ? c : '?';
   }
-  return impl_->lcm.publish(channel, data, size) == 0;
-}
-
-bool LcmLink::Inject(const std::string& channel, const void* data, unsigned size) {
-  return impl_->lcm.publish(channel, data, size) == 0;
-}
-
-bool LcmLink::Wait(int timeout_ms) { return impl_->lcm.handleTimeout(timeout_ms) > 0; }
-
-void LcmLink::RecordTo(const std::string& path) {
-  impl_->record = std::make_unique<lcm::LogFile>(path, "w");
-  if (!impl_->record->good()) {
-    impl_->record.reset();
-    throw std::runtime_error("LcmLink: cannot write the log file '" + path + "'");
-  }
+  return out;
 }
 
 namespace {
@@ -72,14 +50,104 @@ std::uint64_t BigEndian(const unsigned char* bytes, int n) {
   return value;
 }
 
+void PutBigEndian(std::uint64_t value, int n, unsigned char* bytes) {
+  for (int i = n - 1; i >= 0; --i, value >>= 8) bytes[i] = static_cast<unsigned char>(value);
+}
+
 }  // namespace
 
-LogReader::LogReader(const std::string& path) : path_(path) {
+LogWriter::LogWriter(const std::string& path) : path_(path) {
+  // Regular files and character devices (/dev/null) only: a FIFO blocks.
+  struct stat info {};
+  if (::stat(path.c_str(), &info) == 0 && !S_ISREG(info.st_mode) && !S_ISCHR(info.st_mode)) {
+    throw std::runtime_error("cannot write the log '" + path + "': " +
+                             (S_ISDIR(info.st_mode) ? "it is a folder" : "not a regular file"));
+  }
+  file_ = std::fopen(path.c_str(), "wb");
+  if (file_ == nullptr) {
+    throw std::runtime_error("cannot write the log '" + path + "': " + std::strerror(errno));
+  }
+}
+
+LogWriter::~LogWriter() { Close(); }
+
+void LogWriter::Fail(int error_number) {
+  if (error_.empty()) {
+    error_ = "cannot write '" + path_ + "' after " + std::to_string(events_) +
+             " events: " + std::strerror(error_number != 0 ? error_number : EIO);
+  }
+}
+
+bool LogWriter::Write(const std::string& channel, const void* data, unsigned size,
+                      std::int64_t utime) {
+  if (file_ == nullptr || failed()) return false;
+  unsigned char header[28];
+  PutBigEndian(kLogSync, 4, header);
+  PutBigEndian(std::uint64_t(events_), 8, header + 4);
+  PutBigEndian(std::uint64_t(utime), 8, header + 12);
+  PutBigEndian(channel.size(), 4, header + 20);
+  PutBigEndian(size, 4, header + 24);
+  errno = 0;
+  if (std::fwrite(header, 1, sizeof(header), file_) != sizeof(header) ||
+      std::fwrite(channel.data(), 1, channel.size(), file_) != channel.size() ||
+      std::fwrite(data, 1, size, file_) != size) {
+    Fail(errno);
+    return false;
+  }
+  ++events_;
+  return true;
+}
+
+bool LogWriter::Close() {
+  if (file_ == nullptr) return !failed();
+  errno = 0;
+  if (std::fflush(file_) != 0) Fail(errno);
+  if (std::fclose(file_) != 0) Fail(errno);
+  file_ = nullptr;
+  return !failed();
+}
+
+LcmLink::LcmLink(const std::string& url)
+    : url_(WithReceiveBuffer(url)), impl_(std::make_unique<Impl>(url_)) {
+  if (!impl_->lcm.good()) throw std::runtime_error("LcmLink: cannot open LCM URL '" + url_ + "'");
+}
+
+LcmLink::~LcmLink() = default;
+
+int LcmLink::Drain(double budget_s) {
+  using Clock = std::chrono::steady_clock;
+  const auto end = Clock::now() + std::chrono::duration<double>(budget_s);
+  int handled = 0;
+  while (impl_->lcm.handleTimeout(0) > 0) {
+    // The clock is read every 16 messages: cheap when idle, bounded in a flood.
+    if (++handled % 16 == 0 && Clock::now() >= end) break;
+  }
+  return handled;
+}
+
+bool LcmLink::Publish(const std::string& channel, const void* data, unsigned size) {
+  if (record_) record_->Write(channel, data, size, record_utime_);
+  return impl_->lcm.publish(channel, data, size) == 0;
+}
+
+bool LcmLink::Inject(const std::string& channel, const void* data, unsigned size) {
+  return impl_->lcm.publish(channel, data, size) == 0;
+}
+
+bool LcmLink::Wait(int timeout_ms) { return impl_->lcm.handleTimeout(timeout_ms) > 0; }
+
+void LcmLink::RecordTo(const std::string& path) { record_ = std::make_unique<LogWriter>(path); }
+
+bool LcmLink::FinishRecording() { return !record_ || record_->Close(); }
+
+LogReader::LogReader(const std::string& path, std::uint32_t max_event_bytes)
+    : path_(path), max_event_bytes_(max_event_bytes) {
+  if (const std::string problem = scene::RegularFileProblem(path); !problem.empty()) {
+    throw std::runtime_error("cannot read the LCM log '" + path + "': " + problem);
+  }
   file_ = std::fopen(path.c_str(), "rb");
   if (file_ == nullptr) throw std::runtime_error("cannot read the LCM log '" + path + "'");
-  std::fseek(file_, 0, SEEK_END);
-  size_ = std::max<std::int64_t>(1, std::ftell(file_));
-  std::fseek(file_, 0, SEEK_SET);
+  size_ = std::max<std::int64_t>(1, std::int64_t(scene::FileBytes(path)));
   unsigned char sync[4];
   if (std::fread(sync, 1, 4, file_) != 4 || BigEndian(sync, 4) != kLogSync) {
     std::fclose(file_);
@@ -96,35 +164,46 @@ LogReader::~LogReader() {
 }
 
 bool LogReader::Next(std::string* channel, std::vector<std::uint8_t>* data, std::int64_t* utime) {
-  if (file_ == nullptr || !stopped_early_.empty()) return false;
-  unsigned char header[28];
-  const std::size_t got = std::fread(header, 1, sizeof(header), file_);
-  if (got == 0) return false;  // a clean end
-  auto stop = [&](const std::string& why) {
-    stopped_early_ = why + ": event " + std::to_string(events_ + 1) + " at byte " +
-                     std::to_string(offset_) + " of " + std::to_string(size_);
-    return false;
-  };
-  if (got < sizeof(header)) return stop("truncated inside an event header");
-  if (BigEndian(header, 4) != kLogSync) return stop("corrupt (no sync word)");
-  const std::int64_t event_utime = std::int64_t(BigEndian(header + 12, 8));
-  const std::uint64_t channel_length = BigEndian(header + 20, 4),
-                      data_length = BigEndian(header + 24, 4);
-  if (channel_length == 0 || channel_length > 256) return stop("corrupt (channel name length)");
-  const std::int64_t needed = 28 + std::int64_t(channel_length + data_length);
-  if (offset_ + needed > size_) {
-    return stop("truncated (the event needs " + std::to_string(needed) + " bytes)");
+  for (;;) {
+    if (file_ == nullptr || !stopped_early_.empty()) return false;
+    unsigned char header[28];
+    const std::size_t got = std::fread(header, 1, sizeof(header), file_);
+    if (got == 0) return false;  // a clean end
+    auto stop = [&](const std::string& why) {
+      stopped_early_ = why + ": event " + std::to_string(events_ + skipped_ + 1) + " at byte " +
+                       std::to_string(offset_) + " of " + std::to_string(size_);
+      return false;
+    };
+    if (got < sizeof(header)) return stop("truncated inside an event header");
+    if (BigEndian(header, 4) != kLogSync) return stop("corrupt (no sync word)");
+    const std::int64_t event_utime = std::int64_t(BigEndian(header + 12, 8));
+    const std::uint64_t channel_length = BigEndian(header + 20, 4),
+                        data_length = BigEndian(header + 24, 4);
+    if (channel_length == 0 || channel_length > 256) return stop("corrupt (channel name length)");
+    const std::int64_t needed = 28 + std::int64_t(channel_length + data_length);
+    if (offset_ + needed > size_) {
+      return stop("truncated (the event needs " + std::to_string(needed) + " bytes)");
+    }
+    // Events over the budget are stepped over unread.
+    if (data_length > max_event_bytes_) {
+      if (std::fseek(file_, long(channel_length + data_length), SEEK_CUR) != 0) {
+        return stop("unreadable");
+      }
+      offset_ += needed;
+      ++skipped_;
+      continue;
+    }
+    channel->resize(channel_length);
+    data->resize(data_length);
+    if (std::fread(channel->data(), 1, channel_length, file_) != channel_length ||
+        std::fread(data->data(), 1, data_length, file_) != data_length) {
+      return stop("unreadable");
+    }
+    *utime = event_utime;
+    offset_ += needed;
+    ++events_;
+    return true;
   }
-  channel->resize(channel_length);
-  data->resize(data_length);
-  if (std::fread(channel->data(), 1, channel_length, file_) != channel_length ||
-      std::fread(data->data(), 1, data_length, file_) != data_length) {
-    return stop("unreadable");
-  }
-  *utime = event_utime;
-  offset_ += needed;
-  ++events_;
-  return true;
 }
 
 double LogReader::fraction_read() const { return double(offset_) / double(size_); }
@@ -137,9 +216,15 @@ void Deliver(const lcm::ReceiveBuffer* buffer, const std::string& /*channel*/, L
 
 }  // namespace
 
-LatestInput::LatestInput(LcmLink& link, std::string channel)
-    : link_(link), channel_(std::move(channel)) {
-  subscription_ = link_.impl().lcm.subscribeFunction(channel_, &Deliver, this);
+LatestInput::LatestInput(LcmLink& link, std::string channel, MessageCheck check,
+                         std::size_t max_bytes)
+    : link_(link), channel_(std::move(channel)), check_(std::move(check)), max_bytes_(max_bytes) {
+  lcm::Subscription* subscription = link_.impl().lcm.subscribeFunction(channel_, &Deliver, this);
+  if (subscription == nullptr) {
+    throw std::runtime_error("LatestInput: cannot subscribe to '" + Printable(channel_) + "'");
+  }
+  subscription->setQueueCapacity(kQueueCapacity);
+  subscription_ = subscription;
 }
 
 LatestInput::~LatestInput() {
@@ -149,41 +234,59 @@ LatestInput::~LatestInput() {
 void LatestInput::OnMessage(const void* data, unsigned size, std::int64_t receive_utime) {
   ++received_;
   last_receive_utime_ = receive_utime;
+  const auto* bytes = static_cast<const std::uint8_t*>(data);
+  // Checked before anything is copied: a bad message leaves the good one waiting.
+  if (size > max_bytes_) {
+    return Reject("over the channel's budget of " + std::to_string(max_bytes_) + " bytes");
+  }
+  if (check_) {
+    if (std::string problem = check_(bytes, size); !problem.empty()) return Reject(problem);
+  }
   if (queue_) {
-    const auto* bytes = static_cast<const std::uint8_t*>(data);
-    queue_messages_.emplace_back(bytes, bytes + size);
+    if (queued_bytes_ + size > kMaxQueuedBytes) {
+      return Reject("lock-step queue full (" + std::to_string(kMaxQueuedBytes >> 20) + " MB)");
+    }
+    queue_messages_.push_back({{bytes, bytes + size}, receive_utime});
+    queued_bytes_ += size;
     return;
   }
   if (fresh_) ++superseded_;  // the one waiting was never taken
-  const auto* bytes = static_cast<const std::uint8_t*>(data);
-  newest_.assign(bytes, bytes + size);
+  newest_.bytes.assign(bytes, bytes + size);
+  newest_.receive_utime = receive_utime;
   fresh_ = true;
-  last_receive_utime_ = receive_utime;
 }
 
-const std::vector<std::uint8_t>* LatestInput::Peek() const {
-  return queue_messages_.empty() ? nullptr : &queue_messages_.front();
+const std::vector<std::uint8_t>* LatestInput::Peek() {
+  if (queue_messages_.empty()) return nullptr;
+  taken_utime_ = queue_messages_.front().receive_utime;
+  return &queue_messages_.front().bytes;
 }
 
 void LatestInput::Pop() {
-  if (!queue_messages_.empty()) queue_messages_.pop_front();
+  if (queue_messages_.empty()) return;
+  queued_bytes_ -= queue_messages_.front().bytes.size();
+  queue_messages_.pop_front();
 }
 
 const std::vector<std::uint8_t>* LatestInput::TakeNewest() {
   if (!fresh_) return nullptr;
   fresh_ = false;
-  taken_.swap(newest_);
-  return &taken_;
+  std::swap(taken_, newest_);
+  taken_utime_ = taken_.receive_utime;
+  return &taken_.bytes;
 }
 
 void LatestInput::Reject(const std::string& reason) {
   ++rejected_;
-  ++reasons_[reason];
-  last_reason_ = reason;
-  if (log_ != nullptr) log_->Note(channel_, reason);
+  last_reason_ = Printable(reason);
+  // Reasons may quote what arrived: a bounded number are counted apart.
+  if (reasons_.size() < kMaxReasons || reasons_.count(last_reason_) > 0) {
+    ++reasons_[last_reason_];
+  } else {
+    ++reasons_["other"];
+  }
+  if (log_ != nullptr) log_->Note(channel_, last_reason_);
 }
-
-void LatestInput::Accept(std::int64_t receive_utime) { last_accept_utime_ = receive_utime; }
 
 bool LatestInput::Stale(std::int64_t now_utime, double max_age_s) const {
   return last_accept_utime_ < 0 || double(now_utime - last_accept_utime_) * 1e-6 > max_age_s;

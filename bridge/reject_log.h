@@ -12,6 +12,9 @@ namespace sandbox::bridge {
 
 class RejectLog {
  public:
+  // At most this many causes are logged apart; more are "other reasons".
+  static constexpr std::size_t kMaxCauses = 64;
+
   explicit RejectLog(std::ostream* out) : out_(out) {}
   // `source` is the channel or socket, `reason` the cause.
   void Note(const std::string& source, const std::string& reason);

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "bridge/checked_decode.h"
 #include "sandbox_msgs/actor_placements_t.hpp"
 #include "sandbox_msgs/bone_values_t.hpp"
 #include "sandbox_msgs/camera_command_t.hpp"
@@ -9,13 +10,6 @@
 
 namespace sandbox::bridge {
 namespace {
-
-// Decodes `bytes` as Message; false when they are not exactly one.
-template <typename Message>
-bool Decode(const std::vector<std::uint8_t>& bytes, Message* message) {
-  return message->decode(bytes.data(), 0, static_cast<int>(bytes.size())) ==
-         static_cast<int>(bytes.size());
-}
 
 // The seq of an encoded input message: every input type starts with the
 // 8-byte fingerprint, then utime and seq (big-endian int64); -1 when too short.
@@ -33,6 +27,10 @@ bool AllFinite(const double* values, std::size_t n) {
   return true;
 }
 
+// The budget of a bone_values_t message for `n` values: its size, with room
+// for a wrong count to be rejected as one rather than as an oversized message.
+std::size_t BonesBudget(int n) { return 8 + 8 + 8 + 4 + 8 * std::size_t(n) + 65536; }
+
 }  // namespace
 
 RobotInputs::RobotInputs(LcmLink& link, const scene::Level& level, int robot,
@@ -40,14 +38,119 @@ RobotInputs::RobotInputs(LcmLink& link, const scene::Level& level, int robot,
     : level_(level),
       robot_(robot),
       translation_(config.pose),
-      pose_(link, config.channel_prefix + "/POSE"),
-      bones_(link, config.channel_prefix + "/BONES"),
-      actors_(link, config.channel_prefix + "/ACTORS"),
-      camera_(link, config.channel_prefix + "/CAMERA") {}
+      pose_(
+          link, config.channel_prefix + "/POSE",
+          [this](const std::uint8_t* data, std::size_t size) {
+            Pose pose;
+            return ParsePose(data, size, &pose);
+          },
+          sandbox_msgs::robot_pose_t{}.getEncodedSize()),
+      bones_(
+          link, config.channel_prefix + "/BONES",
+          [this](const std::uint8_t* data, std::size_t size) {
+            std::vector<double> values;
+            return ParseBones(data, size, &values);
+          },
+          BonesBudget(level.robots.at(std::size_t(robot)).num_values)),
+      actors_(
+          link, config.channel_prefix + "/ACTORS",
+          [this](const std::uint8_t* data, std::size_t size) {
+            Placements placements;
+            return ParsePlacements(data, size, &placements);
+          },
+          kMaxActorsBytes),
+      camera_(
+          link, config.channel_prefix + "/CAMERA",
+          [this](const std::uint8_t* data, std::size_t size) {
+            Camera camera;
+            return ParseCamera(data, size, &camera);
+          },
+          kMaxCameraBytes) {}
 
 RobotInputs::RobotInputs(LcmLink& link, const scene::Level& level, int robot)
     : RobotInputs(link, level, robot,
                   RobotBridgeConfig::FromModel(level.robots.at(std::size_t(robot)))) {}
+
+std::string RobotInputs::ParsePose(const std::uint8_t* data, std::size_t size, Pose* pose) const {
+  sandbox_msgs::robot_pose_t message{};
+  if (std::string problem = DecodeChecked(data, size, &message); !problem.empty()) return problem;
+  if (!AllFinite(message.position, 3) || !AllFinite(message.orientation, 4)) {
+    return "non-finite pose";
+  }
+  const Eigen::Quaterniond q(message.orientation[0], message.orientation[1], message.orientation[2],
+                             message.orientation[3]);
+  if (std::abs(q.norm() - 1.0) > 1e-3) return "non-unit quaternion";
+  pose->X_WB = translation_.ToWorld(
+      Eigen::Vector3d(message.position[0], message.position[1], message.position[2]), q);
+  pose->seq = message.seq;
+  pose->utime = message.utime;
+  return scene::PoseProblem(pose->X_WB);
+}
+
+std::string RobotInputs::ParseBones(const std::uint8_t* data, std::size_t size,
+                                    std::vector<double>* values) const {
+  const scene::RobotModel& model = level_.robots[std::size_t(robot_)];
+  sandbox_msgs::bone_values_t message{};
+  if (std::string problem = DecodeChecked(data, size, &message); !problem.empty()) return problem;
+  if (message.num_values != model.num_values) {
+    return "expected " + std::to_string(model.num_values) + " bone values, got " +
+           std::to_string(message.num_values);
+  }
+  for (const scene::Bone& bone : model.bones) {
+    const std::string problem =
+        scene::BoneValuesProblem(bone, &message.values[std::size_t(bone.first_value)], bone.num_values);
+    if (!problem.empty()) return problem;
+  }
+  *values = std::move(message.values);
+  return "";
+}
+
+std::string RobotInputs::ParsePlacements(const std::uint8_t* data, std::size_t size,
+                                         Placements* placements) const {
+  // All of a message or none.
+  sandbox_msgs::actor_placements_t message{};
+  if (std::string problem = DecodeChecked(data, size, &message); !problem.empty()) return problem;
+  if (message.num_positions != 3 * std::int64_t(message.num_actors) ||
+      message.num_orientations != 4 * std::int64_t(message.num_actors)) {
+    return "positions and orientations must hold 3 and 4 values per actor";
+  }
+  for (int i = 0; i < message.num_actors; ++i) {
+    const std::string& name = message.names[std::size_t(i)];
+    const int actor = level_.FindActor(name);
+    const double* p = &message.positions[std::size_t(3 * i)];
+    const double* o = &message.orientations[std::size_t(4 * i)];
+    if (actor < 0) return "unknown actor '" + Printable(name, 64) + "'";
+    if (!level_.actors[std::size_t(actor)].movable) {
+      return "actor '" + Printable(name, 64) + "' is not movable";
+    }
+    if (!AllFinite(p, 3) || !AllFinite(o, 4)) return "non-finite placement";
+    const Eigen::Quaterniond q(o[0], o[1], o[2], o[3]);
+    if (std::abs(q.norm() - 1.0) > 1e-3) return "non-unit quaternion";
+    placements->X_WA.emplace_back(actor,
+                                  Eigen::Translation3d(p[0], p[1], p[2]) * q.normalized());
+  }
+  return "";
+}
+
+std::string RobotInputs::ParseCamera(const std::uint8_t* data, std::size_t size,
+                                     Camera* camera) const {
+  sandbox_msgs::camera_command_t message{};
+  if (std::string problem = DecodeChecked(data, size, &message); !problem.empty()) return problem;
+  if (!std::isfinite(message.pan_rad) || !std::isfinite(message.tilt_rad)) {
+    return "non-finite pan or tilt";
+  }
+  if (!(message.zoom > 0.0 && message.zoom <= 100.0)) return "zoom must be in (0, 100]";
+  if (!message.active_camera.empty()) {
+    bool known = false;
+    for (const scene::SensorSpec& spec : level_.robots.at(std::size_t(robot_)).cameras) {
+      known = known || spec.name == message.active_camera;
+    }
+    if (!known) return "unknown camera '" + Printable(message.active_camera, 64) + "'";
+  }
+  camera->trailing = {message.pan_rad, message.tilt_rad, message.zoom};
+  camera->active = message.active_camera;
+  return "";
+}
 
 RobotInputs::Applied RobotInputs::Apply(scene::RobotState* state, scene::CollisionWorld* world) {
   Applied applied;
@@ -79,7 +182,7 @@ RobotInputs::Applied RobotInputs::ApplyNext(scene::RobotState* state,
     ApplyActors(*bytes, world, &applied);
     actors_.Pop();
   }
-  ApplyPose(*pose, state, &applied);
+  ApplyPose(*pose_.Peek(), state, &applied);
   pose_.Pop();
   // Camera commands change no output: the newest wins, as in free running.
   if (const auto* bytes = camera_.TakeNewest()) ApplyCamera(*bytes, &applied);
@@ -88,92 +191,48 @@ RobotInputs::Applied RobotInputs::ApplyNext(scene::RobotState* state,
 
 void RobotInputs::ApplyPose(const std::vector<std::uint8_t>& bytes, scene::RobotState* state,
                             Applied* applied) {
-  sandbox_msgs::robot_pose_t message{};
-  if (!Decode(bytes, &message)) return pose_.Reject("cannot decode as robot_pose_t");
-  if (!AllFinite(message.position, 3) || !AllFinite(message.orientation, 4)) {
-    return pose_.Reject("non-finite pose");
+  Pose pose;
+  if (std::string problem = ParsePose(bytes.data(), bytes.size(), &pose); !problem.empty()) {
+    return pose_.Reject(problem);
   }
-  const Eigen::Quaterniond q(message.orientation[0], message.orientation[1], message.orientation[2],
-                             message.orientation[3]);
-  if (std::abs(q.norm() - 1.0) > 1e-3) return pose_.Reject("non-unit quaternion");
-  if (!state->SetPose(translation_.ToWorld(
-          Eigen::Vector3d(message.position[0], message.position[1], message.position[2]), q))) {
-    return pose_.Reject(state->last_rejection());
-  }
-  pose_.Accept(pose_.last_receive_utime());
+  if (!state->SetPose(pose.X_WB)) return pose_.Reject(state->last_rejection());
+  pose_.Accept();
   applied->pose = true;
-  applied->pose_seq = message.seq;
-  applied->pose_utime = message.utime;
+  applied->pose_seq = pose.seq;
+  applied->pose_utime = pose.utime;
 }
 
 void RobotInputs::ApplyBones(const std::vector<std::uint8_t>& bytes, scene::RobotState* state,
                              Applied* applied) {
-  sandbox_msgs::bone_values_t message{};
-  const int expected = state->model().num_values;
-  if (!Decode(bytes, &message)) return bones_.Reject("cannot decode as bone_values_t");
-  if (message.num_values != expected) {
-    return bones_.Reject("expected " + std::to_string(expected) + " bone values, got " +
-                         std::to_string(message.num_values));
+  std::vector<double> values;
+  if (std::string problem = ParseBones(bytes.data(), bytes.size(), &values); !problem.empty()) {
+    return bones_.Reject(problem);
   }
-  if (!state->SetBones(message.values)) return bones_.Reject(state->last_rejection());
-  bones_.Accept(bones_.last_receive_utime());
+  if (!state->SetBones(values)) return bones_.Reject(state->last_rejection());
+  bones_.Accept();
   applied->bones = true;
 }
 
 void RobotInputs::ApplyActors(const std::vector<std::uint8_t>& bytes, scene::CollisionWorld* world,
                               Applied* applied) {
-  // All of a message or none.
-  sandbox_msgs::actor_placements_t message{};
-  std::string reason;
-  std::vector<std::pair<int, Eigen::Isometry3d>> placements;
-  if (!Decode(bytes, &message)) {
-    reason = "cannot decode as actor_placements_t";
-  } else if (message.num_positions != 3 * message.num_actors ||
-             message.num_orientations != 4 * message.num_actors) {
-    reason = "positions and orientations must hold 3 and 4 values per actor";
+  Placements placements;
+  if (std::string problem = ParsePlacements(bytes.data(), bytes.size(), &placements);
+      !problem.empty()) {
+    return actors_.Reject(problem);
   }
-  for (int i = 0; reason.empty() && i < message.num_actors; ++i) {
-    const int actor = level_.FindActor(message.names[std::size_t(i)]);
-    const double* p = &message.positions[std::size_t(3 * i)];
-    const double* o = &message.orientations[std::size_t(4 * i)];
-    if (actor < 0) {
-      reason = "unknown actor '" + message.names[std::size_t(i)] + "'";
-    } else if (!level_.actors[std::size_t(actor)].movable) {
-      reason = "actor '" + message.names[std::size_t(i)] + "' is not movable";
-    } else if (!AllFinite(p, 3) || !AllFinite(o, 4)) {
-      reason = "non-finite placement";
-    } else if (std::abs(Eigen::Quaterniond(o[0], o[1], o[2], o[3]).norm() - 1.0) > 1e-3) {
-      reason = "non-unit quaternion";
-    } else {
-      placements.emplace_back(actor, Eigen::Translation3d(p[0], p[1], p[2]) *
-                                         Eigen::Quaterniond(o[0], o[1], o[2], o[3]).normalized());
-    }
-  }
-  if (!reason.empty()) return actors_.Reject(reason);
-  for (const auto& [actor, X_WA] : placements) world->SetActorPose(actor, X_WA);
-  actors_.Accept(actors_.last_receive_utime());
+  for (const auto& [actor, X_WA] : placements.X_WA) world->SetActorPose(actor, X_WA);
+  actors_.Accept();
   applied->actors = true;
 }
 
 void RobotInputs::ApplyCamera(const std::vector<std::uint8_t>& bytes, Applied* applied) {
-  sandbox_msgs::camera_command_t message{};
-  if (!Decode(bytes, &message)) return camera_.Reject("cannot decode as camera_command_t");
-  if (!std::isfinite(message.pan_rad) || !std::isfinite(message.tilt_rad)) {
-    return camera_.Reject("non-finite pan or tilt");
+  Camera camera;
+  if (std::string problem = ParseCamera(bytes.data(), bytes.size(), &camera); !problem.empty()) {
+    return camera_.Reject(problem);
   }
-  if (!(message.zoom > 0.0 && message.zoom <= 100.0)) {
-    return camera_.Reject("zoom must be in (0, 100], got " + std::to_string(message.zoom));
-  }
-  if (!message.active_camera.empty()) {
-    bool known = false;
-    for (const scene::SensorSpec& camera : level_.robots.at(std::size_t(robot_)).cameras) {
-      known = known || camera.name == message.active_camera;
-    }
-    if (!known) return camera_.Reject("unknown camera '" + message.active_camera + "'");
-    active_camera_ = message.active_camera;
-  }
-  trailing_ = {message.pan_rad, message.tilt_rad, message.zoom};
-  camera_.Accept(camera_.last_receive_utime());
+  if (!camera.active.empty()) active_camera_ = camera.active;
+  trailing_ = camera.trailing;
+  camera_.Accept();
   applied->camera = true;
 }
 

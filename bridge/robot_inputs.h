@@ -1,9 +1,11 @@
 #pragma once
 // A robot's inputs from external models: <ROBOT>/POSE (robot_pose_t),
 // <ROBOT>/BONES (bone_values_t), <ROBOT>/ACTORS (actor_placements_t) and
-// <ROBOT>/CAMERA (camera_command_t), each the newest message of its channel,
-// checked, translated and applied; bad messages are rejected, counted by
-// reason, and the last good value stays.
+// <ROBOT>/CAMERA (camera_command_t), each the newest good message of its
+// channel, translated and applied. Every message is decoded and checked when
+// it arrives (its size against the channel's budget, its layout, finite
+// values, unit quaternions, the bone count, known and movable actors): a bad
+// one is rejected, counted by reason, and never displaces the last good one.
 
 #include <cstdint>
 #include <string>
@@ -20,8 +22,12 @@ namespace sandbox::bridge {
 
 class RobotInputs {
  public:
-  // Subscribes the robot's channels (<prefix>/POSE, /BONES, /ACTORS) on
-  // `link`; the config also says the convention its pose publisher speaks.
+  // Byte budgets of the variable-size inputs (POSE and BONES have one exact size).
+  static constexpr std::size_t kMaxActorsBytes = 1u << 20;
+  static constexpr std::size_t kMaxCameraBytes = 4096;
+
+  // Subscribes the robot's channels (<prefix>/POSE, /BONES, /ACTORS, /CAMERA)
+  // on `link`; the config also says the convention its pose publisher speaks.
   // `level` must outlive this.
   RobotInputs(LcmLink& link, const scene::Level& level, int robot, const RobotBridgeConfig& config);
   // With the robot's own [robot.bridge] settings.
@@ -39,8 +45,8 @@ class RobotInputs {
   Applied Apply(scene::RobotState* state, scene::CollisionWorld* world);
 
   // Lock-step (for replays and deterministic runs): the inputs queue every
-  // message, and ApplyNext() consumes exactly the oldest pose message, after
-  // the bone and placement messages whose seq is not above its seq.
+  // good message, and ApplyNext() consumes exactly the oldest pose message,
+  // after the bone and placement messages whose seq is not above its seq.
   void set_lockstep(bool lockstep);
   bool HasPose() const { return pose_.queued() > 0; }
   Applied ApplyNext(scene::RobotState* state, scene::CollisionWorld* world);
@@ -59,6 +65,26 @@ class RobotInputs {
   }
 
  private:
+  // A message decoded and checked, ready to apply.
+  struct Pose {
+    Eigen::Isometry3d X_WB;
+    std::int64_t seq{-1}, utime{-1};
+  };
+  struct Placements {
+    std::vector<std::pair<int, Eigen::Isometry3d>> X_WA;  // actor index, pose
+  };
+  struct Camera {
+    sensors::TrailingCommand trailing;
+    std::string active;  // empty: keep the active camera
+  };
+  // Each returns "" with the value, or why the message is rejected.
+  std::string ParsePose(const std::uint8_t* data, std::size_t size, Pose* pose) const;
+  std::string ParseBones(const std::uint8_t* data, std::size_t size,
+                         std::vector<double>* values) const;
+  std::string ParsePlacements(const std::uint8_t* data, std::size_t size,
+                              Placements* placements) const;
+  std::string ParseCamera(const std::uint8_t* data, std::size_t size, Camera* camera) const;
+
   void ApplyPose(const std::vector<std::uint8_t>& bytes, scene::RobotState* state,
                  Applied* applied);
   void ApplyBones(const std::vector<std::uint8_t>& bytes, scene::RobotState* state,

@@ -46,17 +46,23 @@ std::string TypeOf(const std::uint8_t* data, std::uint32_t size) {
   return text;
 }
 
+void Count(const std::string& channel, const std::uint8_t* data, std::uint32_t size,
+           std::int64_t utime, std::map<std::string, ChannelStats>* stats) {
+  ChannelStats& s = (*stats)[channel];
+  if (s.messages == 0) {
+    s.first_utime = utime;
+    s.type = TypeOf(data, size);
+  }
+  ++s.messages;
+  s.bytes += size;
+  s.last_utime = utime;
+}
+
 struct Collector {
   std::map<std::string, ChannelStats>* stats;
   void On(const lcm::ReceiveBuffer* buffer, const std::string& channel) {
-    ChannelStats& s = (*stats)[channel];
-    if (s.messages == 0) {
-      s.first_utime = buffer->recv_utime;
-      s.type = TypeOf(static_cast<const std::uint8_t*>(buffer->data), buffer->data_size);
-    }
-    ++s.messages;
-    s.bytes += buffer->data_size;
-    s.last_utime = buffer->recv_utime;
+    Count(channel, static_cast<const std::uint8_t*>(buffer->data), buffer->data_size,
+          buffer->recv_utime, stats);
   }
 };
 
@@ -75,6 +81,20 @@ std::map<std::string, ChannelStats> ListenToAll(LcmLink& link, double seconds) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   while (std::chrono::steady_clock::now() < end) link.impl().lcm.handleTimeout(20);
   link.impl().lcm.unsubscribe(subscription);
+  return stats;
+}
+
+std::map<std::string, ChannelStats> ReadLogTopics(const std::string& path,
+                                                  std::string* stopped_early) {
+  std::map<std::string, ChannelStats> stats;
+  LogReader log(path);
+  std::string channel;
+  std::vector<std::uint8_t> data;
+  std::int64_t utime = 0;
+  while (log.Next(&channel, &data, &utime)) {
+    Count(channel, data.data(), std::uint32_t(data.size()), utime, &stats);
+  }
+  *stopped_early = log.stopped_early();
   return stats;
 }
 

@@ -22,4 +22,10 @@ struct ChannelStats {
 // Listens to every channel on `link` for `seconds`.
 std::map<std::string, ChannelStats> ListenToAll(LcmLink& link, double seconds);
 
+// The same for every event of an LCM log file (times are the events' own).
+// Throws std::runtime_error naming the file (see LogReader); a log cut short
+// is read up to the break, which *stopped_early then tells.
+std::map<std::string, ChannelStats> ReadLogTopics(const std::string& path,
+                                                  std::string* stopped_early);
+
 }  // namespace sandbox::bridge

@@ -36,12 +36,30 @@ bool RobotState::Reject(const std::string& reason) {
   return false;
 }
 
-bool RobotState::SetPose(const Eigen::Isometry3d& X_WB) {
-  if (!X_WB.matrix().allFinite()) return Reject("non-finite pose");
+std::string PoseProblem(const Eigen::Isometry3d& X_WB) {
+  if (!X_WB.matrix().allFinite()) return "non-finite pose";
   const Eigen::Matrix3d R = X_WB.linear();
   if (!(R.transpose() * R).isApprox(Eigen::Matrix3d::Identity(), 1e-6) || R.determinant() < 0.0) {
-    return Reject("pose rotation is not a rotation");
+    return "pose rotation is not a rotation";
   }
+  return "";
+}
+
+std::string BoneValuesProblem(const Bone& bone, const double* values, int num_values) {
+  if (num_values != bone.num_values) return "wrong number of bone values";
+  for (int i = 0; i < num_values; ++i) {
+    if (!std::isfinite(values[i])) return "non-finite bone value";
+  }
+  if (bone.rotation == BoneRotation::kQuaternion &&
+      std::abs(Eigen::Quaterniond(values[0], values[1], values[2], values[3]).norm() - 1.0) >
+          1e-3) {
+    return "non-unit bone quaternion";
+  }
+  return "";
+}
+
+bool RobotState::SetPose(const Eigen::Isometry3d& X_WB) {
+  if (std::string problem = PoseProblem(X_WB); !problem.empty()) return Reject(problem);
   X_WB_ = X_WB;
   return true;
 }
@@ -51,15 +69,12 @@ bool RobotState::SetBone(int bone, const double* values, int num_values) {
     return Reject("bone index out of range");
   }
   const Bone& b = model_->bones[static_cast<std::size_t>(bone)];
-  if (num_values != b.num_values) return Reject("wrong number of bone values");
-  for (int i = 0; i < num_values; ++i) {
-    if (!std::isfinite(values[i])) return Reject("non-finite bone value");
+  if (std::string problem = BoneValuesProblem(b, values, num_values); !problem.empty()) {
+    return Reject(problem);
   }
   Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
   if (b.rotation == BoneRotation::kQuaternion) {
-    q = Eigen::Quaterniond(values[0], values[1], values[2], values[3]);
-    if (std::abs(q.norm() - 1.0) > 1e-3) return Reject("non-unit bone quaternion");
-    q.normalize();
+    q = Eigen::Quaterniond(values[0], values[1], values[2], values[3]).normalized();
   } else {
     for (std::size_t a = 0; a < b.axes.size(); ++a) {
       q = q * Eigen::Quaterniond(Eigen::AngleAxisd(values[a], b.axes[a]));
@@ -75,16 +90,15 @@ bool RobotState::SetBones(const std::vector<double>& values) {
     return Reject("wrong number of bone values");
   }
   // Check everything first, so that a bad bone leaves every bone as it was.
-  const std::vector<Eigen::Quaterniond> before = rotation_;
-  const std::vector<double> values_before = values_;
+  for (const Bone& bone : model_->bones) {
+    const std::string problem = BoneValuesProblem(
+        bone, &values[static_cast<std::size_t>(bone.first_value)], bone.num_values);
+    if (!problem.empty()) return Reject(problem);
+  }
   for (std::size_t b = 0; b < model_->bones.size(); ++b) {
     const Bone& bone = model_->bones[b];
-    if (!SetBone(static_cast<int>(b), &values[static_cast<std::size_t>(bone.first_value)],
-                 bone.num_values)) {
-      rotation_ = before;
-      values_ = values_before;
-      return false;
-    }
+    SetBone(static_cast<int>(b), &values[static_cast<std::size_t>(bone.first_value)],
+            bone.num_values);
   }
   return true;
 }

@@ -11,6 +11,12 @@
 
 namespace sandbox::scene {
 
+// Why a pose or one bone's values would be rejected ("" when they would not):
+// the checks of RobotState::SetPose and SetBone, for callers that check
+// before they hold a state.
+std::string PoseProblem(const Eigen::Isometry3d& X_WB);
+std::string BoneValuesProblem(const Bone& bone, const double* values, int num_values);
+
 class RobotState {
  public:
   // At the model's spawn pose with every bone at rest, already updated.

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <random>
 #include <sstream>
 
@@ -78,9 +79,11 @@ TEST_F(RobotInputsTest, BadMessagesAreRejectedAndTheLastGoodValueStays) {
     link_.Drain();
     inputs_.Apply(&state_, &world_);
   }
-  EXPECT_EQ(inputs_.pose().last_reject_reason(), "cannot decode as robot_pose_t");
-  EXPECT_EQ(inputs_.bones().last_reject_reason(), "cannot decode as bone_values_t");
-  EXPECT_EQ(inputs_.actors().last_reject_reason(), "cannot decode as actor_placements_t");
+  const std::string other_type = ": wrong fingerprint (another type?)";
+  EXPECT_EQ(inputs_.pose().last_reject_reason(), "cannot decode as robot_pose_t" + other_type);
+  EXPECT_EQ(inputs_.bones().last_reject_reason(), "cannot decode as bone_values_t" + other_type);
+  EXPECT_EQ(inputs_.actors().last_reject_reason(),
+            "cannot decode as actor_placements_t" + other_type);
   // NaN, a long quaternion.
   Publish(link_, "ELAHA/POSE", Pose(2, std::nan(""), 0, 0));
   link_.Drain();
@@ -165,7 +168,7 @@ TEST_F(RobotInputsTest, CameraCommandsSteerTheTrailingCameraAndSwitchTheActiveOn
   Publish(link_, "ELAHA/CAMERA", command);
   link_.Drain();
   EXPECT_FALSE(inputs_.Apply(&state_, &world_).camera);
-  EXPECT_EQ(inputs_.camera().last_reject_reason(), "zoom must be in (0, 100], got 0.000000");
+  EXPECT_EQ(inputs_.camera().last_reject_reason(), "zoom must be in (0, 100]");
   command.zoom = 1.5;
   command.active_camera = "periscope";
   Publish(link_, "ELAHA/CAMERA", command);
@@ -182,6 +185,75 @@ TEST_F(RobotInputsTest, CameraCommandsSteerTheTrailingCameraAndSwitchTheActiveOn
   EXPECT_TRUE(inputs_.Apply(&state_, &world_).camera);
   EXPECT_EQ(inputs_.active_camera(), "belly");
   EXPECT_EQ(inputs_.trailing().zoom, 1.5);
+}
+
+TEST_F(RobotInputsTest, HostileMessagesNeverDisplaceTheGoodOneWaiting) {
+  Publish(link_, "ELAHA/POSE", Pose(1, 10, 20, 30));
+  sandbox_msgs::bone_values_t bones{};
+  bones.num_values = 45;
+  bones.values.assign(45, 0.0);
+  bones.values[2] = 0.1;
+  Publish(link_, "ELAHA/BONES", bones);
+  // After the good messages: a negative count, a count of two billion, a
+  // message far over the channel's budget, a NaN pose and another type.
+  std::vector<std::uint8_t> negative(std::size_t(bones.getEncodedSize()));
+  bones.encode(negative.data(), 0, int(negative.size()));
+  negative[24] = 0xff, negative[25] = 0xff, negative[26] = 0xff, negative[27] = 0xfb;
+  link_.Publish("ELAHA/BONES", negative.data(), unsigned(negative.size()));
+  std::vector<std::uint8_t> huge = negative;
+  huge[24] = 0x7f;
+  link_.Publish("ELAHA/BONES", huge.data(), unsigned(huge.size()));
+  const std::vector<std::uint8_t> oversized(8u << 20, 0x41);
+  link_.Publish("ELAHA/BONES", oversized.data(), unsigned(oversized.size()));
+  link_.Publish("ELAHA/ACTORS", oversized.data(), unsigned(oversized.size()));
+  Publish(link_, "ELAHA/POSE", Pose(2, std::nan(""), 0, 0));
+  Publish(link_, "ELAHA/POSE", bones);
+  link_.Drain();
+  const RobotInputs::Applied applied = inputs_.Apply(&state_, &world_);
+  ASSERT_TRUE(applied.pose);
+  EXPECT_EQ(applied.pose_seq, 1);
+  EXPECT_TRUE(applied.bones);
+  EXPECT_EQ(state_.bone_values()[2], 0.1);
+  EXPECT_EQ(inputs_.pose().rejected(), 2);
+  EXPECT_EQ(inputs_.pose().superseded(), 0);
+  EXPECT_EQ(inputs_.bones().rejected(), 3);
+  const std::map<std::string, std::int64_t>& reasons = inputs_.bones().rejected_by_reason();
+  EXPECT_EQ(reasons.at("cannot decode as bone_values_t: num_values is negative"), 1);
+  EXPECT_EQ(reasons.at("cannot decode as bone_values_t: values runs past the end"), 1);
+  EXPECT_EQ(reasons.at("over the channel's budget of 65924 bytes"), 1);
+  EXPECT_EQ(inputs_.actors().last_reject_reason(), "over the channel's budget of 1048576 bytes");
+}
+
+TEST_F(RobotInputsTest, TheNewestOfAThousandPosesBetweenTwoTicksWins) {
+  // 1000 poses within one tick: 100 kHz at 100 ticks a second. LCM's own
+  // queue (30 messages by default) would keep the oldest and drop the rest.
+  for (int seq = 1; seq <= 1000; ++seq) Publish(link_, "ELAHA/POSE", Pose(seq, seq, 0, 50));
+  link_.Drain();
+  const RobotInputs::Applied applied = inputs_.Apply(&state_, &world_);
+  EXPECT_EQ(applied.pose_seq, 1000);
+  EXPECT_EQ(inputs_.pose().received(), 1000);
+  EXPECT_EQ(inputs_.pose().superseded(), 999);
+}
+
+TEST_F(RobotInputsTest, ReasonsQuotingTheSenderAreBoundedAndPrintable) {
+  sandbox_msgs::actor_placements_t actors{};
+  actors.num_actors = 1;
+  actors.num_positions = 3;
+  actors.positions = {0, 0, 0};
+  actors.num_orientations = 4;
+  actors.orientations = {1, 0, 0, 0};
+  for (int i = 0; i < 200; ++i) {
+    actors.names = {"\x1b[2Jactor " + std::to_string(i) + std::string(500, 'x')};
+    Publish(link_, "ELAHA/ACTORS", actors);
+  }
+  link_.Drain();
+  EXPECT_EQ(inputs_.actors().rejected(), 200);
+  EXPECT_LE(inputs_.actors().rejected_by_reason().size(), LatestInput::kMaxReasons + 1);
+  EXPECT_EQ(inputs_.actors().rejected_by_reason().at("other"), 200 - 32);
+  const std::string& last = inputs_.actors().last_reject_reason();
+  EXPECT_EQ(last.rfind("unknown actor '?[2Jactor 199xxx", 0), 0u) << last;
+  EXPECT_LE(last.size(), 160u);
+  EXPECT_EQ(last.find('\x1b'), std::string::npos);
 }
 
 TEST(LcmLinkTest, MulticastUrlsGetABigReceiveBuffer) {
