@@ -68,11 +68,8 @@ int RunBenchFrames(const std::vector<std::string>& args, std::ostream& out, std:
   }
   try {
     auto whole = [&](const std::string& option, int fallback) {
-      if (!parsed->values.count(option)) return fallback;
-      const double v = ParseNumbers(parsed->Value(option), option).at(0);
-      if (!(v >= 1 && v <= 1e6 && v == std::floor(v)))
-        throw CommandError(option + " must be a whole number from 1");
-      return int(v);
+      return parsed->values.count(option) ? int(ParseWhole(parsed->Value(option), option, 1, 1000000))
+                                          : fallback;
     };
     const int frames = whole("--frames", 500), runs = whole("--runs", 3);
     const std::filesystem::path dir = parsed->Value("--out", "bench-frames");
@@ -183,6 +180,9 @@ int RunBenchFrames(const std::vector<std::string>& args, std::ostream& out, std:
     }
     out << "\nframes.csv and one plot per case -> " << dir.string() << "\n";
     return 0;
+  } catch (const UsageError& error) {
+    err << "sandbox bench-frames: " << error.what() << "\n";
+    return 2;
   } catch (const std::exception& error) {
     err << "sandbox bench-frames: " << error.what() << "\n";
     return 1;

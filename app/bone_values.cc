@@ -32,20 +32,20 @@ void ApplyBones(const std::string& spec, const RobotModel& model, RobotState* st
     std::string bone_word;
     if (!(words >> bone_word)) continue;
     int bone = model.FindBone(bone_word);
-    if (bone < 0 && !bone_word.empty() &&
+    if (bone < 0 && !bone_word.empty() && bone_word.size() <= 6 &&
         bone_word.find_first_not_of("0123456789") == std::string::npos) {
       bone = std::atoi(bone_word.c_str());
     }
     if (bone < 0 || bone >= static_cast<int>(model.bones.size())) {
-      throw CommandError("--bones: robot '" + model.name + "' has no bone '" + bone_word + "' (" +
+      throw UsageError("--bones: robot '" + model.name + "' has no bone '" + bone_word + "' (" +
                          std::to_string(model.bones.size()) + " bones)");
     }
     const scene::Bone& b = model.bones[static_cast<std::size_t>(bone)];
     std::vector<double> values;
     std::string word;
-    while (words >> word) values.push_back(ParseNumbers(word, "--bones " + bone_word).at(0));
+    while (words >> word) values.push_back(ParseNumber(word, "--bones " + bone_word));
     if (static_cast<int>(values.size()) != b.num_values) {
-      throw CommandError("--bones: bone '" + b.name + "' takes " + std::to_string(b.num_values) +
+      throw UsageError("--bones: bone '" + b.name + "' takes " + std::to_string(b.num_values) +
                          (b.rotation == scene::BoneRotation::kQuaternion
                               ? " values (quaternion w x y z)"
                               : " values (angles in degrees)") +
@@ -55,7 +55,7 @@ void ApplyBones(const std::string& spec, const RobotModel& model, RobotState* st
       for (double& v : values) v *= scene::kDegToRad;
     }
     if (!state->SetBone(bone, values.data(), b.num_values)) {
-      throw CommandError("--bones: bone '" + b.name + "' rejected: " + state->last_rejection());
+      throw UsageError("--bones: bone '" + b.name + "' rejected: " + state->last_rejection());
     }
   }
 }

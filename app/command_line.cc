@@ -50,17 +50,33 @@ std::vector<double> ParseNumbers(const std::string& text, const std::string& opt
     char* end = nullptr;
     const double value = std::strtod(item.c_str(), &end);
     if (item.empty() || *end != '\0' || !std::isfinite(value)) {
-      throw CommandError(option + ": '" + item + "' is not a finite number");
+      throw UsageError(option + ": '" + item + "' is not a finite number");
     }
     values.push_back(value);
   }
   return values;
 }
 
+double ParseNumber(const std::string& text, const std::string& option) {
+  const std::vector<double> values = ParseNumbers(text, option);
+  if (values.size() != 1) throw UsageError(option + " takes one number, got '" + text + "'");
+  return values[0];
+}
+
+long long ParseWhole(const std::string& text, const std::string& option, long long min,
+                     long long max) {
+  const double value = ParseNumber(text, option);
+  if (!(value >= double(min) && value <= double(max)) || value != std::floor(value)) {
+    throw UsageError(option + " must be a whole number from " + std::to_string(min) + " to " +
+                     std::to_string(max) + ", got '" + text + "'");
+  }
+  return static_cast<long long>(value);
+}
+
 Eigen::Isometry3d ParsePose(const std::string& text, const std::string& option) {
   const std::vector<double> v = ParseNumbers(text, option);
   if (v.size() != 3 && v.size() != 6) {
-    throw CommandError(option + " takes X,Y,Z or X,Y,Z,ROLL,PITCH,YAW, got " +
+    throw UsageError(option + " takes X,Y,Z or X,Y,Z,ROLL,PITCH,YAW, got " +
                        std::to_string(v.size()) + " numbers");
   }
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();

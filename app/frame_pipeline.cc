@@ -23,6 +23,27 @@ namespace {
 // would otherwise wait behind rendering and encoding (Linux nice is per thread).
 void LowerThisThreadsPriority() { setpriority(PRIO_PROCESS, id_t(syscall(SYS_gettid)), 10); }
 
+// Queues a job or frame where the stage behind it may be late: a newer one of
+// the same camera takes the older one's place (so every camera keeps its turn,
+// however often the others come), else the oldest waiting one is dropped when
+// the queue is full. Returns how many were dropped.
+template <typename Item>
+int PushNewestPerCamera(std::deque<Item>* queue, Item item, std::size_t capacity) {
+  for (Item& waiting : *queue) {
+    if (waiting.camera == item.camera) {
+      waiting = std::move(item);
+      return 1;
+    }
+  }
+  int dropped = 0;
+  if (queue->size() >= capacity) {
+    queue->pop_front();
+    dropped = 1;
+  }
+  queue->push_back(std::move(item));
+  return dropped;
+}
+
 }  // namespace
 
 struct FramePipeline::Video {
@@ -63,11 +84,10 @@ void FramePipeline::Submit(RenderJob job) {
     std::unique_lock<std::mutex> lock(mutex_);
     if (config_.lossless) {
       room_.wait(lock, [&] { return render_queue_.size() < config_.queue_capacity; });
-    } else if (render_queue_.size() >= config_.queue_capacity) {
-      render_queue_.pop_front();
-      ++dropped_render_;
+      render_queue_.push_back(std::move(job));
+    } else {
+      dropped_render_ += PushNewestPerCamera(&render_queue_, std::move(job), config_.queue_capacity);
     }
-    render_queue_.push_back(std::move(job));
   }
   render_wake_.notify_one();
 }
@@ -123,11 +143,11 @@ void FramePipeline::RenderLoop() {
       std::unique_lock<std::mutex> lock(mutex_);
       if (config_.lossless) {
         room_.wait(lock, [&] { return write_queue_.size() < config_.queue_capacity; });
-      } else if (write_queue_.size() >= config_.queue_capacity) {
-        write_queue_.pop_front();
-        ++dropped_write_;
+        write_queue_.push_back(std::move(item));
+      } else {
+        dropped_write_ +=
+            PushNewestPerCamera(&write_queue_, std::move(item), config_.queue_capacity);
       }
-      write_queue_.push_back(std::move(item));
     }
     write_wake_.notify_one();
   }
@@ -193,25 +213,30 @@ void FramePipeline::Write(const Encoded& item) {
     } else if (item.depth) {
       WriteDepthMillimetres(item.frame, (dir / (name.str() + "_depth.png")).string());
     }
-    std::unique_ptr<std::ofstream>& index = indexes_[item.camera];
+    std::unique_ptr<RowFile>& index = indexes_[item.camera];
     if (!index) {
-      index = std::make_unique<std::ofstream>(dir / (item.camera + ".csv"));
-      *index << "tick,time_s,file,x,y,z,qw,qx,qy,qz,cam_x,cam_y,cam_z,cam_qw,cam_qx,cam_qy,cam_qz,"
-                "fx,fy,cx,cy\n"
-             << std::setprecision(10);
+      index = std::make_unique<RowFile>(
+          (dir / (item.camera + ".csv")).string(),
+          "tick,time_s,file,x,y,z,qw,qx,qy,qz,cam_x,cam_y,cam_z,cam_qw,cam_qx,cam_qy,cam_qz,"
+          "fx,fy,cx,cy");
     }
+    std::ostringstream row;
+    row << std::setprecision(10);
     for (const Eigen::Isometry3d* X : {&item.robot_pose, &item.view.X_WC}) {
       const Eigen::Vector3d p = X->translation();
       const Eigen::Quaterniond q(X->linear());
-      if (X == &item.robot_pose) *index << item.tick << "," << item.time_s << "," << file;
-      *index << "," << p.x() << "," << p.y() << "," << p.z() << "," << q.w() << "," << q.x() << ","
-             << q.y() << "," << q.z();
+      if (X == &item.robot_pose) row << item.tick << "," << item.time_s << "," << file;
+      row << "," << p.x() << "," << p.y() << "," << p.z() << "," << q.w() << "," << q.x() << ","
+          << q.y() << "," << q.z();
     }
     // Square pixels: one focal length from the vertical field of view; pixel
     // centres at whole coordinates, as OpenCV's camera matrix has them.
     const double f = 0.5 * item.view.height / std::tan(0.5 * item.view.fov_y_rad);
-    *index << "," << f << "," << f << "," << 0.5 * item.view.width - 0.5 << ","
-           << 0.5 * item.view.height - 0.5 << "\n";
+    row << "," << f << "," << f << "," << 0.5 * item.view.width - 0.5 << ","
+        << 0.5 * item.view.height - 0.5;
+    // The row is the frame's last part: a frame whose row cannot be written is removed.
+    index->Add(row.str());
+    if (!index->Flush()) throw std::runtime_error(index->error());
     ++written_;
   } catch (const std::exception& e) {
     Fail(e.what());

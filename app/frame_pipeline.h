@@ -1,8 +1,10 @@
 #pragma once
 // Camera frames off the loop thread: a render thread that owns the GL context
 // renders the jobs the loop submits, and an encoder thread writes them with
-// OpenCV. Both queues are small and bounded: when a stage is behind, the
-// oldest waiting job is dropped and counted, so the loop never waits.
+// OpenCV. Both queues are small and bounded: when a stage is behind, a
+// camera's newer job replaces its older one still waiting (so a 10 Hz camera
+// is not starved by two 30 Hz ones on a busy machine), and the oldest job is
+// dropped when the queue is full; drops are counted, and the loop never waits.
 //
 // Files: DIR/<camera>_<tick>.jpg (or .png) and/or one DIR/<camera>.mp4 (or
 // .avi) per camera; DIR/<camera>_<tick>_depth.png (16-bit millimetres),
@@ -26,6 +28,7 @@
 #include <thread>
 #include <vector>
 
+#include "app/row_file.h"
 #include "scene/level.h"
 #include "scene/robot_state.h"
 #include "sensors/renderer.h"
@@ -111,7 +114,7 @@ class FramePipeline {
   std::string first_error_;
   struct Video;
   std::map<std::string, std::unique_ptr<Video>> videos_;           // write thread only
-  std::map<std::string, std::unique_ptr<std::ofstream>> indexes_;  // write thread only
+  std::map<std::string, std::unique_ptr<RowFile>> indexes_;  // write thread only
   std::chrono::steady_clock::time_point retry_after_{};            // write thread only
   std::thread render_thread_, write_thread_;
 };

@@ -61,6 +61,7 @@ void WritePly(const fs::path& file, const RobotState& state) {
     }
     base += mesh.bind.positions_A.size();
   }
+  out.close();  // the last buffer's write errors show here
   if (!out) throw CommandError("cannot write " + file.string());
 }
 
@@ -77,6 +78,7 @@ void WriteBoneFrames(const fs::path& file, const RobotState& state) {
         << X.translation().y() << "," << X.translation().z() << "," << q.w() << "," << q.x() << ","
         << q.y() << "," << q.z() << "\n";
   }
+  out.close();  // the last buffer's write errors show here
   if (!out) throw CommandError("cannot write " + file.string());
 }
 
@@ -102,11 +104,11 @@ int RunPose(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     const scene::Level level = scene::LoadLevel(level_file);
     if (level.robots.empty()) throw CommandError(level_file + ": the level declares no [[robot]]");
     const int robot = robot_name.empty() ? 0 : level.FindRobot(robot_name);
-    if (robot < 0) throw CommandError("the level has no robot '" + robot_name + "'");
+    if (robot < 0) throw UsageError("the level has no robot '" + robot_name + "'");
     const RobotModel& model = level.robots[static_cast<std::size_t>(robot)];
     RobotState state(model);
     if (!pose_text.empty() && !state.SetPose(ParsePose(pose_text, "--robot-pose"))) {
-      throw CommandError("--robot-pose rejected: " + state.last_rejection());
+      throw UsageError("--robot-pose rejected: " + state.last_rejection());
     }
     if (!bones_text.empty()) ApplyBones(bones_text, model, &state);
     state.Update();
@@ -121,6 +123,9 @@ int RunPose(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   } catch (const scene::LevelError& error) {
     err << "sandbox pose: " << error.what() << "\n";
     return 1;
+  } catch (const UsageError& error) {
+    err << "sandbox pose: " << error.what() << "\n";
+    return 2;
   } catch (const CommandError& error) {
     err << "sandbox pose: " << error.what() << "\n";
     return 1;

@@ -90,14 +90,13 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
     const Eigen::Isometry3d X_at = ParsePose(parsed->Value("--at"), "--at");
     sensors::CameraView view;
     auto whole = [&](const std::string& option, int fallback) {
-      return parsed->values.count(option) ? int(ParseNumbers(parsed->Value(option), option).at(0))
+      return parsed->values.count(option) ? int(ParseWhole(parsed->Value(option), option, 1, 16384))
                                           : fallback;
     };
     view.width = whole("--width", 640);
     view.height = whole("--height", 480);
     view.fov_y_rad =
-        (parsed->values.count("--fov") ? ParseNumbers(parsed->Value("--fov"), "--fov").at(0)
-                                       : 60.0) *
+        (parsed->values.count("--fov") ? ParseNumber(parsed->Value("--fov"), "--fov") : 60.0) *
         M_PI / 180.0;
     const scene::Level level = scene::LoadLevel(parsed->level.value_or(kDefaultLevel));
     std::unique_ptr<scene::RobotState> robot;
@@ -106,11 +105,11 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
       const int index =
           parsed->Value("--robot").empty() ? 0 : level.FindRobot(parsed->Value("--robot"));
       if (index < 0)
-        throw CommandError("the level has no robot '" + parsed->Value("--robot") + "'");
+        throw UsageError("the level has no robot '" + parsed->Value("--robot") + "'");
       robot_index = index;
       robot = std::make_unique<scene::RobotState>(level.robots[std::size_t(index)]);
       if (camera != "fixed" && !robot->SetPose(X_at)) {
-        throw CommandError("--at rejected: " + robot->last_rejection());
+        throw UsageError("--at rejected: " + robot->last_rejection());
       }
       if (!parsed->Value("--bones").empty())
         ApplyBones(parsed->Value("--bones"), robot->model(), robot.get());
@@ -139,7 +138,7 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
     sensors::Overlay overlay;
     if (parsed->flags.count("--overlay")) {
       const double stub_m = parsed->values.count("--stub")
-                                ? ParseNumbers(parsed->Value("--stub"), "--stub").at(0)
+                                ? ParseNumber(parsed->Value("--stub"), "--stub")
                                 : 0.0;
       BuildOverlay(level, robot_index, robot.get(), stub_m, &overlay);
     }
@@ -157,6 +156,9 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
     out << std::fixed << std::setprecision(1) << " (" << ms << " ms with set-up, "
         << renderer->description() << ")\n";
     return 0;
+  } catch (const UsageError& error) {
+    err << "sandbox render: " << error.what() << "\n";
+    return 2;
   } catch (const scene::LevelError& error) {
     err << "sandbox render: " << error.what() << "\n";
     return 1;

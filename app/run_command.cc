@@ -50,19 +50,24 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     out << kUsage;
     return 0;
   }
+  RunOptions options;
   try {
-    SandboxLoop loop(ParseRunOptions(*parsed), hooks, out, err);
+    options = ParseRunOptions(*parsed);
+  } catch (const UsageError& error) {
+    err << "sandbox run: " << error.what() << "\n";
+    return 2;
+  }
+  try {
+    SandboxLoop loop(options, hooks, out, err);
     LiveView* view = loop.live_view();
-    if (view == nullptr) {
-      loop.Run();
-      return 0;
-    }
+    if (view == nullptr) return loop.Run();
     // The window on this (the main) thread, the loop on another.
     std::atomic<bool> done{false};
     std::exception_ptr failure;
+    int code = 0;
     std::thread loop_thread([&] {
       try {
-        loop.Run();
+        code = loop.Run();
       } catch (...) {
         failure = std::current_exception();
       }
@@ -77,7 +82,7 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     }
     loop_thread.join();
     if (failure) std::rethrow_exception(failure);
-    return 0;
+    return code;
   } catch (const std::exception& error) {  // scene::LevelError, CommandError, LCM, files
     err << "sandbox run: " << error.what() << "\n";
     return 1;

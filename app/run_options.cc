@@ -19,16 +19,16 @@ void ParseFrames(const std::string& text, FramePipelineConfig* config) {
                         : format == "mp4" || format == "avi" ? config->video_format
                                                              : format;
     if (&slot == &format) {
-      throw CommandError(
+      throw UsageError(
           "--frames must be jpg, png, mp4 or avi (or a list like jpg,mp4, or none), "
           "got '" +
           format + "'");
     }
-    if (!slot.empty()) throw CommandError("--frames: one image and one video format at most");
+    if (!slot.empty()) throw UsageError("--frames: one image and one video format at most");
     slot = format;
   }
   if (config->image_format.empty() && config->video_format.empty()) {
-    throw CommandError("--frames: nothing to write in '" + text + "' (none writes no frames)");
+    throw UsageError("--frames: nothing to write in '" + text + "' (none writes no frames)");
   }
 }
 
@@ -43,8 +43,9 @@ std::map<std::int64_t, double> ParseStalls(const std::string& text) {
     if (colon != std::string::npos) {
       values = ParseNumbers(item.substr(0, colon) + "," + item.substr(colon + 1), "--stall");
     }
-    if (values.size() != 2 || values[0] < 0 || values[1] < 0) {
-      throw CommandError("--stall wants TICK:MS items, got '" + item + "'");
+    if (values.size() != 2 || !(values[0] >= 0 && values[0] <= 1e12) ||
+        !(values[1] >= 0 && values[1] <= 60000)) {
+      throw UsageError("--stall wants TICK:MS items (MS up to 60000), got '" + item + "'");
     }
     stalls[std::int64_t(values[0])] = values[1];
   }
@@ -62,15 +63,24 @@ RunOptions ParseRunOptions(const ParsedArgs& args) {
   RunOptions options;
   options.level = args.level.value_or(kDefaultLevel);
   auto number = [&](const std::string& option, double fallback) {
-    return args.values.count(option) ? ParseNumbers(args.Value(option), option).at(0) : fallback;
+    return args.values.count(option) ? ParseNumber(args.Value(option), option) : fallback;
   };
   if (args.Value("--rate") == "max") {
     options.rate_hz = 0.0;
   } else {
     options.rate_hz = number("--rate", 100.0);
-    if (!(options.rate_hz > 0.0)) throw CommandError("--rate must be positive or max");
+    if (!(options.rate_hz >= kMinRateHz && options.rate_hz <= kMaxRateHz)) {
+      throw UsageError("--rate must be positive (0.01 to 100000 Hz) or max, got '" +
+                       args.Value("--rate") + "'");
+    }
   }
-  options.duration_s = number("--duration", -1.0);
+  if (args.values.count("--duration")) {
+    options.duration_s = number("--duration", 0.0);
+    if (!(options.duration_s > 0.0)) {
+      throw UsageError("--duration must be positive (leave it out to run until Ctrl-C), got '" +
+                       args.Value("--duration") + "'");
+    }
+  }
   options.lcm_url = args.Value("--lcm-url");
   options.replay_file = args.Value("--replay");
   options.lockstep = options.replay() || args.flags.count("--lockstep") > 0;
@@ -80,18 +90,18 @@ RunOptions ParseRunOptions(const ParsedArgs& args) {
   options.frames.depth_format = args.Value("--depth", "png");
   if (options.frames.depth_format != "png" && options.frames.depth_format != "npy" &&
       options.frames.depth_format != "exr") {
-    throw CommandError("--depth must be png, npy or exr, got '" + options.frames.depth_format +
+    throw UsageError("--depth must be png, npy or exr, got '" + options.frames.depth_format +
                        "'");
   }
   options.scans_every_s = number("--scans-every", 0.0);
   if (args.values.count("--scans-every") &&
       (options.out_dir.empty() || !(options.scans_every_s > 0.0))) {
-    throw CommandError("--scans-every needs --out and a positive number of seconds");
+    throw UsageError("--scans-every needs --out and a positive number of seconds");
   }
   options.view = args.flags.count("--view") > 0;
   const std::string realtime = args.Value("--realtime", "auto");
   if (realtime != "auto" && realtime != "off") {
-    throw CommandError("--realtime must be auto or off, got '" + realtime + "'");
+    throw UsageError("--realtime must be auto or off, got '" + realtime + "'");
   }
   options.realtime = realtime == "auto";
   options.stalls_ms = ParseStalls(args.Value("--stall"));

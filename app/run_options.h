@@ -12,10 +12,14 @@
 
 namespace sandbox::app {
 
+// The rates --rate takes (the loop waits at most one period, and any wait
+// ends at once on Ctrl-C or at the end of --duration).
+constexpr double kMinRateHz = 0.01, kMaxRateHz = 100000.0;
+
 struct RunOptions {
   std::string level;           // a scene file or manifest
   double rate_hz{100.0};       // 0: free running (--rate max)
-  double duration_s{-1.0};     // < 0: until stopped
+  double duration_s{0.0};      // 0: until stopped
   std::string lcm_url;         // empty: LCM's default
   bool lockstep{false};        // one pose message a tick (a replay is always lock-step)
   std::string replay_file;     // an LCM log read instead of the network
@@ -34,7 +38,7 @@ struct RunOptions {
 // The value options and flags `sandbox run` takes.
 extern const std::set<std::string> kRunValueOptions, kRunFlags;
 
-// Throws CommandError for a bad value or combination.
+// Throws UsageError for a bad value or combination.
 RunOptions ParseRunOptions(const ParsedArgs& args);
 
 }  // namespace sandbox::app

@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <csignal>
 #include <filesystem>
 #include <iomanip>
 #include <sstream>
@@ -14,6 +13,8 @@
 #include <variant>
 
 #include "app/command_line.h"
+#include "app/stop_signal.h"
+#include "app/tick_pacer.h"
 #include "sensors/debug_overlay.h"
 #include "sensors/range_sensor.h"
 
@@ -21,9 +22,6 @@ namespace sandbox::app {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-std::atomic<bool> stop_requested{false};
-void OnSignal(int) { stop_requested = true; }
 
 std::string Format(double value) {
   std::ostringstream out;
@@ -99,7 +97,7 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
       link_(options.replay() ? "memq://" : options.lcm_url),
       reject_log_(&err),
       stats_(PrepareOutDir(options)) {
-  stop_requested = false;  // from here on RequestStop() and signals end Run()
+  StopSignal::Clear();  // from here on RequestStop() and signals end Run()
   if (!options_.record_file.empty()) link_.RecordTo(options_.record_file);
   robots_.resize(level_.robots.size());
   for (std::size_t r = 0; r < level_.robots.size(); ++r) {
@@ -122,7 +120,7 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
     }
   }
   for (const sensors::MountedSensor& m : mounted_) {
-    SensorRun run{&m, {}, 0.0, {}};
+    SensorRun run{&m, {}, RateSchedule(m.spec.rate_hz), {}};
     if (const auto* face = std::get_if<sensors::FaceScannerConfig>(&m.config)) {
       run.sensor.emplace<sensors::FaceScanner>(*face);
       run.face_scan = std::get<sensors::FaceScanner>(run.sensor).EmptyScan();
@@ -134,7 +132,9 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
     sensor_runs_.push_back(std::move(run));
   }
   for (const sensors::MountedCamera& camera : cameras_) {
-    camera_runs_.push_back({&camera, sensors::ChaseCamera(camera.chase)});
+    // Cameras without a rate run at 30 Hz.
+    camera_runs_.push_back({&camera, sensors::ChaseCamera(camera.chase),
+                            RateSchedule(camera.spec.rate_hz > 0.0 ? camera.spec.rate_hz : 30.0)});
   }
   // Cameras: rendered off the loop, into the output folder and/or the live view.
   if (options_.view) {
@@ -160,7 +160,7 @@ SandboxLoop::~SandboxLoop() {
   if (hooks_.before_close) hooks_.before_close(link_);
 }
 
-void SandboxLoop::RequestStop() { stop_requested = true; }
+void SandboxLoop::RequestStop() { StopSignal::Request(); }
 
 bool SandboxLoop::has_pose() const {
   for (const RobotRun& robot : robots_) {
@@ -169,15 +169,19 @@ bool SandboxLoop::has_pose() const {
   return false;
 }
 
-void SandboxLoop::Run() {
+int SandboxLoop::Run() {
   // The loop thread at real-time priority when allowed (and when it sleeps
   // between ticks): the kernel then wakes it at once, whatever else runs.
+  // Free-running and lock-step loops never sleep between ticks: they would
+  // only starve the rest of the machine.
+  const bool paced = !options_.lockstep && !options_.free_running();
   std::string priority;
   const NormalPriorityAtExit restore_priority;
-  if (options_.realtime && !options_.free_running()) {
+  if (options_.realtime && paced) {
     priority = RaiseToRealTime() ? ", real-time priority"
                                  : ", normal priority (real-time needs CAP_SYS_NICE or ulimit -r)";
   }
+  const StopSignal signals;  // SIGINT and SIGTERM end the loop, and wake its waits
   const std::string pace = options_.lockstep         ? std::string("lock-step")
                            : options_.free_running() ? std::string("free running")
                                                      : Format(options_.rate_hz) + " Hz";
@@ -186,16 +190,22 @@ void SandboxLoop::Run() {
        << (options_.replay() ? "replaying " + options_.replay_file : pace + ", LCM " + link_.url())
        << priority << "\n"
        << std::flush;
-  std::signal(SIGINT, OnSignal);
-  std::signal(SIGTERM, OnSignal);
 
-  const bool paced = !options_.lockstep && !options_.free_running();
-  const auto period = std::chrono::duration<double>(paced ? 1.0 / options_.rate_hz : 0.0);
+  const double period_s = paced ? 1.0 / options_.rate_hz : 0.0;
+  // Inputs are drained for at most a quarter of a period (a flood cannot hold the loop).
+  const double drain_budget_s = paced ? std::min(0.25 * period_s, 0.005) : 0.001;
   const auto start = Clock::now();
-  auto deadline = start;
-  while (!stop_requested) {
-    const double wall_s = std::chrono::duration<double>(Clock::now() - start).count();
-    if (options_.duration_s >= 0.0 && wall_s >= options_.duration_s) break;
+  auto seconds_since_start = [&start](Clock::time_point t) {
+    return std::chrono::duration<double>(t - start).count();
+  };
+  auto at = [&start](double s) {
+    return start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+  };
+  const bool timed = options_.duration_s > 0.0;
+  TickPacer pacer(period_s, 0.0);
+  while (!StopSignal::requested()) {
+    const double wall_s = seconds_since_start(Clock::now());
+    if (timed && wall_s >= options_.duration_s) break;
     if (options_.lockstep) {
       bool wait = false;
       if (!NextLockstepInput(wall_s, &wait)) break;
@@ -204,56 +214,52 @@ void SandboxLoop::Run() {
     const auto tick_start = Clock::now();
     TickRecord record;
     record.tick = tick_;
-    record.start_s = std::chrono::duration<double>(tick_start - start).count();
-    record.lateness_ms =
-        paced ? std::chrono::duration<double, std::milli>(tick_start - deadline).count() : 0.0;
+    record.start_s = seconds_since_start(tick_start);
+    record.lateness_ms = 1e3 * pacer.Lateness(record.start_s);
     const std::int64_t rays_before = caster_.rays_cast();
     if (live_view_) {
       for (const ViewKey key : live_view_->TakeKeys()) controls_.Apply(key, int(cameras_.size()));
       if (controls_.quit) break;
       if (controls_.paused) {  // the world holds still; inputs keep only their newest
-        link_.Drain();
-        std::this_thread::sleep_for(std::chrono::milliseconds(10));
-        deadline = Clock::now();
+        link_.Drain(drain_budget_s);
+        StopSignal::SleepUntil(Clock::now() + std::chrono::milliseconds(10));
+        pacer.Restart(seconds_since_start(Clock::now()));
         continue;
       }
     }
     if (hooks_.before_tick) hooks_.before_tick(link_, wall_s);
     // 1-2. Inputs applied; 3-4. sensors that are due, their outputs, the state.
     std::int64_t now = bridge::NowUtime();
-    const double t = ApplyInputs(wall_s, &now, &record);
+    const double t = ApplyInputs(wall_s, drain_budget_s, &now, &record);
     RunDueSensors(t, now);
     for (RobotRun& robot : robots_) robot.outputs->PublishState(*robot.state, robot.input, now);
     WriteDueScans(t);
     // 5. Cameras that are due: jobs for the render thread (copies, no waiting).
     SubmitDueFrames(t, &record);
     PublishStatusIfDue(t, now);
+    ReportRecordingFailure();
     if (const auto stall = options_.stalls_ms.find(tick_); stall != options_.stalls_ms.end()) {
-      std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(stall->second));
+      StopSignal::SleepUntil(Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                                std::chrono::duration<double, std::milli>(
+                                                    stall->second)));
     }
     ++tick_;
-    // 6. Record the tick; wait for the next. A late tick starts the next at
-    // once and the deadlines restart from there: no catching up.
+    // 6. Record the tick; wait for the next (or the end of the run, or a stop).
     const auto tick_end = Clock::now();
     record.duration_ms = std::chrono::duration<double, std::milli>(tick_end - tick_start).count();
     record.rays = caster_.rays_cast() - rays_before;
     bool overrun = false;
-    if (paced) {
-      deadline += std::chrono::duration_cast<Clock::duration>(period);
-      if (tick_end > deadline) {
-        overrun = true;
-        deadline = tick_end;
-      } else {
-        std::this_thread::sleep_until(deadline);
-      }
-    }
+    const double next_s = pacer.Next(seconds_since_start(tick_end), &overrun);
     stats_.Add(record, overrun);
+    if (paced && !overrun) {
+      StopSignal::SleepUntil(at(timed ? std::min(next_s, options_.duration_s) : next_s));
+    }
   }
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
   if (frames_) frames_->Finish();  // queues drained, videos and indexes closed
   scan_files_.Finish();
-  PrintSummary(std::chrono::duration<double>(Clock::now() - start).count());
+  link_.FinishRecording();
+  PrintSummary(seconds_since_start(Clock::now()));
+  return output_lost_ ? kExitOutputLost : 0;
 }
 
 bool SandboxLoop::NextLockstepInput(double wall_s, bool* wait) {
@@ -285,9 +291,10 @@ bool SandboxLoop::NextLockstepInput(double wall_s, bool* wait) {
   return true;
 }
 
-double SandboxLoop::ApplyInputs(double wall_s, std::int64_t* now_utime, TickRecord* record) {
+double SandboxLoop::ApplyInputs(double wall_s, double drain_budget_s, std::int64_t* now_utime,
+                                TickRecord* record) {
   // The newest message per channel (lock-step: the next pose), applied.
-  if (!options_.lockstep) link_.Drain();
+  if (!options_.lockstep) link_.Drain(drain_budget_s);
   for (std::size_t r = 0; r < robots_.size(); ++r) {
     RobotRun& robot = robots_[r];
     const bridge::RobotInputs::Applied applied =
@@ -325,9 +332,8 @@ double SandboxLoop::ApplyInputs(double wall_s, std::int64_t* now_utime, TickReco
 
 void SandboxLoop::RunDueSensors(double t, std::int64_t now_utime) {
   for (SensorRun& run : sensor_runs_) {
-    if (t < run.next_due_s) continue;
-    const double rate = run.mounted->spec.rate_hz;
-    run.next_due_s = rate > 0.0 ? std::max(run.next_due_s + 1.0 / rate, t) : t;
+    if (!run.schedule.Due(t)) continue;
+    run.schedule.Done(t);
     RobotRun& robot = robots_[std::size_t(run.mounted->robot)];
     sensors::RayFilter filter;
     filter.ignore_robot = run.mounted->robot;
@@ -353,8 +359,8 @@ void SandboxLoop::RunDueSensors(double t, std::int64_t now_utime) {
 }
 
 void SandboxLoop::WriteDueScans(double t) {
-  if (options_.scans_every_s <= 0.0 || t < next_scan_file_s_) return;
-  next_scan_file_s_ = std::max(next_scan_file_s_ + options_.scans_every_s, t);
+  if (options_.scans_every_s <= 0.0 || !scan_file_schedule_.Due(t)) return;
+  scan_file_schedule_.Done(t);
   for (const SensorRun& run : sensor_runs_) {
     if (run.face_scan.n == 0) continue;
     std::ostringstream name;
@@ -388,9 +394,8 @@ void SandboxLoop::SubmitDueFrames(double t, TickRecord* record) {
         run.camera->Pose(*robot.state, &run.chase, steer, dt);  // the chase lag advances every tick
     if (run.camera->spec.type == "trailing")
       view.fov_y_rad = sensors::ZoomedFov(view.fov_y_rad, steer.zoom);
-    if (!frames_ || (!write_frames_ && !active) || t < run.next_due_s) continue;
-    const double rate = run.camera->spec.rate_hz > 0.0 ? run.camera->spec.rate_hz : 30.0;
-    run.next_due_s = std::max(run.next_due_s + 1.0 / rate, t);
+    if (!frames_ || (!write_frames_ && !active) || !run.schedule.Due(t)) continue;
+    run.schedule.Done(t);
     RenderJob job;
     job.camera = run.camera->spec.name;
     job.tick = tick_;
@@ -418,13 +423,29 @@ void SandboxLoop::SubmitDueFrames(double t, TickRecord* record) {
 }
 
 void SandboxLoop::PublishStatusIfDue(double t, std::int64_t now_utime) {
-  if (t < next_status_s_) return;
+  // Which inputs are stale now (camera commands come only when someone steers).
+  std::vector<bool> stale;
+  for (const RobotRun& robot : robots_) {
+    for (const bridge::LatestInput* in :
+         {&robot.inputs->pose(), &robot.inputs->bones(), &robot.inputs->actors()}) {
+      stale.push_back(in->Stale(now_utime, robot.config.stale_after_s));
+    }
+  }
+  const bool changed = stale != stale_;
+  stale_ = std::move(stale);
+  if (t < next_status_s_ && !changed) return;
   next_status_s_ = t + 1.0;
   const double rate_now = t > 0.0 ? double(tick_) / t : 0.0;
   for (RobotRun& robot : robots_) {
     robot.outputs->PublishStatus(rate_now, tick_, stats_.overruns(), robot.Channels(now_utime),
                                  now_utime);
   }
+}
+
+void SandboxLoop::ReportRecordingFailure() {
+  if (recording_failure_reported_ || link_.record_error().empty()) return;
+  recording_failure_reported_ = true;
+  err_ << "sandbox run: recording stopped: " << link_.record_error() << "\n";
 }
 
 void SandboxLoop::PrintSummary(double elapsed_s) {
@@ -468,14 +489,17 @@ void SandboxLoop::PrintSummary(double elapsed_s) {
                          paced ? 1e3 / options_.rate_hz : 0.0, (dir / "ticks.png").string());
     } catch (const std::exception& error) {
       err_ << "sandbox run: warning: " << error.what() << "\n";
+      output_lost_ = true;
     }
     if (!stats_.Flush()) {
       err_ << "sandbox run: warning: " << (dir / "ticks.csv").string()
            << " is incomplete (cannot write)\n";
+      output_lost_ = true;
     }
     out_ << "  statistics: " << (dir / "ticks.csv").string() << ", " << (dir / "ticks.png").string()
          << "\n";
     if (options_.scans_every_s > 0.0) {
+      output_lost_ = output_lost_ || scan_files_.failed() > 0;
       out_ << "  scans: " << scan_files_.written() << " PLY files written, "
            << scan_files_.dropped() << " dropped, " << scan_files_.failed() << " failed"
            << (scan_files_.failed() > 0 ? " (" + scan_files_.error() + ")" : "") << " -> "
@@ -488,7 +512,15 @@ void SandboxLoop::PrintSummary(double elapsed_s) {
          << (controls_.overlay ? ", overlay toggled" : "")
          << (controls_.quit ? ", quit by key" : "") << "\n";
   }
+  if (!options_.record_file.empty()) {
+    ReportRecordingFailure();
+    output_lost_ = output_lost_ || !link_.record_error().empty();
+    out_ << "  recording: " << link_.recorded() << " messages -> " << options_.record_file
+         << (link_.record_error().empty() ? "" : " (INCOMPLETE: " + link_.record_error() + ")")
+         << "\n";
+  }
   if (frames_ && write_frames_) {
+    output_lost_ = output_lost_ || frames_->failed() > 0;
     out_ << "  frames: " << frames_->rendered() << " rendered, " << frames_->written()
          << " written, " << frames_->dropped() << " dropped, " << frames_->failed() << " failed"
          << (frames_->failed() > 0 ? " (" + frames_->error() + ")" : "") << " -> "

@@ -20,6 +20,7 @@
 
 #include "app/frame_pipeline.h"
 #include "app/live_view.h"
+#include "app/rate_schedule.h"
 #include "app/run_hooks.h"
 #include "app/run_options.h"
 #include "app/scan_files.h"
@@ -45,10 +46,14 @@ class SandboxLoop {
   SandboxLoop(const SandboxLoop&) = delete;
   SandboxLoop& operator=(const SandboxLoop&) = delete;
 
+  // The exit code of a run that finished but could not write all of its
+  // output (frames, scans, the recording or the statistics).
+  static constexpr int kExitOutputLost = 3;
+
   // Runs until the duration ends, a replayed log ends, SIGINT/SIGTERM, the
   // live view's q or RequestStop(); then finishes the files and prints the
-  // summary to `out`.
-  void Run();
+  // summary to `out`. Returns 0, or kExitOutputLost.
+  int Run();
   // Any thread: ends Run() after the current tick.
   static void RequestStop();
   // The live view when asked for (its window is the caller's to run), or null.
@@ -73,13 +78,14 @@ class SandboxLoop {
     // The sensor, made once from its config (range sensors use the config itself).
     std::variant<std::monostate, sensors::FaceScanner, sensors::GroundScanner, sensors::Lidar>
         sensor;
-    double next_due_s{0.0};
+    RateSchedule schedule;
     sensors::FaceScan face_scan;  // the latest, faces as last scanned
   };
   struct CameraRun {
     const sensors::MountedCamera* camera;
     sensors::ChaseCamera chase;
-    double next_due_s{0.0}, last_s{-1.0};
+    RateSchedule schedule;
+    double last_s{-1.0};
   };
 
   // Lock-step: makes the next pose available (reading the replayed log up to
@@ -87,11 +93,15 @@ class SandboxLoop {
   bool NextLockstepInput(double wall_s, bool* wait);
   // Applies the inputs; returns the tick's time (input time in lock-step) and
   // sets *now_utime to the time stamp outputs carry.
-  double ApplyInputs(double wall_s, std::int64_t* now_utime, TickRecord* record);
+  double ApplyInputs(double wall_s, double drain_budget_s, std::int64_t* now_utime,
+                     TickRecord* record);
   void RunDueSensors(double t, std::int64_t now_utime);
   void WriteDueScans(double t);
   void SubmitDueFrames(double t, TickRecord* record);
+  // Once a second, and at once when an input turns stale or fresh.
   void PublishStatusIfDue(double t, std::int64_t now_utime);
+  // Says once that the recording (--record) could not be written.
+  void ReportRecordingFailure();
   void PrintSummary(double elapsed_s);
   bool has_pose() const;
 
@@ -119,8 +129,13 @@ class SandboxLoop {
   std::unique_ptr<FramePipeline> frames_;
 
   std::int64_t tick_{0};
+  std::vector<bool> stale_;  // per robot and input, as last published
+  bool recording_failure_reported_{false};
+  bool output_lost_{false};
   std::int64_t first_input_utime_{-1};
-  double next_status_s_{0.0}, next_progress_s_{0.0}, next_scan_file_s_{0.0};
+  double next_status_s_{0.0}, next_progress_s_{0.0};
+  RateSchedule scan_file_schedule_{options_.scans_every_s > 0.0 ? 1.0 / options_.scans_every_s
+                                                                : 0.0};
 };
 
 }  // namespace sandbox::app

@@ -66,12 +66,13 @@ void WriteSamples(const std::string& file, const std::string& header,
           << "\n";
     }
   }
+  out.close();  // the last buffer's write errors show here
   if (!out) throw CommandError("cannot write " + file);
 }
 
 double Positive(const std::string& text, const std::string& option) {
   const std::vector<double> v = ParseNumbers(text, option);
-  if (v.size() != 1 || !(v[0] > 0.0)) throw CommandError(option + " must be one positive number");
+  if (v.size() != 1 || !(v[0] > 0.0)) throw UsageError(option + " must be one positive number");
   return v[0];
 }
 
@@ -190,12 +191,15 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   } catch (const scene::LevelError& error) {
     err << "sandbox scan: " << error.what() << "\n";
     return 1;
+  } catch (const UsageError& error) {
+    err << "sandbox scan: " << error.what() << "\n";
+    return 2;
   } catch (const CommandError& error) {
     err << "sandbox scan: " << error.what() << "\n";
     return 1;
-  } catch (const std::invalid_argument& error) {
+  } catch (const std::invalid_argument& error) {  // a sensor setting from the options
     err << "sandbox scan: " << error.what() << "\n";
-    return 1;
+    return 2;
   }
 }
 

@@ -26,6 +26,7 @@ void WriteFaceScanPly(const sensors::FaceScan& scan, const std::string& path) {
           << (face.occupancy[i] == sensors::kOccupied ? "255 0 0" : "0 255 0") << '\n';
     }
   }
+  out.close();  // the last buffer's write errors show here
   if (!out) throw std::runtime_error("cannot write " + path);
 }
 

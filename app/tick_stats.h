@@ -8,10 +8,11 @@
 // 20,000 points, each the longest of a block of ticks.
 
 #include <cstdint>
-#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
+
+#include "app/row_file.h"
 
 namespace sandbox::app {
 
@@ -58,8 +59,11 @@ class TickStats {
 
   void Add(const TickRecord& record, bool overrun);
   StatsSummary Summary() const;
-  // Flushes the CSV; false when some of it could not be written.
+  // Flushes the CSV; false when some of it could not be written (a full
+  // disk: those rows are lost, the file stays whole, later rows are written
+  // when there is room again).
   bool Flush();
+  std::int64_t lost_rows() const { return csv_ ? csv_->lost_rows() : 0; }
   std::int64_t overruns() const { return overruns_; }
   // Tick durations for the plot: one point per `ticks_per_point` ticks (the
   // longest of them), the last block possibly partial.
@@ -69,7 +73,7 @@ class TickStats {
   static constexpr std::size_t kMaxPlotPoints = 20000;
 
  private:
-  std::unique_ptr<std::ofstream> csv_;
+  std::unique_ptr<RowFile> csv_;
   Histogram durations_, lateness_;
   double sum_ms_{0}, max_ms_{0}, max_lateness_ms_{0};
   std::int64_t overruns_{0};

@@ -5,7 +5,9 @@
 %   octave --no-gui examples/fly_wing.m [DURATION_S] [hover]
 %
 % "hover" holds the wing at (12, 34, 56) instead (the tests use it). In MATLAB,
-% set the two variables below and run the file.
+% set the two variables below and run the file. The types jar is
+% build/sandbox_msgs.jar, or the one the environment variable SANDBOX_MSGS_JAR
+% names (a build in another folder).
 args = argv();
 duration_s = 10;
 hover = false;
@@ -13,7 +15,9 @@ if numel(args) >= 1, duration_s = str2double(args{1}); end
 if numel(args) >= 2, hover = strcmp(args{2}, 'hover'); end
 
 javaaddpath('/usr/share/java/lcm.jar');      % Debian's liblcm-java
-javaaddpath(fullfile(pwd, 'build', 'sandbox_msgs.jar'));   % the sandbox's types
+types_jar = getenv('SANDBOX_MSGS_JAR');
+if isempty(types_jar), types_jar = fullfile(pwd, 'build', 'sandbox_msgs.jar'); end
+javaaddpath(types_jar);                      % the sandbox's types
 lc = javaMethod('getSingleton', 'lcm.lcm.LCM');   % LCM's default URL
 
 rate_hz = 100;

@@ -69,14 +69,14 @@ TEST(PoseCommandTest, BadBonesAreOneClearMessage) {
   sandbox::testing::TempDir dir;
   const std::string out = " --out " + (dir.path() / "x.ply").string();
   auto run = RunSandbox("pose " + Robots() + " --robot ARM --bones 'elbow 10'" + out);
-  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_EQ(run.exit_code, 2);
   EXPECT_EQ(run.out, "sandbox pose: --bones: robot 'ARM' has no bone 'elbow' (7 bones)\n");
   run = RunSandbox("pose " + Robots() + " --robot ARM --bones 'link2 10 20'" + out);
-  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_EQ(run.exit_code, 2);
   EXPECT_EQ(run.out,
             "sandbox pose: --bones: bone 'link2' takes 1 values (angles in degrees), got 2\n");
   run = RunSandbox("pose " + Robots() + " --robot NOBODY" + out);
-  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_EQ(run.exit_code, 2);
   EXPECT_EQ(run.out, "sandbox pose: the level has no robot 'NOBODY'\n");
   EXPECT_EQ(RunSandbox("pose " + Robots()).exit_code, 2);  // no --out
 }

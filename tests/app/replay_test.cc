@@ -8,43 +8,17 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <lcm/lcm-cpp.hpp>
 #include <sstream>
 
-#include "sandbox_msgs/robot_pose_t.hpp"
+#include "tests/app/flight_log.h"
 #include "tests/app/run_sandbox.h"
 #include "tests/test_util.h"
 
 namespace {
 
 using sandbox::testing::RunSandbox;
+using sandbox::testing::WriteFlightLog;
 namespace fs = std::filesystem;
-
-// A log of `poses` ELAHA/POSE messages at 50 Hz, circling 60 m up.
-void WriteFlightLog(const std::string& path, int poses) {
-  lcm::LogFile log(path, "w");
-  ASSERT_TRUE(log.good());
-  for (int i = 0; i < poses; ++i) {
-    sandbox_msgs::robot_pose_t pose{};
-    pose.utime = 1'000'000 + 20'000 * std::int64_t(i);
-    pose.seq = i;
-    const double a = 0.01 * i;
-    pose.position[0] = 100 * std::cos(a);
-    pose.position[1] = 100 * std::sin(a);
-    pose.position[2] = 60;
-    pose.orientation[0] = std::cos((a + M_PI / 2) / 2);
-    pose.orientation[3] = std::sin((a + M_PI / 2) / 2);
-    std::vector<std::uint8_t> bytes(std::size_t(pose.getEncodedSize()));
-    pose.encode(bytes.data(), 0, int(bytes.size()));
-    lcm::LogEvent event;
-    event.eventnum = i;
-    event.timestamp = pose.utime;
-    event.channel = "ELAHA/POSE";
-    event.datalen = int32_t(bytes.size());
-    event.data = bytes.data();
-    ASSERT_EQ(log.writeEvent(&event), 0);
-  }
-}
 
 std::string Read(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);

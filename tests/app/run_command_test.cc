@@ -15,6 +15,7 @@
 
 #include "assets/generators/sample_terrain.h"
 #include "scene/level.h"
+#include "tests/app/flight_log.h"
 #include "tests/app/run_sandbox.h"
 #include "tests/test_util.h"
 
@@ -62,10 +63,14 @@ std::vector<IndexRow> ReadIndex(const std::filesystem::path& csv) {
   return rows;
 }
 
+// A replayed flight in lock-step: the cameras are due by input time and no
+// frame is dropped, so every count is exact whatever the machine's speed.
 TEST(RunCommandTest, CamerasWriteIndexedFramesAtTheirRatesWithDepth) {
   sandbox::testing::TempDir dir;
-  const double duration_s = 1.5;
-  const auto run = RunSandbox("run --duration 1.5 --lcm-url memq:// --out " + dir.path().string());
+  const std::string log = (dir.path() / "flight.lcmlog").string();
+  sandbox::testing::WriteFlightLog(log, 75);  // 50 Hz: 1.48 s of input time
+  const double last_s = 74 * 0.02;
+  const auto run = RunSandbox("run --replay " + log + " --out " + (dir.path() / "out").string());
   ASSERT_EQ(run.exit_code, 0) << run.out;
   std::smatch counts;
   ASSERT_TRUE(std::regex_search(
@@ -73,12 +78,12 @@ TEST(RunCommandTest, CamerasWriteIndexedFramesAtTheirRatesWithDepth) {
       std::regex(R"(frames: (\d+) rendered, (\d+) written, (\d+) dropped, (\d+) failed)")))
       << run.out;
   const long rendered = std::stol(counts[1]), written = std::stol(counts[2]);
+  EXPECT_EQ(std::stol(counts[3]), 0) << run.out;  // lock-step is lossless
   EXPECT_EQ(std::stol(counts[4]), 0) << run.out;
-  EXPECT_LE(written, rendered);
-  EXPECT_GE(written, 5) << run.out;
+  EXPECT_EQ(written, rendered);
 
   // The sample level's cameras: chase and trailing 640x480 at 30 Hz, belly 320x240 at 10 Hz
-  // with depth.
+  // with depth. A camera's frame k is due at k / rate: the first tick at or after it.
   struct Camera {
     const char* name;
     int width, height;
@@ -89,27 +94,30 @@ TEST(RunCommandTest, CamerasWriteIndexedFramesAtTheirRatesWithDepth) {
   for (const Camera& camera :
        {Camera{"chase", 640, 480, 30.0, false}, Camera{"trailing", 640, 480, 30.0, false},
         Camera{"belly", 320, 240, 10.0, true}}) {
-    const std::vector<IndexRow> rows = ReadIndex(dir.path() / (std::string(camera.name) + ".csv"));
-    ASSERT_FALSE(rows.empty()) << camera.name;
+    const std::vector<IndexRow> rows =
+        ReadIndex(dir.path() / "out" / (std::string(camera.name) + ".csv"));
     indexed += long(rows.size());
-    EXPECT_LE(double(rows.size()), duration_s * camera.rate_hz + 2) << camera.name;
+    EXPECT_EQ(long(rows.size()), long(std::floor(last_s * camera.rate_hz)) + 1) << camera.name;
     for (std::size_t i = 0; i < rows.size(); ++i) {
-      if (i > 0) {
-        EXPECT_GT(rows[i].tick, rows[i - 1].tick) << camera.name;
-      }
-      const cv::Mat color = cv::imread((dir.path() / rows[i].file).string(), cv::IMREAD_UNCHANGED);
+      const double due_s = double(i) / camera.rate_hz;
+      EXPECT_GE(rows[i].time_s, due_s - 1e-9) << camera.name << " frame " << i;
+      EXPECT_LT(rows[i].time_s, due_s + 0.02 - 1e-9) << camera.name << " frame " << i;
+      EXPECT_EQ(rows[i].tick, std::lround(rows[i].time_s / 0.02)) << camera.name;
+      const cv::Mat color =
+          cv::imread((dir.path() / "out" / rows[i].file).string(), cv::IMREAD_UNCHANGED);
       ASSERT_FALSE(color.empty()) << rows[i].file;
       EXPECT_EQ(color.cols, camera.width);
       EXPECT_EQ(color.rows, camera.height);
       EXPECT_EQ(color.type(), CV_8UC3);
       const std::string stem = rows[i].file.substr(0, rows[i].file.size() - 4);
-      const std::filesystem::path depth_file = dir.path() / (stem + "_depth.png");
+      const std::filesystem::path depth_file = dir.path() / "out" / (stem + "_depth.png");
       EXPECT_EQ(std::filesystem::exists(depth_file), camera.depth) << depth_file;
     }
     if (camera.depth) {
       // Pitched 60 degrees down from 60 m up: the ground fills most of the view.
       const cv::Mat depth = cv::imread(
-          (dir.path() / (rows[0].file.substr(0, rows[0].file.size() - 4) + "_depth.png")).string(),
+          (dir.path() / "out" / (rows[0].file.substr(0, rows[0].file.size() - 4) + "_depth.png"))
+              .string(),
           cv::IMREAD_UNCHANGED);
       ASSERT_EQ(depth.type(), CV_16UC1);
       EXPECT_GT(cv::countNonZero(depth), depth.total() / 2);
@@ -120,10 +128,12 @@ TEST(RunCommandTest, CamerasWriteIndexedFramesAtTheirRatesWithDepth) {
 
 TEST(RunCommandTest, PayloadDepthBackProjectsOntoTheTerrainThroughTheIndexedPoseAndIntrinsics) {
   sandbox::testing::TempDir dir;
-  const auto run =
-      RunSandbox("run --duration 0.3 --lcm-url memq:// --frames png --out " + dir.path().string());
+  const std::string log = (dir.path() / "hover.lcmlog").string();
+  sandbox::testing::WriteFlightLog(log, 3, 20'000, 0.0);  // over the origin, 60 m up
+  const auto run = RunSandbox("run --replay " + log + " --frames png --out " +
+                              (dir.path() / "out").string());
   ASSERT_EQ(run.exit_code, 0) << run.out;
-  const std::vector<IndexRow> rows = ReadIndex(dir.path() / "belly.csv");
+  const std::vector<IndexRow> rows = ReadIndex(dir.path() / "out" / "belly.csv");
   ASSERT_FALSE(rows.empty());
   const IndexRow& row = rows[0];
   // The belly camera: 320 x 240, 70 degrees vertically.
@@ -131,12 +141,12 @@ TEST(RunCommandTest, PayloadDepthBackProjectsOntoTheTerrainThroughTheIndexedPose
   EXPECT_EQ(row.fx, row.fy);
   EXPECT_EQ(row.cx, 159.5);
   EXPECT_EQ(row.cy, 119.5);
-  // Pitched 60 degrees down on the body (the robot at its spawn pose, level).
+  // Pitched 60 degrees down on the body (the robot level).
   EXPECT_TRUE(row.X_WC.translation().isApprox(row.X_WB.translation(), 1e-9));
   EXPECT_NEAR((row.X_WC.linear() * Eigen::Vector3d::UnitX()).z(), -std::sin(M_PI / 3), 1e-6);
-  const cv::Mat depth =
-      cv::imread((dir.path() / (row.file.substr(0, row.file.size() - 4) + "_depth.png")).string(),
-                 cv::IMREAD_UNCHANGED);
+  const cv::Mat depth = cv::imread(
+      (dir.path() / "out" / (row.file.substr(0, row.file.size() - 4) + "_depth.png")).string(),
+      cv::IMREAD_UNCHANGED);
   ASSERT_EQ(depth.type(), CV_16UC1);
   // Every sampled pixel's point lies on the terrain or the lake's water (z = 6 m),
   // whichever is higher: the analytic surface, not the renderer's or the caster's.
@@ -171,7 +181,11 @@ TEST(RunCommandTest, PayloadDepthBackProjectsOntoTheTerrainThroughTheIndexedPose
   EXPECT_GE(on_surface, sampled * 97 / 100) << on_surface << " of " << sampled;
 }
 
-TEST(RunCommandTest, SlowTicksAreFollowedAtOnceWithoutBunchingAndStatisticsAreWritten) {
+// The loop's pacing in real time; the exact rules (a late tick is followed at
+// once, no burst to catch up) are TickPacerTest's. What holds on any machine:
+// the slowed ticks last at least their stall and overrun, and the summary,
+// ticks.csv and the plot agree.
+TEST(RunCommandTest, SlowTicksOverrunAndTheStatisticsAgreeWithTheSummary) {
   sandbox::testing::TempDir dir;
   // Ticks 50-52 take 40 ms each: four periods.
   const auto run = RunSandbox(
@@ -194,17 +208,12 @@ TEST(RunCommandTest, SlowTicksAreFollowedAtOnceWithoutBunchingAndStatisticsAreWr
     duration.push_back(std::stod(cell[2]));
     rays.push_back(std::stol(cell[5]));
   }
-  ASSERT_GT(start.size(), 100u);
+  // A 10x slower machine still ticks 15 times in 1.5 s; ticks are 10 ms apart at least.
+  ASSERT_GT(start.size(), 53u);
+  EXPECT_LE(start.size(), 151u);
   for (int i = 50; i <= 52; ++i) EXPECT_GE(duration[std::size_t(i)], 40.0) << i;
-  // Each slow tick is followed at once (no wait: it is already late) ...
-  for (int i = 51; i <= 53; ++i) {
-    EXPECT_NEAR(start[std::size_t(i)],
-                start[std::size_t(i - 1)] + duration[std::size_t(i - 1)] / 1e3, 2e-3)
-        << i;
-  }
-  // ... and then the loop keeps its period from there: no burst of ticks to catch up.
-  for (std::size_t i = 54; i + 1 < start.size(); ++i) {
-    EXPECT_GT(start[i] - start[i - 1], 0.005) << "ticks " << i - 1 << " and " << i << " bunch up";
+  for (std::size_t i = 1; i < start.size(); ++i) {
+    EXPECT_GE(start[i], start[i - 1] + duration[i - 1] / 1e3 - 1e-6) << "tick " << i;
   }
   // The summary agrees with the file: the longest tick and the overruns.
   const double longest = *std::max_element(duration.begin(), duration.end());
@@ -227,17 +236,21 @@ TEST(RunCommandTest, SlowTicksAreFollowedAtOnceWithoutBunchingAndStatisticsAreWr
   EXPECT_EQ(plot.rows, 500);
 }
 
-TEST(RunCommandTest, CtrlCFinishesVideosIndexesAndTheSummary) {
+// SIGINT (Ctrl-C) or SIGTERM once a few frames are written: the run stops
+// cleanly, the video holds every indexed frame, ticks.csv is complete.
+void CheckStopsCleanlyOn(const std::string& signal) {
   sandbox::testing::TempDir dir;
-  // SIGINT after 2 s, as Ctrl-C sends it; the run has no duration of its own.
+  const std::string out = dir.path().string();
   const auto run = sandbox::testing::RunCommand(
-      "timeout --preserve-status -s INT 2 " + std::string(SANDBOX_BINARY) +
-      " run --lcm-url memq:// --frames mp4 --out " + dir.path().string());
+      std::string(SANDBOX_BINARY) + " run --lcm-url memq:// --frames jpg,mp4 --out " + out +
+      " & pid=$!; for i in $(seq 1200); do [ $(ls " + out +
+      " | grep -c '^chase_.*jpg$') -ge 3 ] && break; sleep 0.05; done; kill -" + signal +
+      " $pid; wait $pid");
   ASSERT_EQ(run.exit_code, 0) << run.out;
   EXPECT_NE(run.out.find(" ticks in "), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("statistics: "), std::string::npos) << run.out;
   const long indexed = long(ReadIndex(dir.path() / "chase.csv").size());
-  EXPECT_GE(indexed, 20);
+  EXPECT_GE(indexed, 3);
   cv::VideoCapture video((dir.path() / "chase.mp4").string());
   ASSERT_TRUE(video.isOpened());
   long frames = 0;
@@ -245,8 +258,41 @@ TEST(RunCommandTest, CtrlCFinishesVideosIndexesAndTheSummary) {
   EXPECT_EQ(frames, indexed);  // a finalised video holds every indexed frame
   std::ifstream ticks(dir.path() / "ticks.csv");
   long rows = -1;
-  for (std::string line; std::getline(ticks, line);) ++rows;
-  EXPECT_GE(rows, 150);
+  std::string line, last;
+  while (std::getline(ticks, line)) ++rows, last = line;
+  EXPECT_GE(rows, 1);
+  EXPECT_EQ(std::count(last.begin(), last.end(), ','), 6) << "a cut row: " << last;
+  std::smatch ticked;
+  ASSERT_TRUE(std::regex_search(run.out, ticked, std::regex(R"(sandbox run: (\d+) ticks in)")));
+  EXPECT_EQ(std::stol(ticked[1]), rows);
+}
+
+TEST(RunCommandTest, CtrlCFinishesVideosIndexesAndTheSummary) { CheckStopsCleanlyOn("INT"); }
+
+TEST(RunCommandTest, SigtermFinishesVideosIndexesAndTheSummary) { CheckStopsCleanlyOn("TERM"); }
+
+// Waits end at the end of --duration or on a signal, however long the period.
+TEST(RunCommandTest, AnyWaitEndsAtTheDurationOrOnASignal) {
+  const auto slow = RunSandbox("run --rate 0.01 --duration 1 --lcm-url memq://");
+  ASSERT_EQ(slow.exit_code, 0) << slow.out;
+  std::smatch elapsed;
+  ASSERT_TRUE(std::regex_search(slow.out, elapsed,
+                                std::regex(R"(sandbox run: 1 ticks in ([0-9.]+) s)")))
+      << slow.out;
+  EXPECT_LT(std::stod(elapsed[1]), 30.0);  // not the 100 s period
+  // SIGINT in the middle of a 100 s wait, once the loop has started.
+  sandbox::testing::TempDir dir;
+  const std::string log = (dir.path() / "run.txt").string();
+  const auto interrupted = sandbox::testing::RunCommand(
+      std::string(SANDBOX_BINARY) + " run --rate 0.01 --lcm-url memq:// > " + log +
+      " 2>&1 & pid=$!; for i in $(seq 1200); do grep -q '^sandbox run:' " + log +
+      " && break; sleep 0.05; done; sleep 0.5; kill -INT $pid; wait $pid; code=$?; cat " + log +
+      "; exit $code");
+  ASSERT_EQ(interrupted.exit_code, 0) << interrupted.out;
+  ASSERT_TRUE(std::regex_search(interrupted.out, elapsed,
+                                std::regex(R"(sandbox run: \d+ ticks in ([0-9.]+) s)")))
+      << interrupted.out;
+  EXPECT_LT(std::stod(elapsed[1]), 30.0);
 }
 
 TEST(RunCommandTest, BadFrameOptionsFailClearly) {
@@ -265,9 +311,21 @@ TEST(RunCommandTest, BadFrameOptionsFailClearly) {
   const auto scans = RunSandbox("run --duration 0.1 --lcm-url memq:// --scans-every 1");
   EXPECT_NE(scans.out.find("--scans-every needs --out"), std::string::npos) << scans.out;
   const auto stall = RunSandbox("run --duration 0.1 --lcm-url memq:// --stall 5");
-  EXPECT_NE(stall.out.find("--stall wants TICK:MS items, got '5'"), std::string::npos) << stall.out;
-  const auto rate = RunSandbox("run --duration 0.1 --lcm-url memq:// --rate -3");
-  EXPECT_NE(rate.out.find("--rate must be positive or max"), std::string::npos) << rate.out;
+  EXPECT_EQ(stall.exit_code, 2);
+  EXPECT_NE(stall.out.find("--stall wants TICK:MS items (MS up to 60000), got '5'"),
+            std::string::npos)
+      << stall.out;
+  for (const char* value : {"-3", "1e-9", "1e9", "nan", "''"}) {
+    const auto rate = RunSandbox("run --duration 0.1 --lcm-url memq:// --rate " +
+                                 std::string(value));
+    EXPECT_EQ(rate.exit_code, 2) << value;
+    EXPECT_NE(rate.out.find("--rate"), std::string::npos) << rate.out;
+  }
+  for (const char* value : {"-1", "0", "inf"}) {
+    const auto duration = RunSandbox("run --lcm-url memq:// --duration " + std::string(value));
+    EXPECT_EQ(duration.exit_code, 2) << value << ": " << duration.out;
+    EXPECT_NE(duration.out.find("--duration"), std::string::npos) << duration.out;
+  }
   const auto flag = RunSandbox("run --duration 0.1 --fast");
   EXPECT_EQ(flag.exit_code, 2);
   EXPECT_NE(flag.out.find("--fast"), std::string::npos) << flag.out;

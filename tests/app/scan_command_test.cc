@@ -82,10 +82,10 @@ TEST(ScanCommandTest, BadArgumentsAreOneClearMessage) {
   sandbox::testing::TempDir dir;
   const std::string out = " --out " + (dir.path() / "x.csv").string();
   auto run = RunSandbox("scan --at 0,0,nan" + out);
-  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_EQ(run.exit_code, 2);
   EXPECT_EQ(run.out, "sandbox scan: --at: 'nan' is not a finite number\n");
   run = RunSandbox("scan --at 0,0,30 --resolution 0.01 --half-extent 100" + out);
-  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_EQ(run.exit_code, 2);
   EXPECT_EQ(
       run.out,
       "sandbox scan: half_extent_m 100 at resolution_m 0.01 makes more than 10 million rays\n");

@@ -7,15 +7,15 @@
 #   multiprocess.sh SANDBOX FLY_WING FACE_CHECK LEVEL
 set -euo pipefail
 sandbox=$1 fly_wing=$2 face_check=$3 level=$4
+source "$(dirname "$0")/processes.sh"
 run_log=$(mktemp /tmp/sandbox-multiprocess-run-XXXXXX.log)
 trap 'rm -f "$run_log"' EXIT
-"$sandbox" run "$level" --duration 5 > "$run_log" &
-run_pid=$!
-"$fly_wing" --duration 4 --rate 200 > /dev/null &
+start_sandbox "$run_log" "$sandbox" run "$level"
+"$fly_wing" --duration 300 --rate 200 > /dev/null &
 fly_pid=$!
-sleep 1  # let the first external poses arrive
-"$face_check" "$level" --faces 24 --seconds 3
-status=$?
-wait "$fly_pid" "$run_pid"
+status=0
+"$face_check" "$level" --faces 24 --seconds 120 || status=$?
+stop "$fly_pid"
+stop "$sandbox_pid"
 cat "$run_log"
 exit "$status"

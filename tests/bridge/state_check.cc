@@ -1,7 +1,11 @@
-// Waits for <ROBOT>/STATE from a running sandbox and checks that the robot
-// stands at the expected world position. Exit 0 when it does.
+// Waits for what a running sandbox publishes about a robot, and exits 0 as
+// soon as it shows what is expected (1 when nothing does within S seconds):
 //
 //   state_check ROBOT X Y Z TOLERANCE_M [--seconds S]
+//       <ROBOT>/STATE: the robot, moved by an external pose, within
+//       TOLERANCE_M of the world position (X, Y, Z);
+//   state_check ROBOT --received N [--seconds S]
+//       <ROBOT>/STATUS: at least N messages received on <ROBOT>/POSE.
 
 #include <chrono>
 #include <cmath>
@@ -11,35 +15,84 @@
 #include <lcm/lcm-cpp.hpp>
 #include <string>
 
+#include "bridge/checked_decode.h"
 #include "sandbox_msgs/robot_state_t.hpp"
+#include "sandbox_msgs/status_t.hpp"
 
-struct Last {
-  bool any{false};
+struct Watch {
+  std::string robot;
+  double expected[3]{0, 0, 0};
+  double tolerance{0};
+  long long want_received{-1};  // >= 0: watch STATUS instead
+  bool any{false}, there{false};
   double p[3]{0, 0, 0};
-  void On(const lcm::ReceiveBuffer*, const std::string&, const sandbox_msgs::robot_state_t* m) {
-    if (m->input_seq <= 0) return;  // still the spawn pose
+  long long received{0};
+
+  void OnState(const lcm::ReceiveBuffer* buffer, const std::string&) {
+    sandbox_msgs::robot_state_t m;
+    if (!sandbox::bridge::DecodeChecked(static_cast<const std::uint8_t*>(buffer->data),
+                                        buffer->data_size, &m)
+             .empty() ||
+        m.input_seq <= 0) {  // not a state, or still the spawn pose
+      return;
+    }
     any = true;
-    for (int k = 0; k < 3; ++k) p[k] = m->position[k];
+    for (int k = 0; k < 3; ++k) p[k] = m.position[k];
+    there = there || Error() <= tolerance;
+  }
+  void OnStatus(const lcm::ReceiveBuffer* buffer, const std::string&) {
+    sandbox_msgs::status_t m;
+    if (!sandbox::bridge::DecodeChecked(static_cast<const std::uint8_t*>(buffer->data),
+                                        buffer->data_size, &m)
+             .empty()) {
+      return;
+    }
+    for (int c = 0; c < m.num_channels; ++c) {
+      if (m.channels[std::size_t(c)] == robot + "/POSE") received = m.received[std::size_t(c)];
+    }
+    there = there || received >= want_received;
+  }
+  double Error() const {
+    return std::hypot(p[0] - expected[0], p[1] - expected[1], p[2] - expected[2]);
   }
 };
 
 int main(int argc, char** argv) {
-  if (argc < 6) {
-    std::fprintf(stderr, "usage: state_check ROBOT X Y Z TOLERANCE_M [--seconds S]\n");
+  const bool status = argc >= 4 && !std::strcmp(argv[2], "--received");
+  if (argc < 6 && !status) {
+    std::fprintf(stderr,
+                 "usage: state_check ROBOT X Y Z TOLERANCE_M [--seconds S]\n"
+                 "       state_check ROBOT --received N [--seconds S]\n");
     return 2;
   }
-  const double expected[3] = {std::atof(argv[2]), std::atof(argv[3]), std::atof(argv[4])};
-  const double tolerance = std::atof(argv[5]);
-  const double seconds = argc > 7 && !std::strcmp(argv[6], "--seconds") ? std::atof(argv[7]) : 3.0;
+  Watch watch;
+  watch.robot = argv[1];
+  int next = 6;
+  if (status) {
+    watch.want_received = std::atoll(argv[3]);
+    next = 4;
+  } else {
+    for (int k = 0; k < 3; ++k) watch.expected[k] = std::atof(argv[2 + k]);
+    watch.tolerance = std::atof(argv[5]);
+  }
+  const double seconds =
+      argc > next + 1 && !std::strcmp(argv[next], "--seconds") ? std::atof(argv[next + 1]) : 3.0;
   lcm::LCM lcm("udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304");
-  Last last;
-  lcm.subscribe(std::string(argv[1]) + "/STATE", &Last::On, &last);
+  if (status) {
+    lcm.subscribe(watch.robot + "/STATUS", &Watch::OnStatus, &watch);
+  } else {
+    lcm.subscribe(watch.robot + "/STATE", &Watch::OnState, &watch);
+  }
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (std::chrono::steady_clock::now() < end) lcm.handleTimeout(50);
-  const double error =
-      std::hypot(last.p[0] - expected[0], last.p[1] - expected[1], last.p[2] - expected[2]);
-  std::printf(
-      "state_check: robot at (%.3f, %.3f, %.3f), expected (%.3f, %.3f, %.3f), off by %.4f m\n",
-      last.p[0], last.p[1], last.p[2], expected[0], expected[1], expected[2], error);
-  return last.any && error <= tolerance ? 0 : 1;
+  while (!watch.there && std::chrono::steady_clock::now() < end) lcm.handleTimeout(50);
+  if (status) {
+    std::printf("state_check: %s/POSE %lld received, expected %lld\n", watch.robot.c_str(),
+                watch.received, watch.want_received);
+  } else {
+    std::printf(
+        "state_check: robot at (%.3f, %.3f, %.3f), expected (%.3f, %.3f, %.3f), off by %.4f m\n",
+        watch.p[0], watch.p[1], watch.p[2], watch.expected[0], watch.expected[1],
+        watch.expected[2], watch.Error());
+  }
+  return watch.there ? 0 : 1;
 }
