@@ -31,6 +31,7 @@ struct ClosestHitIgnoring : btCollisionWorld::ClosestRayResultCallback {
 
 CollisionWorld::CollisionWorld(const Level& level) : impl_(std::make_unique<Impl>()) {
   Impl& w = *impl_;
+  w.broadphase.m_deferedcollide = true;  // no overlap search when objects are added
   w.num_actors = static_cast<int>(level.actors.size());
   w.objects_of_body.resize(level.actors.size() + level.robots.size());
   for (std::size_t a = 0; a < level.actors.size(); ++a) {

@@ -59,10 +59,13 @@ struct RobotPiece {
 // object's user index is its body.
 struct CollisionWorld::Impl {
   // Bullet wants a dispatcher to build a collision world; it is never used to
-  // step anything.
+  // step anything. Nothing collides either, so no overlapping pairs are kept:
+  // with Bullet's default pair cache, 4000 actors at one spot made 8 million
+  // pairs, and removing them one by one took 36 s.
   btDefaultCollisionConfiguration configuration;
   btCollisionDispatcher dispatcher{&configuration};
-  btDbvtBroadphase broadphase;
+  btNullPairCache pair_cache;
+  btDbvtBroadphase broadphase{&pair_cache};
   btCollisionWorld world{&dispatcher, &broadphase, &configuration};
   std::vector<MeshObject> objects;
   std::vector<std::vector<int>> objects_of_body;  // indices into `objects`
