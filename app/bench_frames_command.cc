@@ -113,7 +113,7 @@ int RunBenchFrames(const std::vector<std::string>& args, std::ostream& out, std:
     for (const std::string level_name : {"empty", "sample"}) {
       const scene::Level& level = level_name == "empty" ? empty : sample;
       renderer = sensors::MakeRenderer();  // a fresh context per level
-      renderer->SetLevel(level, OpenCvTextureDecoder());
+      renderer->SetLevel(level, OpenCvTextureDecoder(level.limits));
       scene::CollisionWorld world(level);
       for (const std::string work : {"robot", "scanner", "overlay"}) {
         const Case c{level_name, work};

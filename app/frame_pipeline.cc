@@ -102,7 +102,7 @@ void FramePipeline::RenderLoop() {
   std::unique_ptr<sensors::Renderer> renderer;
   try {
     renderer = sensors::MakeRenderer();
-    renderer->SetLevel(level_, OpenCvTextureDecoder());
+    renderer->SetLevel(level_, OpenCvTextureDecoder(level_.limits));
     for (const std::string& warning : renderer->warnings())
       std::cerr << "sandbox: warning: " << warning << "\n";
   } catch (const std::exception& e) {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <mutex>
 #include <opencv2/imgcodecs.hpp>
@@ -9,26 +10,90 @@
 #include <stdexcept>
 #include <vector>
 
+#include "scene/files.h"
+
 namespace sandbox::app {
 
-sensors::TextureDecoder OpenCvTextureDecoder() {
-  return [](const scene::EmbeddedTexture* embedded, const std::string& path,
-            sensors::RgbaImage* image) {
+bool ImageHeaderSize(const std::uint8_t* data, std::size_t size, std::uint32_t* width,
+                     std::uint32_t* height) {
+  auto big_endian = [&](std::size_t at, int n) {
+    std::uint32_t v = 0;
+    for (int i = 0; i < n; ++i) v = v << 8 | data[at + std::size_t(i)];
+    return v;
+  };
+  // PNG: the signature, then IHDR with width and height.
+  if (size >= 24 && std::memcmp(data, "\x89PNG\r\n\x1a\n", 8) == 0) {
+    *width = big_endian(16, 4), *height = big_endian(20, 4);
+    return true;
+  }
+  // JPEG: markers up to a start of frame (SOF0-SOF15 but DHT, JPG, DAC).
+  if (size < 4 || data[0] != 0xff || data[1] != 0xd8) return false;
+  std::size_t at = 2;
+  while (at + 9 <= size) {
+    if (data[at] != 0xff) return false;
+    const std::uint8_t marker = data[at + 1];
+    if (marker == 0xff) {  // fill byte
+      ++at;
+      continue;
+    }
+    if (marker >= 0xc0 && marker <= 0xcf && marker != 0xc4 && marker != 0xc8 && marker != 0xcc) {
+      *height = big_endian(at + 5, 2), *width = big_endian(at + 7, 2);
+      return true;
+    }
+    at += 2 + big_endian(at + 2, 2);
+  }
+  return false;
+}
+
+sensors::TextureDecoder OpenCvTextureDecoder(const scene::LoadLimits& limits) {
+  return [limits](const scene::EmbeddedTexture* embedded, const std::string& path,
+                  sensors::RgbaImage* image) -> std::string {
     cv::Mat decoded;
+    auto too_big = [&](std::uint64_t width, std::uint64_t height) {
+      return width * height > limits.max_texture_pixels
+                 ? std::to_string(width) + " x " + std::to_string(height) +
+                       " pixels, over the limit of " + std::to_string(limits.max_texture_pixels) +
+                       " ([level] max_texture_pixels)"
+                 : std::string();
+    };
     if (embedded != nullptr && embedded->height > 0) {  // raw RGBA texels
+      if (std::string problem = too_big(std::uint64_t(embedded->width), std::uint64_t(embedded->height));
+          !problem.empty()) {
+        return problem;
+      }
       image->width = embedded->width;
       image->height = embedded->height;
       image->rgba = embedded->bytes;
-      return true;
+      return "";
     }
-    if (embedded != nullptr) {
-      const cv::Mat bytes(1, int(embedded->bytes.size()), CV_8U,
-                          const_cast<std::uint8_t*>(embedded->bytes.data()));
-      decoded = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
-    } else {
-      decoded = cv::imread(path, cv::IMREAD_UNCHANGED);
+    std::vector<std::uint8_t> file_bytes;
+    const std::vector<std::uint8_t>* bytes = embedded != nullptr ? &embedded->bytes : nullptr;
+    if (embedded == nullptr) {
+      // Only regular files (a FIFO would block), within the limits.
+      if (std::string problem = scene::RegularFileProblem(path); !problem.empty()) return problem;
+      try {
+        limits.CheckFileSize(path);
+      } catch (const scene::LevelError& error) {
+        return error.what();
+      }
+      file_bytes.resize(scene::FileBytes(path));
+      std::ifstream in(path, std::ios::binary);
+      if (!in.read(reinterpret_cast<char*>(file_bytes.data()), std::streamsize(file_bytes.size()))) {
+        return "cannot be read";
+      }
+      bytes = &file_bytes;
     }
-    if (decoded.empty()) return false;
+    std::uint32_t width = 0, height = 0;
+    if (ImageHeaderSize(bytes->data(), bytes->size(), &width, &height)) {
+      if (std::string problem = too_big(width, height); !problem.empty()) return problem;
+    }
+    const cv::Mat encoded(1, int(bytes->size()), CV_8U, const_cast<std::uint8_t*>(bytes->data()));
+    try {
+      decoded = cv::imdecode(encoded, cv::IMREAD_UNCHANGED);
+    } catch (const cv::Exception& error) {
+      return std::string("OpenCV cannot decode it: ") + error.what();
+    }
+    if (decoded.empty()) return "OpenCV cannot decode it";
     if (decoded.depth() != CV_8U) decoded.convertTo(decoded, CV_8U, 1.0 / 257.0);
     const int code = decoded.channels() == 1   ? cv::COLOR_GRAY2RGBA
                      : decoded.channels() == 3 ? cv::COLOR_BGR2RGBA
@@ -37,7 +102,7 @@ sensors::TextureDecoder OpenCvTextureDecoder() {
     image->width = decoded.cols;
     image->height = decoded.rows;
     image->rgba.assign(decoded.data, decoded.data + decoded.total() * 4);
-    return true;
+    return "";
   };
 }
 

@@ -1,14 +1,25 @@
 #pragma once
 // Images through OpenCV: texture decoding for the renderer, and frame writing.
 
+#include <cstdint>
 #include <string>
+
+#include "scene/load_limits.h"
 
 #include "sensors/renderer.h"
 
 namespace sandbox::app {
 
 // Decodes embedded (PNG, JPEG, ...) or file textures to RGBA with OpenCV.
-sensors::TextureDecoder OpenCvTextureDecoder();
+// Texture files must be regular files within limits.max_file_mb, and a PNG or
+// JPEG whose header states more than limits.max_texture_pixels is refused
+// before it is decoded (other formats: OpenCV's own limit of 2^30 pixels).
+sensors::TextureDecoder OpenCvTextureDecoder(const scene::LoadLimits& limits = {});
+
+// The width and height a PNG or JPEG states in its header; false for other
+// formats or a header cut short.
+bool ImageHeaderSize(const std::uint8_t* data, std::size_t size, std::uint32_t* width,
+                     std::uint32_t* height);
 
 // Writes a frame's colour; the format follows the file's extension (.jpg,
 // .png, ...). Throws std::runtime_error naming the file when it cannot.

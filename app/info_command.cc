@@ -1,6 +1,8 @@
 #include "app/info_command.h"
 
+#include <cctype>
 #include <chrono>
+#include <filesystem>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -10,6 +12,8 @@
 
 #include "app/command_line.h"
 #include "app/defaults.h"
+#include "app/isolated_load.h"
+#include "app/loaded_level.h"
 #include "app/process_stats.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
@@ -177,9 +181,11 @@ void PrintText(const Level& level, const std::vector<sensors::MountedSensor>& se
 }
 
 const char* kUsage =
-    "usage: sandbox info [LEVEL] [--json] [--up AXIS] [--unit-scale METRES]\n"
+    "usage: sandbox info [LEVEL] [--json] [--up AXIS] [--unit-scale METRES] [--isolate]\n"
     "  LEVEL         a level manifest (.toml) or any scene file assimp reads\n"
-    "                (default: the bundled sample level)\n"
+    "                (default: the bundled sample level); a scene file is first read in a\n"
+    "                separate process, so that a file that crashes assimp is an error\n"
+    "  --isolate     read a manifest's assets that way too\n"
     "  --json        machine-readable output (docs/info-json.md)\n"
     "  --up AXIS     up axis of a scene file that does not say: x, -x, y, -y, z, -z\n"
     "  --unit-scale  metres per unit of a scene file that does not say\n";
@@ -187,7 +193,8 @@ const char* kUsage =
 }  // namespace
 
 int RunInfo(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  const auto parsed = ParseArgs(args, "info", {"--up", "--unit-scale"}, {"--json"}, kUsage, err);
+  const auto parsed =
+      ParseArgs(args, "info", {"--up", "--unit-scale"}, {"--json", "--isolate"}, kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
     out << kUsage;
@@ -215,12 +222,27 @@ int RunInfo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     conversion.unit_scale_m = value;
   }
 
+  // A scene file is someone else's: assimp reads it apart first (a crash
+  // becomes an error). A manifest's own assets are read apart with --isolate.
+  std::string extension = std::filesystem::path(file).extension().string();
+  for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+  const bool isolate = parsed->flags.count("--isolate") > 0 || extension != ".toml";
+  if (isolate) {
+    try {
+      CheckLoadsInIsolation(file, conversion);
+    } catch (const scene::LevelError& error) {
+      err << "sandbox info: " << error.what() << "\n";
+      return 1;
+    }
+  }
   using Clock = std::chrono::steady_clock;
   try {
     LoadFigures figures;
     const auto start = Clock::now();
-    const Level level = scene::LoadLevel(file, conversion);
-    const std::vector<sensors::MountedSensor> sensors = sensors::MakeRobotSensors(level);
+    // The checks `sandbox run` makes, too: what info accepts, run accepts.
+    const LoadedLevel loaded_level = LoadCheckedLevel(file, conversion);
+    const Level& level = loaded_level.level;
+    const std::vector<sensors::MountedSensor>& sensors = loaded_level.sensors;
     const auto loaded = Clock::now();
     const scene::CollisionWorld world(level);
     const auto built = Clock::now();

@@ -7,6 +7,7 @@
 #include "app/bench_frames_command.h"
 #include "app/demo_command.h"
 #include "app/info_command.h"
+#include "app/isolated_load.h"
 #include "app/pose_command.h"
 #include "app/render_command.h"
 #include "app/run_command.h"
@@ -48,6 +49,8 @@ int main(int argc, char** argv) {
     if (args[0] == "run") return sandbox::app::RunLoop(rest, std::cout, std::cerr);
     if (args[0] == "render") return sandbox::app::RunRender(rest, std::cout, std::cerr);
     if (args[0] == "topics") return sandbox::app::RunTopics(rest, std::cout, std::cerr);
+    // The child of an isolated load (--isolate); not for users.
+    if (args[0] == "__load-level") return sandbox::app::RunLoadLevelChild(rest, std::cout);
   } catch (const std::exception& error) {
     std::cerr << "sandbox " << args[0] << ": " << error.what() << "\n";
     return 1;

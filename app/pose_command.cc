@@ -9,6 +9,7 @@
 
 #include "app/bone_values.h"
 #include "app/command_line.h"
+#include "app/loaded_level.h"
 #include "app/defaults.h"
 #include "scene/level.h"
 #include "scene/robot_state.h"
@@ -22,7 +23,7 @@ using scene::RobotState;
 
 const char* kUsage =
     "usage: sandbox pose [LEVEL] [--robot NAME] [--robot-pose X,Y,Z[,ROLL,PITCH,YAW]]\n"
-    "                    [--bones FILE|LIST] --out MESH.ply\n"
+    "                    [--bones FILE|LIST] [--isolate] --out MESH.ply\n"
     "  LEVEL         a level manifest with [[robot]] tables (default: the sample level)\n"
     "  --robot       which robot (default: the first)\n"
     "  --robot-pose  world position in metres, roll/pitch/yaw in degees (default: spawn pose)\n"
@@ -30,7 +31,8 @@ const char* kUsage =
     "                BONE a name or bone-map index; angles in degrees, quaternions w x y z;\n"
     "                or a file with one entry a line ('#' starts a comment)\n"
     "  --out         the posed mesh (ASCII PLY, world frame); bone frames go to\n"
-    "                MESH.bones.csv beside it\n";
+    "                MESH.bones.csv beside it\n"
+    "  --isolate     read the level in a separate process first (a crash of assimp is an error)\n";
 
 void WritePly(const fs::path& file, const RobotState& state) {
   const RobotModel& model = state.model();
@@ -86,7 +88,8 @@ void WriteBoneFrames(const fs::path& file, const RobotState& state) {
 
 int RunPose(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   const auto parsed =
-      ParseArgs(args, "pose", {"--robot", "--robot-pose", "--bones", "--out"}, {}, kUsage, err);
+      ParseArgs(args, "pose", {"--robot", "--robot-pose", "--bones", "--out"}, {"--isolate"}, kUsage,
+                err);
   if (!parsed) return 2;
   if (parsed->help) {
     out << kUsage;
@@ -101,7 +104,8 @@ int RunPose(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     return 2;
   }
   try {
-    const scene::Level level = scene::LoadLevel(level_file);
+    const LoadedLevel loaded = LoadCheckedLevel(level_file, {}, parsed->flags.count("--isolate") > 0);
+    const scene::Level& level = loaded.level;
     if (level.robots.empty()) throw CommandError(level_file + ": the level declares no [[robot]]");
     const int robot = robot_name.empty() ? 0 : level.FindRobot(robot_name);
     if (robot < 0) throw UsageError("the level has no robot '" + robot_name + "'");

@@ -7,6 +7,7 @@
 
 #include "app/bone_values.h"
 #include "app/command_line.h"
+#include "app/loaded_level.h"
 #include "app/defaults.h"
 #include "app/images.h"
 #include "scene/collision_world.h"
@@ -21,7 +22,7 @@ namespace {
 const char* kUsage =
     "usage: sandbox render [LEVEL] --camera chase|trailing|payload|fixed --at X,Y,Z[,R,P,Y]\n"
     "                      [--robot NAME] [--bones LIST] [--width W] [--height H] [--fov DEG]\n"
-    "                      [--overlay] [--stub M] --out FILE.jpg|.png\n"
+    "                      [--overlay] [--stub M] [--isolate] --out FILE.jpg|.png\n"
     "  --camera  chase: the spring arm behind the robot; trailing: 25 m behind, 8 m up;\n"
     "            payload: on the robot, looking forward (also writes FILE_depth.png, 16-bit\n"
     "            millimetres); fixed: the camera itself at --at\n"
@@ -33,7 +34,8 @@ const char* kUsage =
     "  --overlay the debug overlay: the robot's face scanners (or a default one, 1 m over\n"
     "            25 m) scanned in full at the pose, occupied samples red and free green,\n"
     "            bone frames and movable actors' bounds\n"
-    "  --stub    draw samples as stubs of M metres along their rays instead of points\n";
+    "  --stub    draw samples as stubs of M metres along their rays instead of points\n"
+    "  --isolate read the level in a separate process first (a crash of assimp is an error)\n";
 
 // The overlay at one robot state: its face scanners scanned in full.
 void BuildOverlay(const scene::Level& level, int robot_index, const scene::RobotState* robot,
@@ -70,7 +72,7 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
   const auto parsed = ParseArgs(
       args, "render",
       {"--camera", "--at", "--robot", "--bones", "--width", "--height", "--fov", "--out", "--stub"},
-      {"--overlay"}, kUsage, err);
+      {"--overlay", "--isolate"}, kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
     out << kUsage;
@@ -98,7 +100,9 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
     view.fov_y_rad =
         (parsed->values.count("--fov") ? ParseNumber(parsed->Value("--fov"), "--fov") : 60.0) *
         M_PI / 180.0;
-    const scene::Level level = scene::LoadLevel(parsed->level.value_or(kDefaultLevel));
+    const LoadedLevel loaded = LoadCheckedLevel(parsed->level.value_or(kDefaultLevel), {},
+                                                parsed->flags.count("--isolate") > 0);
+    const scene::Level& level = loaded.level;
     std::unique_ptr<scene::RobotState> robot;
     int robot_index = -1;
     if (!level.robots.empty()) {
@@ -129,7 +133,7 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
     view.ValidateOrThrow();
     const auto start = std::chrono::steady_clock::now();
     std::unique_ptr<sensors::Renderer> renderer = sensors::MakeRenderer();
-    renderer->SetLevel(level, OpenCvTextureDecoder());
+    renderer->SetLevel(level, OpenCvTextureDecoder(level.limits));
     for (const std::string& warning : renderer->warnings())
       err << "sandbox render: warning: " << warning << "\n";
     sensors::Frame frame;

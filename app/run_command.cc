@@ -14,8 +14,11 @@ namespace {
 const char* kUsage =
     "usage: sandbox run [LEVEL] [--rate HZ|max] [--duration S] [--lcm-url URL] [--lockstep]\n"
     "                   [--replay LOG] [--record LOG] [--out DIR] [--frames LIST] [--depth D]\n"
-    "                   [--scans-every S] [--view] [--realtime auto|off] [--stall TICK:MS,...]\n"
+    "                   [--scans-every S] [--view] [--realtime auto|off] [--isolate]\n"
+    "                   [--stall TICK:MS,...]\n"
     "  LEVEL          a level (default: the bundled sample level)\n"
+    "  --isolate      read the level in a separate process first: a file that crashes assimp\n"
+    "                 is then an error naming it (docs/reliability.md)\n"
     "  --rate         loop rate in Hz (default 100); max: free running, as fast as it can\n"
     "  --duration     stop after this many seconds (default: run until Ctrl-C)\n"
     "  --lcm-url      LCM URL (default: LCM's own; multicast URLs get a 4 MB receive buffer)\n"

@@ -57,7 +57,7 @@ std::map<std::int64_t, double> ParseStalls(const std::string& text) {
 const std::set<std::string> kRunValueOptions = {
     "--rate",   "--duration", "--lcm-url",     "--replay", "--record",  "--out",
     "--frames", "--depth",    "--scans-every", "--stall",  "--realtime"};
-const std::set<std::string> kRunFlags = {"--lockstep", "--view"};
+const std::set<std::string> kRunFlags = {"--lockstep", "--view", "--isolate"};
 
 RunOptions ParseRunOptions(const ParsedArgs& args) {
   RunOptions options;
@@ -99,6 +99,7 @@ RunOptions ParseRunOptions(const ParsedArgs& args) {
     throw UsageError("--scans-every needs --out and a positive number of seconds");
   }
   options.view = args.flags.count("--view") > 0;
+  options.isolate = args.flags.count("--isolate") > 0;
   const std::string realtime = args.Value("--realtime", "auto");
   if (realtime != "auto" && realtime != "off") {
     throw UsageError("--realtime must be auto or off, got '" + realtime + "'");

@@ -28,6 +28,7 @@ struct RunOptions {
   FramePipelineConfig frames;  // image, video and depth formats (out_dir set later)
   double scans_every_s{0.0};   // 0: no scan files
   bool view{false};            // the live view
+  bool isolate{false};         // load the level in a child process first
   bool realtime{true};         // ask for SCHED_FIFO
   std::map<std::int64_t, double> stalls_ms;  // test aid: tick -> extra milliseconds
 

@@ -46,13 +46,6 @@ struct NormalPriorityAtExit {
   }
 };
 
-// The robots' sensors, once their output channels are known not to collide.
-std::vector<sensors::MountedSensor> CheckedSensors(const scene::Level& level) {
-  std::vector<sensors::MountedSensor> mounted = sensors::MakeRobotSensors(level);
-  bridge::CheckOutputChannels(level);
-  return mounted;
-}
-
 // Creates the output folder (and its scans/); returns the statistics file, or "".
 std::string PrepareOutDir(const RunOptions& options) {
   if (options.out_dir.empty()) return "";
@@ -88,9 +81,7 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
       hooks_(std::move(hooks)),
       out_(out),
       err_(err),
-      level_(scene::LoadLevel(options.level)),
-      mounted_(CheckedSensors(level_)),
-      cameras_(sensors::MakeRobotCameras(level_)),
+      loaded_(LoadCheckedLevel(options.level, {}, options.isolate)),
       world_(level_),
       log_(options.replay() ? std::make_unique<bridge::LogReader>(options.replay_file) : nullptr),
       // A replay feeds its inputs through an in-process link: nothing on the network.
@@ -102,7 +93,7 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
   robots_.resize(level_.robots.size());
   for (std::size_t r = 0; r < level_.robots.size(); ++r) {
     RobotRun& robot = robots_[r];
-    robot.config = bridge::RobotBridgeConfig::FromModel(level_.robots[r]);
+    robot.config = loaded_.bridges[r];
     robot.state = std::make_unique<scene::RobotState>(level_.robots[r]);
     robot.inputs = std::make_unique<bridge::RobotInputs>(link_, level_, int(r), robot.config);
     robot.outputs = std::make_unique<bridge::RobotOutputs>(

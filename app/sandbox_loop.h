@@ -20,6 +20,7 @@
 
 #include "app/frame_pipeline.h"
 #include "app/live_view.h"
+#include "app/loaded_level.h"
 #include "app/rate_schedule.h"
 #include "app/run_hooks.h"
 #include "app/run_options.h"
@@ -109,9 +110,10 @@ class SandboxLoop {
   const RunHooks hooks_;
   std::ostream& out_;
   std::ostream& err_;
-  const scene::Level level_;
-  const std::vector<sensors::MountedSensor> mounted_;
-  const std::vector<sensors::MountedCamera> cameras_;
+  const LoadedLevel loaded_;
+  const scene::Level& level_{loaded_.level};
+  const std::vector<sensors::MountedSensor>& mounted_{loaded_.sensors};
+  const std::vector<sensors::MountedCamera>& cameras_{loaded_.cameras};
   scene::CollisionWorld world_;
   std::unique_ptr<bridge::LogReader> log_;
   bridge::LcmLink link_;

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "app/command_line.h"
+#include "app/loaded_level.h"
 #include "app/defaults.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
@@ -22,8 +23,9 @@ namespace {
 const char* kUsage =
     "usage: sandbox scan [LEVEL] --at X,Y,Z[,ROLL,PITCH,YAW] [--sensor face|ground|lidar|ray]\n"
     "                    [--resolution R] [--half-extent E] [--aligned body|world]\n"
-    "                    [--see-robots] --out FILE.csv|FILE.ply\n"
+    "                    [--see-robots] [--isolate] --out FILE.csv|FILE.ply\n"
     "  LEVEL          a level (default: the bundled sample level)\n"
+    "  --isolate      read the level in a separate process first (a crash of assimp is an error)\n"
     "  --at           sensor pose: metres, roll/pitch/yaw in degrees\n"
     "  --sensor       face (default): the six-face scanner, all faces; ground: height map\n"
     "                 below; lidar: 16 x 1024 beams, -15..15 degrees, 100 m; ray: one ray down\n"
@@ -81,7 +83,7 @@ double Positive(const std::string& text, const std::string& option) {
 int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   const auto parsed = ParseArgs(
       args, "scan", {"--at", "--sensor", "--resolution", "--half-extent", "--aligned", "--out"},
-      {"--see-robots"}, kUsage, err);
+      {"--see-robots", "--isolate"}, kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
     out << kUsage;
@@ -111,7 +113,8 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     const double res = resolution.empty() ? 1.0 : Positive(resolution, "--resolution");
     const double extent = half_extent.empty() ? 25.0 : Positive(half_extent, "--half-extent");
 
-    const scene::Level level = scene::LoadLevel(level_file);
+    const LoadedLevel loaded = LoadCheckedLevel(level_file, {}, parsed->flags.count("--isolate") > 0);
+    const scene::Level& level = loaded.level;
     const scene::CollisionWorld world(level);
     sensors::RayCaster caster;
     sensors::RayFilter filter;

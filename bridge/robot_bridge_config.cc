@@ -1,5 +1,11 @@
 #include "bridge/robot_bridge_config.h"
 
+#include <arpa/inet.h>
+
+#include <set>
+
+#include "bridge/outputs.h"
+
 namespace sandbox::bridge {
 namespace {
 
@@ -34,6 +40,11 @@ RobotBridgeConfig RobotBridgeConfig::FromModel(const scene::RobotModel& model) {
   if (!(config.stale_after_s > 0.0)) read.Fail("stale_after_s", "'stale_after_s' must be positive");
   config.state_in_pose_convention = read.Flag("state_in_pose_convention", false);
   config.bind_address = read.Text("bind_address", config.bind_address);
+  in_addr address{};
+  if (inet_pton(AF_INET, config.bind_address.c_str(), &address) != 1) {
+    read.Fail("bind_address", "'bind_address' must be an IPv4 address like 127.0.0.1, got '" +
+                                  config.bind_address + "'");
+  }
   auto port = [&](const std::string& key) {
     const int value = read.Whole(key, 0);
     if (value < 0 || value > 65535) read.Fail(key, "'" + key + "' must be a port, 0 to 65535");
@@ -41,6 +52,10 @@ RobotBridgeConfig RobotBridgeConfig::FromModel(const scene::RobotModel& model) {
   };
   config.net_fdm_port = port("net_fdm_port");
   config.udp_doubles_port = port("udp_doubles_port");
+  if (config.net_fdm_port > 0 && config.net_fdm_port == config.udp_doubles_port) {
+    read.Fail("udp_doubles_port", "'udp_doubles_port' and 'net_fdm_port' are both " +
+                                      std::to_string(config.net_fdm_port));
+  }
   config.net_fdm_max_deflection_rad =
       read.Number("net_fdm_max_deflection_deg", 25.0) * M_PI / 180.0;
   for (const char* surface : kSurfaces) {
@@ -57,17 +72,52 @@ RobotBridgeConfig RobotBridgeConfig::FromModel(const scene::RobotModel& model) {
   }
   if (read.Has("udp_doubles_layout")) {
     config.udp_doubles_layout = read.Texts("udp_doubles_layout");
+    std::set<std::string> seen;
     for (const std::string& item : config.udp_doubles_layout) {
       if (item != "position" && item != "quaternion" && item != "rpy" && item != "bones") {
         read.Fail("udp_doubles_layout",
                   "'udp_doubles_layout' items are position, quaternion, rpy and bones, got '" +
                       item + "'");
       }
+      if (!seen.insert(item).second) {
+        read.Fail("udp_doubles_layout", "'udp_doubles_layout' names '" + item + "' twice");
+      }
+    }
+    if (seen.count("quaternion") && seen.count("rpy")) {
+      read.Fail("udp_doubles_layout", "'udp_doubles_layout' takes quaternion or rpy, not both");
+    }
+    if (config.udp_doubles_layout.empty()) {
+      read.Fail("udp_doubles_layout", "'udp_doubles_layout' must name at least one item");
     }
   }
   config.udp_doubles_big_endian = read.Flag("udp_doubles_big_endian", false);
   read.RejectUnknownKeys("robot bridge");
   return config;
+}
+
+std::vector<RobotBridgeConfig> RobotBridgeConfigs(const scene::Level& level) {
+  std::vector<RobotBridgeConfig> configs;
+  std::map<std::string, std::string> prefixes;  // prefix -> robot
+  std::map<int, std::string> ports;             // UDP port -> robot
+  for (const scene::RobotModel& model : level.robots) {
+    RobotBridgeConfig config = RobotBridgeConfig::FromModel(model);
+    const scene::SettingsReader read(model.bridge);
+    if (const auto [it, fresh] = prefixes.emplace(config.channel_prefix, model.name); !fresh) {
+      read.Fail("channel_prefix", "robot '" + model.name + "' would use the channel prefix '" +
+                                      config.channel_prefix + "' of robot '" + it->second +
+                                      "'; give one of them its own 'channel_prefix'");
+    }
+    for (const auto& [key, value] : {std::pair<const char*, int>{"net_fdm_port", config.net_fdm_port},
+                                     {"udp_doubles_port", config.udp_doubles_port}}) {
+      if (value == 0) continue;
+      if (const auto [it, fresh] = ports.emplace(value, model.name); !fresh) {
+        read.Fail(key, "port " + std::to_string(value) + " is taken by robot '" + it->second + "'");
+      }
+    }
+    configs.push_back(std::move(config));
+  }
+  CheckOutputChannels(level);
+  return configs;
 }
 
 }  // namespace sandbox::bridge

@@ -42,8 +42,15 @@ struct RobotBridgeConfig {
 
   // Reads the robot's [robot.bridge] settings. Throws scene::LevelError naming
   // the manifest, line and key: an unknown key or convention, a port out of
-  // range, a surface bone that is not in the bone map or has no angle.
+  // range, a bind address that is no IPv4 address, a surface bone that is not
+  // in the bone map or has no angle, a UDP layout that repeats or mixes items.
   static RobotBridgeConfig FromModel(const scene::RobotModel& model);
 };
+
+// Every robot's bridge settings, checked together as `sandbox run` needs
+// them: each robot's own, no two robots on one channel prefix, no UDP port
+// taken twice, no two sensors of a robot on one channel
+// (CheckOutputChannels). Throws scene::LevelError naming both sides.
+std::vector<RobotBridgeConfig> RobotBridgeConfigs(const scene::Level& level);
 
 }  // namespace sandbox::bridge

@@ -8,11 +8,26 @@
 #include <algorithm>
 #include <assimp/Importer.hpp>
 #include <cctype>
+#include <cstring>
 #include <fstream>
 #include <map>
+#include <stdexcept>
 
 #include "scene/assimp_read.h"
+#include "scene/files.h"
 #include "scene/heightmap.h"
+
+// assimp's internal checks (ai_assert; Debian builds assimp with them on)
+// call this and abort the process. Defined here, it takes the place of
+// assimp's own for the whole program: the failed check becomes an exception,
+// which assimp's importers and post-processing steps catch and turn into a
+// failed import (ReadFile and ApplyPostProcessing return null with this text).
+namespace Assimp {
+void aiAssertViolation(const char* expression, const char* file, int line) {
+  throw std::runtime_error(std::string("assimp's check '") + expression + "' failed (" + file +
+                           ":" + std::to_string(line) + ")");
+}
+}  // namespace Assimp
 
 namespace sandbox::scene {
 namespace {
@@ -96,10 +111,11 @@ Eigen::Matrix4d ToEigen(const aiMatrix4x4& m) {
 
 namespace {
 
-// Drops faces whose vertex indices are out of range (a safety net: the Quake 3
-// faces, where assimp 5.2.5 left such indices, are rebuilt before this). Runs
-// before any post-processing step reads the indices. Returns how many faces
-// were dropped.
+// Drops faces whose vertex indices are out of range, and faces without any
+// (a binary PLY can say 0; assimp's triangulation then fails its own check).
+// A safety net: the Quake 3 faces, where assimp 5.2.5 left such indices, are
+// rebuilt before this. Runs before any post-processing step reads the
+// indices. Returns how many faces were dropped.
 std::size_t DropFacesWithBadIndices(const aiScene& scene) {
   std::size_t dropped = 0;
   for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
@@ -107,7 +123,8 @@ std::size_t DropFacesWithBadIndices(const aiScene& scene) {
     unsigned kept = 0;
     for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
       aiFace& face = mesh->mFaces[f];
-      const bool good = std::all_of(face.mIndices, face.mIndices + face.mNumIndices,
+      const bool good = face.mNumIndices > 0 && face.mIndices != nullptr &&
+                        std::all_of(face.mIndices, face.mIndices + face.mNumIndices,
                                     [&](unsigned i) { return i < mesh->mNumVertices; });
       if (!good) {
         ++dropped;
@@ -120,7 +137,18 @@ std::size_t DropFacesWithBadIndices(const aiScene& scene) {
       }
       ++kept;
     }
+    if (kept == mesh->mNumFaces) continue;
     mesh->mNumFaces = kept;
+    // The primitive types the importer set may name the dropped faces (the
+    // triangulation step trusts them and fails its check otherwise).
+    mesh->mPrimitiveTypes = 0;
+    for (unsigned f = 0; f < kept; ++f) {
+      const unsigned n = mesh->mFaces[f].mNumIndices;
+      mesh->mPrimitiveTypes |= n == 1   ? aiPrimitiveType_POINT
+                               : n == 2 ? aiPrimitiveType_LINE
+                               : n == 3 ? aiPrimitiveType_TRIANGLE
+                                        : aiPrimitiveType_POLYGON;
+    }
   }
   return dropped;
 }
@@ -190,7 +218,15 @@ Material ConvertMaterial(const aiScene& scene, const aiMaterial& in, const fs::p
   return out;
 }
 
-EmbeddedTexture ConvertTexture(const aiTexture& in) {
+EmbeddedTexture ConvertTexture(const aiTexture& in, const fs::path& file,
+                               const LoadLimits& limits) {
+  if (in.mHeight > 0) {
+    LoadLimits::Check(file,
+                      "an embedded texture of " + std::to_string(in.mWidth) + " x " +
+                          std::to_string(in.mHeight) + " pixels",
+                      std::uint64_t{in.mWidth} * in.mHeight, limits.max_texture_pixels,
+                      "max_texture_pixels");
+  }
   EmbeddedTexture out;
   out.format_hint = in.achFormatHint;
   if (in.mHeight == 0) {
@@ -300,15 +336,44 @@ class NodeCollector {
 
 }  // namespace
 
-void CheckReadable(const fs::path& file) {
-  std::error_code error;
-  if (!fs::exists(file, error)) throw LevelError(file.string() + ": no such file");
-  if (fs::is_directory(file, error)) throw LevelError(file.string() + ": is a folder, not a file");
+namespace {
+
+std::uint32_t LittleEndian32(const unsigned char* p) {
+  return std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 |
+         std::uint32_t(p[3]) << 24;
+}
+
+// A binary glTF must be what its header says: assimp allocates the lengths it
+// reads there before it reads the chunks. Header: "glTF", version, total
+// length; then chunks of (length, type, data), the first JSON.
+void CheckGlbHeader(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
-  if (!in || in.peek() == std::ifstream::traits_type::eof()) {
-    throw LevelError(file.string() + (in ? ": file is empty" : ": cannot be read"));
+  unsigned char header[12] = {};
+  in.read(reinterpret_cast<char*>(header), sizeof(header));
+  const std::uint64_t size = FileBytes(file);
+  if (in.gcount() < 12 || std::memcmp(header, "glTF", 4) != 0) {
+    throw LevelError(file.string() + ": not a binary glTF (no 12-byte 'glTF' header)");
+  }
+  if (LittleEndian32(header + 8) != size) {
+    throw LevelError(file.string() + ": its header says " + std::to_string(LittleEndian32(header + 8)) +
+                     " bytes, the file has " + std::to_string(size));
+  }
+  // Every chunk within the file.
+  std::uint64_t at = 12;
+  while (at + 8 <= size) {
+    unsigned char chunk[8];
+    in.seekg(std::streamoff(at));
+    if (!in.read(reinterpret_cast<char*>(chunk), 8)) break;
+    const std::uint64_t length = LittleEndian32(chunk);
+    if (at + 8 + length > size) {
+      throw LevelError(file.string() + ": a chunk at byte " + std::to_string(at) + " says " +
+                       std::to_string(length) + " bytes, past the end of the file");
+    }
+    at += 8 + length;
   }
 }
+
+}  // namespace
 
 std::string LowerExtension(const fs::path& file) {
   std::string ext = file.extension().string();
@@ -335,7 +400,9 @@ void TransformMesh(const Eigen::Affine3d& T, Mesh* mesh) {
 }
 
 AssimpScene ReadAssimpScene(Assimp::Importer& importer, const fs::path& file,
-                            const AssetConversion& conversion) {
+                            const AssetConversion& conversion, const LoadLimits& limits) {
+  CheckReadable(file, limits);
+  if (LowerExtension(file) == ".glb") CheckGlbHeader(file);
   if (!importer.IsExtensionSupported(LowerExtension(file))) {
     throw LevelError(file.string() + ": unsupported format '" + LowerExtension(file) +
                      "' (not a format assimp reads)");
@@ -358,7 +425,7 @@ AssimpScene ReadAssimpScene(Assimp::Importer& importer, const fs::path& file,
   }
   if (const std::size_t dropped = DropFacesWithBadIndices(*scene); dropped > 0) {
     out.warnings.push_back(file.string() + ": dropped " + std::to_string(dropped) +
-                           " faces with out-of-range vertex indices");
+                           " faces with no or out-of-range vertex indices");
   }
   scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_GenSmoothNormals);
   if (scene == nullptr || scene->mRootNode == nullptr) {
@@ -399,21 +466,22 @@ AssimpScene ReadAssimpScene(Assimp::Importer& importer, const fs::path& file,
     out.materials.push_back(ConvertMaterial(*scene, *scene->mMaterials[m], folder));
   }
   for (unsigned t = 0; t < scene->mNumTextures; ++t) {
-    out.textures.push_back(ConvertTexture(*scene->mTextures[t]));
+    out.textures.push_back(ConvertTexture(*scene->mTextures[t], file, limits));
   }
   return out;
 }
 
-ImportedAsset ImportAsset(const fs::path& file, const AssetConversion& conversion) {
-  CheckReadable(file);
-  if (FormatOf(file) == Format::kTerragen) return ImportTerragen(file, conversion);
+ImportedAsset ImportAsset(const fs::path& file, const AssetConversion& conversion,
+                          const LoadLimits& limits) {
+  CheckReadable(file, limits);
+  if (FormatOf(file) == Format::kTerragen) return ImportTerragen(file, conversion, limits);
   if (LowerExtension(file) == ".png" || LowerExtension(file) == ".pgm") {
     throw LevelError(file.string() +
                      ": a heightmap image needs a size; place it in a level manifest with "
                      "heightmap = \"...\" and size = [x, y, z]");
   }
   Assimp::Importer importer;
-  AssimpScene read = ReadAssimpScene(importer, file, conversion);
+  AssimpScene read = ReadAssimpScene(importer, file, conversion, limits);
   ImportedAsset asset;
   asset.up = read.up;
   asset.unit_scale_m = read.unit_scale_m;

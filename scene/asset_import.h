@@ -30,9 +30,12 @@ struct ImportedAsset {
 };
 
 // Reads a scene file with assimp (or a Terragen .ter terrain natively).
-// Throws LevelError naming the file when it is missing, unreadable, of an
-// unsupported format or has no triangles.
-ImportedAsset ImportAsset(const std::filesystem::path& file, const AssetConversion& conversion);
+// Throws LevelError naming the file when it is missing, not a regular file,
+// unreadable, over a limit, of an unsupported format or has no triangles.
+// assimp's own checks (ai_assert) fail the import rather than the process;
+// crashes inside assimp need an isolated import (app/isolated_load.h).
+ImportedAsset ImportAsset(const std::filesystem::path& file, const AssetConversion& conversion,
+                          const LoadLimits& limits = {});
 
 // Appends materials and textures to the level, renumbering the materials'
 // texture references; returns the index the first material got.

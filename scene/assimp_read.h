@@ -26,14 +26,13 @@ struct AssimpScene {
 };
 
 // Reads `file` without validation, rebuilds Quake 3 faces (assimp 5.2.5
-// leaves their indices wrong), drops faces with out-of-range indices (one
-// warning each), triangulates and adds smooth normals where missing. Throws
-// LevelError for an unsupported or unreadable file.
+// leaves their indices wrong), drops faces with out-of-range indices or none
+// (one warning each), triangulates and adds smooth normals where missing.
+// Throws LevelError for an unsupported or unreadable file, a GLB whose
+// header does not match the file, or an embedded texture over the limits.
 AssimpScene ReadAssimpScene(Assimp::Importer& importer, const std::filesystem::path& file,
-                            const AssetConversion& conversion);
+                            const AssetConversion& conversion, const LoadLimits& limits);
 
-// Throws LevelError when `file` is missing, a folder, empty or unreadable.
-void CheckReadable(const std::filesystem::path& file);
 
 // The triangles of `mesh`; counts skipped points and lines in `non_triangles`.
 Mesh ConvertMesh(const aiMesh& mesh, std::size_t* non_triangles);

@@ -6,6 +6,8 @@
 #include <cerrno>
 #include <cstring>
 
+#include "scene/placement.h"
+
 namespace sandbox::scene {
 
 std::string RegularFileProblem(const std::filesystem::path& file) {
@@ -26,6 +28,14 @@ std::uint64_t FileBytes(const std::filesystem::path& file) {
   struct stat info {};
   if (::stat(file.c_str(), &info) != 0 || !S_ISREG(info.st_mode)) return 0;
   return std::uint64_t(info.st_size);
+}
+
+void CheckReadable(const std::filesystem::path& file, const LoadLimits& limits) {
+  if (const std::string problem = RegularFileProblem(file); !problem.empty()) {
+    throw LevelError(file.string() + ": " + problem);
+  }
+  if (FileBytes(file) == 0) throw LevelError(file.string() + ": file is empty");
+  limits.CheckFileSize(file);
 }
 
 }  // namespace sandbox::scene

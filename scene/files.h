@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <string>
 
+#include "scene/load_limits.h"
+
 namespace sandbox::scene {
 
 // Why `file` cannot be read as a regular file ("no such file", "is a FIFO,
@@ -15,5 +17,9 @@ std::string RegularFileProblem(const std::filesystem::path& file);
 
 // The size of a regular file in bytes (0 when it cannot be told).
 std::uint64_t FileBytes(const std::filesystem::path& file);
+
+// Before a level's file is opened: throws LevelError naming it when it is
+// missing, not a regular file, empty, unreadable or over limits.max_file_mb.
+void CheckReadable(const std::filesystem::path& file, const LoadLimits& limits);
 
 }  // namespace sandbox::scene

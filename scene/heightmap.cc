@@ -9,15 +9,27 @@
 #include <memory>
 #include <string>
 
+#include "scene/files.h"
+
 namespace sandbox::scene {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::vector<std::uint8_t> ReadAll(const fs::path& file) {
+// The whole file, once it is known to be a regular file within the limits.
+std::vector<std::uint8_t> ReadAll(const fs::path& file, const LoadLimits& limits) {
+  CheckReadable(file, limits);
   std::ifstream in(file, std::ios::binary);
   if (!in) throw LevelError(file.string() + ": cannot be read");
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void CheckSamples(const fs::path& file, std::uint64_t cols, std::uint64_t rows,
+                  const LoadLimits& limits) {
+  LoadLimits::Check(file,
+                    "a grid of " + std::to_string(cols) + " x " + std::to_string(rows) +
+                        " samples",
+                    cols * rows, limits.max_heightmap_samples, "max_heightmap_samples");
 }
 
 ImportedAsset AssetFromGrid(const fs::path& file, const HeightGrid& grid) {
@@ -34,8 +46,8 @@ ImportedAsset AssetFromGrid(const fs::path& file, const HeightGrid& grid) {
 // baseheight, then the int16 grid), "EOF ".
 class TerragenReader {
  public:
-  TerragenReader(const fs::path& file, std::vector<std::uint8_t> bytes)
-      : file_(file), bytes_(std::move(bytes)) {}
+  TerragenReader(const fs::path& file, std::vector<std::uint8_t> bytes, const LoadLimits& limits)
+      : file_(file), bytes_(std::move(bytes)), limits_(limits) {}
 
   HeightGrid Read() {
     if (bytes_.size() < 16 || std::memcmp(bytes_.data(), "TERRAGENTERRAIN ", 16) != 0) {
@@ -77,6 +89,7 @@ class TerragenReader {
   HeightGrid ReadHeights(int xpts, int ypts, const Eigen::Vector3d& scale_m) {
     if (xpts < 2 || ypts < 2)
       Fail("grid of " + std::to_string(xpts) + " x " + std::to_string(ypts) + " points");
+    CheckSamples(file_, std::uint64_t(xpts), std::uint64_t(ypts), limits_);
     const double height_scale = Int16();
     const double base_height = Int16();
     const std::size_t count = std::size_t(xpts) * std::size_t(ypts);
@@ -121,12 +134,13 @@ class TerragenReader {
 
   fs::path file_;
   std::vector<std::uint8_t> bytes_;
+  const LoadLimits& limits_;
   std::size_t at_{0};
 };
 
 // Binary PGM ("P5"), 8 or 16 bit (big-endian). Heights in [0, 1].
-std::vector<float> ReadPgm(const fs::path& file, int* cols, int* rows) {
-  const std::vector<std::uint8_t> bytes = ReadAll(file);
+std::vector<float> ReadPgm(const fs::path& file, int* cols, int* rows, const LoadLimits& limits) {
+  const std::vector<std::uint8_t> bytes = ReadAll(file, limits);
   std::size_t at = 0;
   auto token = [&]() {
     while (at < bytes.size() && (std::isspace(bytes[at]) || bytes[at] == '#')) {
@@ -141,13 +155,24 @@ std::vector<float> ReadPgm(const fs::path& file, int* cols, int* rows) {
     return out;
   };
   if (token() != "P5") throw LevelError(file.string() + ": not a binary PGM (P5) image");
-  *cols = std::atoi(token().c_str());
-  *rows = std::atoi(token().c_str());
-  const int max_value = std::atoi(token().c_str());
+  // Header numbers: at most 6 digits each (a PGM is at most 65535 wide, its
+  // values at most 65535).
+  auto number = [&](const char* what) {
+    const std::string text = token();
+    if (text.empty() || text.size() > 6 || text.find_first_not_of("0123456789") != std::string::npos) {
+      throw LevelError(file.string() + ": PGM header: " + what + " '" + text.substr(0, 16) +
+                       "' is not a number up to 999999");
+    }
+    return std::stoi(text);
+  };
+  *cols = number("width");
+  *rows = number("height");
+  const int max_value = number("maximum value");
   ++at;  // the single white space before the data
+  CheckSamples(file, std::uint64_t(*cols), std::uint64_t(*rows), limits);
   const int depth = max_value > 255 ? 2 : 1;
-  const std::size_t count = std::size_t(std::max(*cols, 0)) * std::size_t(std::max(*rows, 0));
-  if (max_value <= 0 || count == 0 || at + count * depth > bytes.size()) {
+  const std::size_t count = std::size_t(*cols) * std::size_t(*rows);
+  if (max_value <= 0 || max_value > 65535 || count == 0 || at + count * depth > bytes.size()) {
     throw LevelError(file.string() + ": PGM header or data is broken");
   }
   std::vector<float> values(count);
@@ -160,12 +185,20 @@ std::vector<float> ReadPgm(const fs::path& file, int* cols, int* rows) {
 }
 
 // PNG of any colour type, reduced to its first channel. Heights in [0, 1].
-std::vector<float> ReadPng(const fs::path& file, int* cols, int* rows) {
+std::vector<float> ReadPng(const fs::path& file, int* cols, int* rows, const LoadLimits& limits) {
+  CheckReadable(file, limits);
   png_image image;
   std::memset(&image, 0, sizeof(image));
   image.version = PNG_IMAGE_VERSION;
   if (!png_image_begin_read_from_file(&image, file.string().c_str())) {
     throw LevelError(file.string() + ": cannot read PNG: " + image.message);
+  }
+  // The size its header states, before anything that size is allocated.
+  try {
+    CheckSamples(file, image.width, image.height, limits);
+  } catch (const LevelError&) {
+    png_image_free(&image);
+    throw;
   }
   image.format = PNG_FORMAT_LINEAR_Y;  // 16-bit grey, linear
   std::vector<std::uint16_t> pixels(PNG_IMAGE_SIZE(image) / 2);
@@ -225,8 +258,9 @@ Mesh MeshFromHeightGrid(const HeightGrid& grid) {
   return mesh;
 }
 
-ImportedAsset ImportTerragen(const fs::path& file, const AssetConversion& conversion) {
-  HeightGrid grid = TerragenReader(file, ReadAll(file)).Read();
+ImportedAsset ImportTerragen(const fs::path& file, const AssetConversion& conversion,
+                             const LoadLimits& limits) {
+  HeightGrid grid = TerragenReader(file, ReadAll(file, limits), limits).Read();
   ImportedAsset asset = AssetFromGrid(file, grid);
   asset.up = conversion.up.value_or(UpAxis::kPosZ);
   asset.unit_scale_m = conversion.unit_scale_m.value_or(1.0);
@@ -234,14 +268,15 @@ ImportedAsset ImportTerragen(const fs::path& file, const AssetConversion& conver
   return asset;
 }
 
-ImportedAsset ImportHeightmapImage(const fs::path& file, const Eigen::Vector3d& size_m) {
+ImportedAsset ImportHeightmapImage(const fs::path& file, const Eigen::Vector3d& size_m,
+                                   const LoadLimits& limits) {
   const std::string ext = LowerExtension(file);
   int cols = 0, rows = 0;
   std::vector<float> values;
   if (ext == ".pgm") {
-    values = ReadPgm(file, &cols, &rows);
+    values = ReadPgm(file, &cols, &rows, limits);
   } else if (ext == ".png") {
-    values = ReadPng(file, &cols, &rows);
+    values = ReadPng(file, &cols, &rows, limits);
   } else {
     throw LevelError(file.string() + ": a heightmap must be a .png or .pgm image");
   }

@@ -26,12 +26,16 @@ struct HeightGrid {
 Mesh MeshFromHeightGrid(const HeightGrid& grid);
 
 // A Terragen terrain: its own SCAL spacing and ALTW heights, corner at the
-// origin. `conversion.unit_scale_m` scales the whole terrain.
-ImportedAsset ImportTerragen(const std::filesystem::path& file, const AssetConversion& conversion);
+// origin. `conversion.unit_scale_m` scales the whole terrain. Grids over
+// limits.max_heightmap_samples are refused before anything is allocated.
+ImportedAsset ImportTerragen(const std::filesystem::path& file, const AssetConversion& conversion,
+                             const LoadLimits& limits = {});
 
 // A heightmap image centred on the origin: `size_m` = (x extent, y extent,
-// height of the brightest value). The first channel is the height.
+// height of the brightest value). The first channel is the height. The size
+// the image header states is checked against limits.max_heightmap_samples
+// before the image is decoded.
 ImportedAsset ImportHeightmapImage(const std::filesystem::path& file,
-                                   const Eigen::Vector3d& size_m);
+                                   const Eigen::Vector3d& size_m, const LoadLimits& limits = {});
 
 }  // namespace sandbox::scene

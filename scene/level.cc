@@ -1,8 +1,11 @@
 #include "scene/level.h"
 
+#include <map>
 #include <numeric>
+#include <sstream>
 
 #include "scene/asset_import.h"
+#include "scene/files.h"
 #include "scene/heightmap.h"
 #include "scene/manifest.h"
 
@@ -33,13 +36,41 @@ void AdoptMaterialsAndWarnings(ImportedAsset* asset, Level* level) {
   for (std::string& warning : asset->warnings) level->warnings.push_back(std::move(warning));
 }
 
+// The level's triangles so far against its limit.
+void CheckTriangles(const fs::path& file, const Level& level) {
+  std::size_t triangles = level.num_triangles();
+  for (const RobotModel& robot : level.robots) triangles += robot.num_triangles();
+  LoadLimits::Check(file, "the level has " + std::to_string(triangles) + " triangles", triangles,
+                    level.limits.max_triangles, "max_triangles");
+}
+
+void Reading(const LoadOptions& options, const fs::path& file) {
+  if (options.on_file) options.on_file(file);
+}
+
+// What makes two [[actor]] tables read the same: the file and how it is read.
+std::string AssetKey(const ActorSpec& spec) {
+  std::ostringstream key;
+  key.precision(17);
+  key << spec.file.string() << '\n';
+  if (spec.is_heightmap) {
+    key << "heightmap " << spec.heightmap_size_m.transpose();
+  } else {
+    const AssetConversion& c = spec.placement.conversion;
+    key << (c.up ? ToString(*c.up) : "-") << ' ' << c.unit_scale_m.value_or(0.0);
+  }
+  return key.str();
+}
+
 // A scene file as a level: one actor per node with meshes, posed at the
 // node's rigid transform.
-Level LoadSceneFile(const fs::path& file, const AssetConversion& conversion) {
-  ImportedAsset asset = ImportAsset(file, conversion);
+Level LoadSceneFile(const fs::path& file, const LoadOptions& options) {
+  Reading(options, file);
+  ImportedAsset asset = ImportAsset(file, options.conversion, options.limits);
   Level level;
   level.file = file;
   level.name = file.stem().string();
+  level.limits = options.limits;
   AdoptMaterialsAndWarnings(&asset, &level);
   for (ImportedNode& node : asset.nodes) {
     Actor actor;
@@ -58,38 +89,52 @@ Level LoadSceneFile(const fs::path& file, const AssetConversion& conversion) {
 
 // A manifest as a level: one actor per [[actor]], all of its asset's nodes
 // merged into it, scaled in the asset root frame and then placed.
-Level LoadManifest(const fs::path& file) {
+Level LoadManifest(const fs::path& file, const LoadOptions& options) {
+  Reading(options, file);
   const LevelManifest manifest = ParseManifest(file);
   Level level;
   level.file = file;
   level.name = manifest.name;
+  level.limits = manifest.limits;
+  // An asset placed many times is read once, and its materials are shared.
+  std::map<std::string, ImportedAsset> read_once;
   for (const ActorSpec& spec : manifest.actors) {
-    ImportedAsset asset;
-    try {
-      asset = spec.is_heightmap ? ImportHeightmapImage(spec.file, spec.heightmap_size_m)
-                                : ImportAsset(spec.file, spec.placement.conversion);
-    } catch (const LevelError& error) {
-      throw LevelError(file.string() + ":" + std::to_string(spec.line) + ": actor '" + spec.name +
-                       "': " + error.what());
+    auto read = read_once.find(AssetKey(spec));
+    if (read == read_once.end()) {
+      ImportedAsset asset;
+      Reading(options, spec.file);
+      try {
+        asset = spec.is_heightmap
+                    ? ImportHeightmapImage(spec.file, spec.heightmap_size_m, level.limits)
+                    : ImportAsset(spec.file, spec.placement.conversion, level.limits);
+      } catch (const LevelError& error) {
+        throw LevelError(file.string() + ":" + std::to_string(spec.line) + ": actor '" +
+                         spec.name + "': " + error.what());
+      }
+      AdoptMaterialsAndWarnings(&asset, &level);
+      read = read_once.emplace(AssetKey(spec), std::move(asset)).first;
     }
-    AdoptMaterialsAndWarnings(&asset, &level);
+    const ImportedAsset& asset = read->second;
     Actor actor;
     actor.name = spec.name;
     actor.source = spec.file.string();
     actor.collision = spec.collision;
     actor.movable = spec.movable;
     actor.X_WA = spec.placement.pose();
-    for (ImportedNode& node : asset.nodes) {
+    for (const ImportedNode& node : asset.nodes) {
       const Eigen::Affine3d X_AN = Eigen::Scaling(spec.placement.scale) * node.X_RN;
-      for (Mesh& mesh : node.meshes) {
-        TransformMesh(X_AN, &mesh);
-        actor.meshes.push_back(std::move(mesh));
+      for (const Mesh& mesh : node.meshes) {
+        actor.meshes.push_back(mesh);
+        TransformMesh(X_AN, &actor.meshes.back());
       }
     }
     level.actors.push_back(std::move(actor));
+    CheckTriangles(spec.file, level);
   }
   for (const RobotSpec& spec : manifest.robots) {
+    Reading(options, spec.file);
     level.robots.push_back(LoadRobotModel(spec, file, &level));
+    CheckTriangles(spec.file, level);
   }
   return level;
 }
@@ -148,12 +193,21 @@ Eigen::AlignedBox3d Level::bounds_W() const {
   return bounds;
 }
 
-Level LoadLevel(const fs::path& file, const AssetConversion& conversion) {
-  if (!fs::exists(file)) throw LevelError(file.string() + ": no such file");
-  Level level =
-      LowerExtension(file) == ".toml" ? LoadManifest(file) : LoadSceneFile(file, conversion);
+Level LoadLevel(const fs::path& file, const LoadOptions& options) {
+  if (const std::string problem = RegularFileProblem(file); !problem.empty()) {
+    throw LevelError(file.string() + ": " + problem);
+  }
+  Level level = LowerExtension(file) == ".toml" ? LoadManifest(file, options)
+                                                : LoadSceneFile(file, options);
+  CheckTriangles(file, level);
   for (Actor& actor : level.actors) ComputeBounds(&actor);
   return level;
+}
+
+Level LoadLevel(const fs::path& file, const AssetConversion& conversion) {
+  LoadOptions options;
+  options.conversion = conversion;
+  return LoadLevel(file, options);
 }
 
 }  // namespace sandbox::scene

@@ -7,12 +7,14 @@
 #include <Eigen/Geometry>
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "scene/load_limits.h"
 #include "scene/mesh.h"
 #include "scene/placement.h"
 #include "scene/robot_model.h"
@@ -40,6 +42,7 @@ struct Level {
   std::vector<EmbeddedTexture> textures;
   std::vector<RobotModel> robots;     // declared by [[robot]] tables of a manifest
   std::vector<std::string> warnings;  // problems that were handled, e.g. dropped faces
+  LoadLimits limits;                  // what it was loaded within (textures are decoded later)
 
   // Index of the actor (robot) called `name`, or -1.
   int FindActor(std::string_view name) const;
@@ -48,9 +51,18 @@ struct Level {
   Eigen::AlignedBox3d bounds_W() const;
 };
 
+struct LoadOptions {
+  AssetConversion conversion;  // a scene file's axes and unit, when it does not say them
+  LoadLimits limits;           // a manifest's [level] table sets its own
+  // Called before each file of the level is read.
+  std::function<void(const std::filesystem::path& file)> on_file;
+};
+
 // Loads a level: a `.toml` file is a level manifest, anything else a scene file
 // that assimp reads (or a Terragen .ter terrain), in which every node with
-// meshes becomes an actor named after its node path. Throws LevelError.
+// meshes becomes an actor named after its node path. Only regular files are
+// read. Throws LevelError, also for a level over its limits.
+Level LoadLevel(const std::filesystem::path& file, const LoadOptions& options);
 Level LoadLevel(const std::filesystem::path& file, const AssetConversion& conversion = {});
 
 }  // namespace sandbox::scene

@@ -7,6 +7,8 @@
 #include <set>
 #include <sstream>
 
+#include "scene/files.h"
+
 namespace sandbox::scene {
 namespace {
 
@@ -48,9 +50,28 @@ class TableReader {
 
   double Number(const toml::node* node, const std::string& key) const {
     if (!node->is_number()) Fail(node, "'" + key + "' must be a number");
-    const double value = *node->value<double>();
+    // Integers beyond 2^53 have no double of their own (toml++ gives none at all).
+    if (const toml::value<std::int64_t>* integer = node->as_integer()) {
+      constexpr std::int64_t kExact = std::int64_t(1) << 53;
+      if (integer->get() > kExact || integer->get() < -kExact) {
+        Fail(node, "'" + key + "' is " + std::to_string(integer->get()) +
+                       ", beyond 2^53 (numbers that large lose their last digits)");
+      }
+      return double(integer->get());
+    }
+    const double value = node->as_floating_point()->get();
     if (!std::isfinite(value)) Fail(node, "'" + key + "' must be finite, got " + Format(value));
     return value;
+  }
+
+  // A whole number from 0 to `max`.
+  std::optional<std::uint64_t> Count(const std::string& key, std::uint64_t max) {
+    const std::optional<double> value = Number(key);
+    if (!value) return std::nullopt;
+    if (!(*value >= 0.0 && *value <= double(max)) || *value != std::floor(*value)) {
+      Fail(Find(key), "'" + key + "' must be a whole number from 0 to " + std::to_string(max));
+    }
+    return std::uint64_t(*value);
   }
 
   std::optional<double> Number(const std::string& key) {
@@ -388,6 +409,13 @@ std::vector<Spec> ParseTables(const fs::path& file, TableReader& top, const std:
 }  // namespace
 
 LevelManifest ParseManifest(const fs::path& file) {
+  if (const std::string problem = RegularFileProblem(file); !problem.empty()) {
+    throw LevelError(file.string() + ": " + problem);
+  }
+  if (FileBytes(file) > kMaxManifestBytes) {
+    throw LevelError(file.string() + ": " + std::to_string(FileBytes(file) >> 20) +
+                     " MB is no level manifest (they are a few KB; at most 16 MB are read)");
+  }
   toml::table root;
   try {
     root = toml::parse_file(file.string());
@@ -406,6 +434,18 @@ LevelManifest ParseManifest(const fs::path& file) {
     if (!level->is_table()) top.Fail(level, "'level' must be a table: [level]");
     TableReader read(file, *level->as_table(), "[level]: ");
     if (const auto name = read.String("name")) manifest.name = *name;
+    // What loading the level may take (scene/load_limits.h).
+    LoadLimits& limits = manifest.limits;
+    const std::uint64_t kHuge = std::uint64_t(1) << 50;
+    for (const auto& [key, value] :
+         {std::pair<const char*, std::uint64_t*>{"max_file_mb", &limits.max_file_mb},
+          {"max_heightmap_samples", &limits.max_heightmap_samples},
+          {"max_texture_pixels", &limits.max_texture_pixels},
+          {"max_triangles", &limits.max_triangles},
+          {"max_import_mb", &limits.max_import_mb},
+          {"max_import_s", &limits.max_import_s}}) {
+      if (const auto set = read.Count(key, kHuge)) *value = *set;
+    }
     read.RejectUnknownKeys();
   }
 

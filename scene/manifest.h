@@ -28,13 +28,19 @@ struct ActorSpec {
 struct LevelManifest {
   std::filesystem::path file;
   std::string name;
+  LoadLimits limits;  // the defaults, or what [level] sets
   std::vector<ActorSpec> actors;
   std::vector<RobotSpec> robots;
 };
 
+// The largest manifest read (a manifest is a few KB; this is no LoadLimits key).
+constexpr std::uint64_t kMaxManifestBytes = 16u << 20;
+
 // Throws LevelError "file:line: what" for a TOML syntax error, an unknown key,
 // a wrong type, a missing or duplicate name, a negative scale, a non-finite
-// number, a non-unit quaternion or an inconsistent bone declaration.
+// number or one beyond 2^53, a non-unit quaternion or an inconsistent bone
+// declaration; and "file: what" for a file that is not a regular file or is
+// larger than kMaxManifestBytes.
 LevelManifest ParseManifest(const std::filesystem::path& file);
 
 }  // namespace sandbox::scene

@@ -264,8 +264,7 @@ RobotModel LoadRobotModel(const RobotSpec& spec, const fs::path& manifest, Level
   Assimp::Importer importer;
   AssimpScene read;
   try {
-    CheckReadable(spec.file);
-    read = ReadAssimpScene(importer, spec.file, spec.placement.conversion);
+    read = ReadAssimpScene(importer, spec.file, spec.placement.conversion, level->limits);
   } catch (const LevelError& error) {
     throw LevelError(where + error.what());
   }

@@ -241,25 +241,30 @@ class OsMesaRenderer : public Renderer {
         RgbaImage image;
         const scene::EmbeddedTexture* texture =
             embedded ? &level.textures[std::size_t(material.base_color_texture_embedded)] : nullptr;
-        if (decoder && decoder(texture, material.base_color_texture_path, &image) &&
-            image.width > 0 && image.height > 0) {
+        const std::string problem =
+            decoder ? decoder(texture, material.base_color_texture_path, &image) : "no decoder";
+        if (problem.empty() && image.width > 0 && image.height > 0) {
           textures_[int(m)] = UploadTexture(image, GL_REPEAT);
         } else {
           warnings_.push_back("material '" + material.name + "': texture " +
                               (embedded ? "(embedded)" : material.base_color_texture_path) +
-                              " cannot be read; drawn with its base colour");
+                              " cannot be read (" + (problem.empty() ? "empty" : problem) +
+                              "); drawn with its base colour");
         }
       }
       if (material.lightmap_texture_embedded >= 0 &&
           material.lightmap_texture_embedded < int(level.textures.size())) {
         RgbaImage image;
-        if (decoder &&
-            decoder(&level.textures[std::size_t(material.lightmap_texture_embedded)], "", &image) &&
-            image.width > 0 && image.height > 0) {
+        const std::string problem =
+            decoder ? decoder(&level.textures[std::size_t(material.lightmap_texture_embedded)], "",
+                              &image)
+                    : "no decoder";
+        if (problem.empty() && image.width > 0 && image.height > 0) {
           lightmaps_[int(m)] = UploadTexture(image, GL_CLAMP_TO_EDGE);
         } else {
-          warnings_.push_back("material '" + material.name +
-                              "': its lightmap cannot be read; lit by the sun instead");
+          warnings_.push_back("material '" + material.name + "': its lightmap cannot be read (" +
+                              (problem.empty() ? "empty" : problem) +
+                              "); lit by the sun instead");
         }
       }
     }

@@ -25,10 +25,10 @@ struct RgbaImage {
   std::vector<std::uint8_t> rgba;  // row 0 at the top
 };
 
-// Decodes an embedded (compressed) texture or an image file; false when it
-// cannot. The app supplies one (OpenCV); the renderer itself decodes nothing.
-using TextureDecoder = std::function<bool(const scene::EmbeddedTexture* embedded,
-                                          const std::string& path, RgbaImage* image)>;
+// Decodes an embedded (compressed) texture or an image file; returns "" or
+// why it cannot. The app supplies one (OpenCV); the renderer itself decodes nothing.
+using TextureDecoder = std::function<std::string(const scene::EmbeddedTexture* embedded,
+                                                 const std::string& path, RgbaImage* image)>;
 
 // A pinhole camera: pose X_WC with x forward, y left, z up (like a robot body).
 struct CameraView {

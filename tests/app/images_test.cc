@@ -1,8 +1,10 @@
 // Depth files as other tools read them: the 16-bit PNG in millimetres through
 // OpenCV, the .npy parsed by the format's own rules, the EXR's header parsed
-// and its values read through OpenEXR.
+// and its values read through OpenEXR. Texture decoding within its limits.
 
 #include "app/images.h"
+
+#include <sys/stat.h>
 
 #include <gtest/gtest.h>
 
@@ -104,6 +106,51 @@ TEST(DepthFileTest, ExrIsOneFloat32ChannelOfMetres) {
   ASSERT_EQ(exr.rows, 2);
   for (int i = 0; i < 6; ++i)
     EXPECT_EQ(exr.at<float>(i / 3, i % 3), frame.depth_m[std::size_t(i)]) << i;
+}
+
+// Textures: the size a PNG or JPEG states, read from its header, and
+// textures that lie about it or are no files refused before decoding.
+TEST(TextureTest, HeaderSizesOfRealPngAndJpeg) {
+  const cv::Mat image(37, 61, CV_8UC3, cv::Scalar(10, 20, 30));
+  for (const char* format : {".png", ".jpg"}) {
+    std::vector<std::uint8_t> bytes;
+    ASSERT_TRUE(cv::imencode(format, image, bytes));
+    std::uint32_t width = 0, height = 0;
+    ASSERT_TRUE(ImageHeaderSize(bytes.data(), bytes.size(), &width, &height)) << format;
+    EXPECT_EQ(width, 61u) << format;
+    EXPECT_EQ(height, 37u) << format;
+    EXPECT_FALSE(ImageHeaderSize(bytes.data(), 10, &width, &height)) << format;
+  }
+  const std::uint8_t bmp[] = {'B', 'M', 0, 0};
+  std::uint32_t width = 0, height = 0;
+  EXPECT_FALSE(ImageHeaderSize(bmp, sizeof(bmp), &width, &height));
+}
+
+TEST(TextureTest, TexturesOverTheLimitOrNotFilesAreRefusedBeforeDecoding) {
+  testing::TempDir dir;
+  const cv::Mat image(300, 400, CV_8UC3, cv::Scalar(0, 128, 255));
+  std::vector<std::uint8_t> png;
+  ASSERT_TRUE(cv::imencode(".png", image, png));
+  scene::LoadLimits limits;
+  limits.max_texture_pixels = 100000;  // less than 400 x 300
+  const sensors::TextureDecoder decode = OpenCvTextureDecoder(limits);
+  scene::EmbeddedTexture embedded;
+  embedded.format_hint = "png";
+  embedded.width = int(png.size());
+  embedded.bytes = png;
+  sensors::RgbaImage rgba;
+  EXPECT_EQ(decode(&embedded, "", &rgba),
+            "400 x 300 pixels, over the limit of 100000 ([level] max_texture_pixels)");
+  EXPECT_EQ(OpenCvTextureDecoder()(&embedded, "", &rgba), "");
+  EXPECT_EQ(rgba.width, 400);
+  EXPECT_EQ(rgba.rgba.size(), 400u * 300 * 4);
+  EXPECT_EQ(rgba.rgba[2], 0);  // blue of BGR (0, 128, 255) is 0; red is 255
+  EXPECT_EQ(rgba.rgba[0], 255);
+  // A file that is a FIFO, and one that is missing.
+  const std::string fifo = (dir.path() / "texture.png").string();
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_EQ(decode(nullptr, fifo, &rgba), "is a FIFO, not a regular file");
+  EXPECT_EQ(decode(nullptr, (dir.path() / "none.png").string(), &rgba), "no such file");
 }
 
 }  // namespace

@@ -6,7 +6,9 @@
 
 #include <array>
 #include <cstdio>
+#include <filesystem>
 #include <string>
+#include <vector>
 
 #include "tests/app/run_sandbox.h"
 #include "tests/test_util.h"
@@ -68,6 +70,50 @@ TEST(InfoCommandTest, BadLevelsExitOneWithOneMessage) {
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_EQ(run.out.find("terminate"), std::string::npos) << run.out;
   EXPECT_EQ(run.out.rfind("sandbox info: " + garbage.string() + ": ", 0), 0u) << run.out;
+}
+
+// `info` makes the checks `run` makes: what one refuses the other refuses
+// with the same message.
+TEST(InfoCommandTest, WhatRunRefusesInfoRefusesWithTheSameMessage) {
+  sandbox::testing::TempDir dir;
+  const std::string robots = (std::filesystem::path(SANDBOX_SOURCE_DIR) /
+                              "assets/robots/generated/flying_wing.gltf")
+                                 .string();
+  auto level = [&](const std::string& name, const std::string& robot_tables) {
+    return dir.Write(name, robot_tables).string();
+  };
+  auto robot = [&](const std::string& name, const std::string& extra) {
+    return "[[robot]]\nname = \"" + name + "\"\nfile = \"" + robots + "\"\n" + extra;
+  };
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      // Two robots on one channel prefix.
+      {level("prefix.toml", robot("A", "") + robot("B", "[robot.bridge]\nchannel_prefix = \"A\"\n")),
+       ":8: robot 'B' bridge: robot 'B' would use the channel prefix 'A' of robot 'A'; give one "
+       "of them its own 'channel_prefix'"},
+      // A port taken by another robot, and a bind address that is none.
+      {level("ports.toml",
+             robot("A", "[robot.bridge]\nnet_fdm_port = 5600\n") +
+                 robot("B", "[robot.bridge]\nudp_doubles_port = 5600\n")),
+       ":10: robot 'B' bridge: port 5600 is taken by robot 'A'"},
+      {level("address.toml", robot("A", "[robot.bridge]\nbind_address = \"localhost\"\n")),
+       ":5: robot 'A' bridge: 'bind_address' must be an IPv4 address like 127.0.0.1, got "
+       "'localhost'"},
+      // A layout that names an item twice.
+      {level("layout.toml",
+             robot("A", "[robot.bridge]\nudp_doubles_layout = [\"position\", \"position\"]\n")),
+       ":5: robot 'A' bridge: 'udp_doubles_layout' names 'position' twice"},
+      // A camera of 100000 pixels a side.
+      {level("camera.toml", robot("A", "[[robot.camera]]\nname = \"c\"\ntype = \"chase\"\n"
+                                       "width = 100000\n")),
+       ":4: camera 'c': resolution must be 1 to 8192 pixels a side, got 100000 x 480"}};
+  for (const auto& [file, message] : cases) {
+    const CommandRun info = Sandbox("info " + file);
+    const CommandRun run = Sandbox("run " + file + " --duration 0.1 --lcm-url memq://");
+    EXPECT_EQ(info.exit_code, 1) << info.out;
+    EXPECT_EQ(run.exit_code, 1) << run.out;
+    EXPECT_EQ(info.out, "sandbox info: " + file + message + "\n");
+    EXPECT_EQ(run.out, "sandbox run: " + file + message + "\n");
+  }
 }
 
 TEST(InfoCommandTest, BadUsageExitsTwo) {

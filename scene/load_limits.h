@@ -1,0 +1,31 @@
+#pragma once
+// What loading one level may take. A level over a limit fails to load with an
+// error naming the file, what it would take and the limit's key; a manifest's
+// [level] table may set each (docs/levels.md). They guard against files that
+// claim sizes they do not have (a 389 KB PNG of 20000 x 20000 pixels, a GLB
+// whose header lies) as much as against files too big for the machine.
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+namespace sandbox::scene {
+
+struct LoadLimits {
+  std::uint64_t max_file_mb{2048};               // any one file the level reads
+  std::uint64_t max_heightmap_samples{1u << 24};  // one heightmap's points (4096 x 4096)
+  std::uint64_t max_texture_pixels{1u << 26};     // one texture, decoded (8192 x 8192)
+  std::uint64_t max_triangles{50'000'000};        // the whole level, robots included
+  // An isolated import (sandbox --isolate): its address space and CPU time.
+  std::uint64_t max_import_mb{8192};
+  std::uint64_t max_import_s{600};
+
+  // Throws LevelError "FILE: WHAT, over the limit of LIMIT ([level] KEY)"
+  // when `amount` is above `limit`.
+  static void Check(const std::filesystem::path& file, const std::string& what,
+                    std::uint64_t amount, std::uint64_t limit, const char* key);
+  // The file's size against max_file_mb.
+  void CheckFileSize(const std::filesystem::path& file) const;
+};
+
+}  // namespace sandbox::scene
