@@ -175,8 +175,9 @@ int RunDemo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     pid_t model = -1;
     if (in_process) {
       run_args.insert(run_args.end(), {"--lcm-url", "memq://"});
-      std::int64_t seq = 0;
-      hooks.before_tick = [&status, &seq](bridge::LcmLink& link, double wall_s) {
+      // The pilot keeps its own sequence number (it outlives this block).
+      hooks.before_tick = [&status, seq = std::int64_t{0}](bridge::LcmLink& link,
+                                                         double wall_s) mutable {
         status.Poll(link);
         sandbox_msgs::robot_pose_t pose;
         sandbox_msgs::bone_values_t bones;

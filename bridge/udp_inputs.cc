@@ -13,8 +13,8 @@
 
 namespace sandbox::bridge {
 
-UdpLatest::UdpLatest(const std::string& address, int port)
-    : name_("udp:" + address + ":" + std::to_string(port)), buffer_(65536) {
+UdpLatest::UdpLatest(const std::string& address, int port, MessageCheck check)
+    : name_("udp:" + address + ":" + std::to_string(port)), check_(std::move(check)), buffer_(65536) {
   socket_ = ::socket(AF_INET, SOCK_DGRAM, 0);
   sockaddr_in where{};
   where.sin_family = AF_INET;
@@ -33,10 +33,17 @@ UdpLatest::~UdpLatest() { ::close(socket_); }
 
 const std::vector<std::uint8_t>* UdpLatest::TakeNewest() {
   bool any = false;
-  for (;;) {
+  // At most this many a call: a flood cannot hold the loop (the rest waits).
+  for (int read = 0; read < 4096; ++read) {
     const ssize_t size = ::recv(socket_, buffer_.data(), buffer_.size(), 0);
     if (size < 0) break;  // EAGAIN: nothing more waiting
     ++received_;
+    if (check_) {
+      if (std::string problem = check_(buffer_.data(), std::size_t(size)); !problem.empty()) {
+        Reject(problem);
+        continue;
+      }
+    }
     if (any) ++superseded_;
     newest_.assign(buffer_.begin(), buffer_.begin() + size);
     any = true;
@@ -46,13 +53,22 @@ const std::vector<std::uint8_t>* UdpLatest::TakeNewest() {
 
 void UdpLatest::Reject(const std::string& reason) {
   ++rejected_;
-  ++reasons_[reason];
-  last_reason_ = reason;
-  if (log_ != nullptr) log_->Note(name_, reason);
+  last_reason_ = Printable(reason);
+  if (reasons_.size() < LatestInput::kMaxReasons || reasons_.count(last_reason_) > 0) {
+    ++reasons_[last_reason_];
+  } else {
+    ++reasons_["other"];
+  }
+  if (log_ != nullptr) log_->Note(name_, last_reason_);
 }
 
 NetFdmInput::NetFdmInput(const RobotBridgeConfig& config)
-    : config_(config), socket_(config.bind_address, config.net_fdm_port) {}
+    : config_(config),
+      socket_(config.bind_address, config.net_fdm_port,
+              [](const std::uint8_t* data, std::size_t size) {
+                NetFdm fdm;
+                return DecodeNetFdm(data, size, &fdm);
+              }) {}
 
 bool NetFdmInput::Apply(scene::RobotState* state) {
   const std::vector<std::uint8_t>* packet = socket_.TakeNewest();
@@ -98,66 +114,92 @@ bool NetFdmInput::Apply(scene::RobotState* state) {
   return true;
 }
 
-DoublesInput::DoublesInput(const RobotBridgeConfig& config, const scene::RobotModel& model)
-    : config_(config),
-      socket_(config.bind_address, config.udp_doubles_port),
-      num_values_(model.num_values) {
-  for (const std::string& item : config_.udp_doubles_layout) {
-    expected_ += item == "position"     ? 3
-                 : item == "quaternion" ? 4
-                 : item == "rpy"        ? 3
-                                        : std::size_t(num_values_);
+namespace {
+
+std::size_t ExpectedDoubles(const RobotBridgeConfig& config, int num_bone_values) {
+  std::size_t expected = 0;
+  for (const std::string& item : config.udp_doubles_layout) {
+    expected += item == "position"     ? 3
+                : item == "quaternion" ? 4
+                : item == "rpy"        ? 3
+                                       : std::size_t(num_bone_values);
   }
+  return expected;
 }
 
-bool DoublesInput::Apply(scene::RobotState* state) {
-  const std::vector<std::uint8_t>* packet = socket_.TakeNewest();
-  if (packet == nullptr) return false;
-  if (packet->size() != 8 * expected_) {
-    socket_.Reject("expected " + std::to_string(expected_) + " doubles (" +
-                   std::to_string(8 * expected_) + " bytes), got " +
-                   std::to_string(packet->size()) + " bytes");
-    return false;
+}  // namespace
+
+std::string DecodeDoubles(const RobotBridgeConfig& config, int num_bone_values,
+                          const std::uint8_t* data, std::size_t size,
+                          const Eigen::Isometry3d& X_WB_before, Eigen::Isometry3d* X_WB,
+                          std::vector<double>* bones) {
+  const std::size_t expected = ExpectedDoubles(config, num_bone_values);
+  if (size != 8 * expected) {
+    return "expected " + std::to_string(expected) + " doubles (" + std::to_string(8 * expected) +
+           " bytes), got " + std::to_string(size) + " bytes";
   }
-  std::vector<double> v(expected_);
-  for (std::size_t i = 0; i < expected_; ++i) {
+  std::vector<double> v(expected);
+  for (std::size_t i = 0; i < expected; ++i) {
     std::uint8_t b[8];
-    std::memcpy(b, packet->data() + 8 * i, 8);
-    if (config_.udp_doubles_big_endian) std::reverse(b, b + 8);
+    std::memcpy(b, data + 8 * i, 8);
+    if (config.udp_doubles_big_endian) std::reverse(b, b + 8);
     std::memcpy(&v[i], b, 8);
-    if (!std::isfinite(v[i])) {
-      socket_.Reject("non-finite value");
-      return false;
-    }
+    if (!std::isfinite(v[i])) return "non-finite value";
   }
-  Eigen::Vector3d position = state->pose().translation();
-  Eigen::Quaterniond q(state->pose().linear());
-  std::vector<double> bones;
+  Eigen::Vector3d position = X_WB_before.translation();
+  Eigen::Quaterniond q(X_WB_before.linear());
+  bones->clear();
   std::size_t at = 0;
-  for (const std::string& item : config_.udp_doubles_layout) {
+  for (const std::string& item : config.udp_doubles_layout) {
     if (item == "position") {
       position = Eigen::Vector3d(v[at], v[at + 1], v[at + 2]), at += 3;
     } else if (item == "quaternion") {
       q = Eigen::Quaterniond(v[at], v[at + 1], v[at + 2], v[at + 3]), at += 4;
-      if (std::abs(q.norm() - 1.0) > 1e-3) {
-        socket_.Reject("non-unit quaternion");
-        return false;
-      }
+      if (std::abs(q.norm() - 1.0) > 1e-3) return "non-unit quaternion";
     } else if (item == "rpy") {
       // In the convention's own frame: aerospace attitude for ned and geodetic.
-      q = config_.pose.convention == Convention::kNed ||
-                  config_.pose.convention == Convention::kGeodetic
+      q = config.pose.convention == Convention::kNed ||
+                  config.pose.convention == Convention::kGeodetic
               ? NedAttitude(v[at], v[at + 1], v[at + 2])
               : Eigen::Quaterniond(Eigen::AngleAxisd(v[at + 2], Eigen::Vector3d::UnitZ()) *
                                    Eigen::AngleAxisd(v[at + 1], Eigen::Vector3d::UnitY()) *
                                    Eigen::AngleAxisd(v[at], Eigen::Vector3d::UnitX()));
       at += 3;
     } else {
-      bones.assign(v.begin() + std::ptrdiff_t(at), v.begin() + std::ptrdiff_t(at) + num_values_);
-      at += std::size_t(num_values_);
+      bones->assign(v.begin() + std::ptrdiff_t(at),
+                    v.begin() + std::ptrdiff_t(at) + num_bone_values);
+      at += std::size_t(num_bone_values);
     }
   }
-  if (!state->SetPose(config_.pose.ToWorld(position, q))) {
+  *X_WB = config.pose.ToWorld(position, q);
+  return scene::PoseProblem(*X_WB);
+}
+
+DoublesInput::DoublesInput(const RobotBridgeConfig& config, const scene::RobotModel& model)
+    : config_(config),
+      socket_(config.bind_address, config.udp_doubles_port,
+              [this](const std::uint8_t* data, std::size_t size) {
+                Eigen::Isometry3d X_WB;
+                std::vector<double> bones;
+                return DecodeDoubles(config_, num_values_, data, size,
+                                     Eigen::Isometry3d::Identity(), &X_WB, &bones);
+              }),
+      num_values_(model.num_values) {
+  expected_ = ExpectedDoubles(config_, num_values_);
+}
+
+bool DoublesInput::Apply(scene::RobotState* state) {
+  const std::vector<std::uint8_t>* packet = socket_.TakeNewest();
+  if (packet == nullptr) return false;
+  Eigen::Isometry3d X_WB;
+  std::vector<double> bones;
+  const std::string problem = DecodeDoubles(config_, num_values_, packet->data(), packet->size(),
+                                            state->pose(), &X_WB, &bones);
+  if (!problem.empty()) {
+    socket_.Reject(problem);
+    return false;
+  }
+  if (!state->SetPose(X_WB)) {
     socket_.Reject(state->last_rejection());
     return false;
   }

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "bridge/lcm_link.h"
 #include "bridge/net_fdm.h"
 #include "bridge/reject_log.h"
 #include "bridge/robot_bridge_config.h"
@@ -16,16 +17,18 @@
 
 namespace sandbox::bridge {
 
-// A non-blocking UDP socket that keeps the newest datagram.
+// A non-blocking UDP socket that keeps the newest good datagram: each one is
+// checked as it is read (`check`, as for LCM inputs), and a bad one is
+// rejected without displacing the good one before it.
 class UdpLatest {
  public:
   // Throws std::runtime_error naming the address and port when it cannot bind.
-  UdpLatest(const std::string& address, int port);
+  UdpLatest(const std::string& address, int port, MessageCheck check = {});
   ~UdpLatest();
   UdpLatest(const UdpLatest&) = delete;
   UdpLatest& operator=(const UdpLatest&) = delete;
 
-  // Reads every waiting datagram; returns the newest or nullptr.
+  // Reads every waiting datagram; returns the newest good one or nullptr.
   const std::vector<std::uint8_t>* TakeNewest();
   void Reject(const std::string& reason);
   // Where rejections are also logged, once per cause per second (nullptr: nowhere).
@@ -41,6 +44,7 @@ class UdpLatest {
  private:
   int socket_{-1};
   std::string name_;
+  MessageCheck check_;
   std::vector<std::uint8_t> buffer_, newest_;
   std::int64_t received_{0}, superseded_{0}, rejected_{0};
   std::map<std::string, std::int64_t> reasons_;
@@ -65,6 +69,15 @@ class NetFdmInput {
   NetFdm last_;
   std::vector<double> values_;  // bone values kept between packets
 };
+
+// A packet of doubles in `config`'s layout and byte order, decoded: the pose
+// (items the layout lacks keep X_WB_before's) and the bone values (empty when
+// the layout has none). Returns "" or why the packet is rejected (size,
+// non-finite value, non-unit quaternion, a pose that is no pose).
+std::string DecodeDoubles(const RobotBridgeConfig& config, int num_bone_values,
+                          const std::uint8_t* data, std::size_t size,
+                          const Eigen::Isometry3d& X_WB_before, Eigen::Isometry3d* X_WB,
+                          std::vector<double>* bones);
 
 // A plain vector of doubles in the configured layout and byte order.
 class DoublesInput {

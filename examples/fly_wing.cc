@@ -3,7 +3,9 @@
 // elevators, and publishes its pose and bones over LCM as a Simulink model or
 // a C++ solver would.
 //
-//   fly_wing [--rate HZ] [--duration S] [--lcm-url URL] [--robot NAME]
+//   fly_wing [--rate HZ] [--duration S] [--poses N] [--lcm-url URL] [--robot NAME]
+//
+// It stops after --duration seconds or after --poses poses, whichever comes first.
 
 #include <chrono>
 #include <cmath>
@@ -18,19 +20,23 @@
 
 int main(int argc, char** argv) {
   double rate_hz = 100.0, duration_s = 10.0;
+  long long poses = -1;
   std::string url, robot = "ELAHA";
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--rate"))
       rate_hz = std::atof(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--duration"))
       duration_s = std::atof(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--poses"))
+      poses = std::atoll(argv[i + 1]), duration_s = 1e9;
     else if (!std::strcmp(argv[i], "--lcm-url"))
       url = argv[i + 1];
     else if (!std::strcmp(argv[i], "--robot"))
       robot = argv[i + 1];
     else {
       std::fprintf(stderr,
-                   "usage: fly_wing [--rate HZ] [--duration S] [--lcm-url URL] [--robot NAME]\n");
+                   "usage: fly_wing [--rate HZ] [--duration S] [--poses N] [--lcm-url URL] "
+                   "[--robot NAME]\n");
       return 2;
     }
   }
@@ -46,7 +52,7 @@ int main(int argc, char** argv) {
   std::int64_t seq = 0;
   for (;;) {
     const double t = std::chrono::duration<double>(Clock::now() - start).count();
-    if (t >= duration_s) break;
+    if (t >= duration_s || seq == poses) break;
     const std::int64_t utime = std::chrono::duration_cast<std::chrono::microseconds>(
                                    std::chrono::system_clock::now().time_since_epoch())
                                    .count();

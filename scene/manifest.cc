@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <set>
 #include <sstream>
 
@@ -416,9 +417,18 @@ LevelManifest ParseManifest(const fs::path& file) {
     throw LevelError(file.string() + ": " + std::to_string(FileBytes(file) >> 20) +
                      " MB is no level manifest (they are a few KB; at most 16 MB are read)");
   }
+  std::ifstream in(file, std::ios::binary);
+  std::string text(FileBytes(file), '\0');
+  if (!in.read(text.data(), std::streamsize(text.size()))) {
+    throw LevelError(file.string() + ": cannot be read");
+  }
+  return ParseManifestText(text, file);
+}
+
+LevelManifest ParseManifestText(std::string_view text, const fs::path& file) {
   toml::table root;
   try {
-    root = toml::parse_file(file.string());
+    root = toml::parse(text, file.string());
   } catch (const toml::parse_error& error) {
     std::ostringstream out;
     out << file.string() << ":" << error.source().begin.line

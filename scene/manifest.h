@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "scene/level.h"
@@ -42,5 +43,8 @@ constexpr std::uint64_t kMaxManifestBytes = 16u << 20;
 // declaration; and "file: what" for a file that is not a regular file or is
 // larger than kMaxManifestBytes.
 LevelManifest ParseManifest(const std::filesystem::path& file);
+// The same for manifest text that `file` would hold (asset paths resolve
+// against its folder; nothing is read).
+LevelManifest ParseManifestText(std::string_view text, const std::filesystem::path& file);
 
 }  // namespace sandbox::scene

@@ -32,7 +32,7 @@ status=0
 "$face_check" "$level" --faces 12 --seconds 120 || status=$?
 wait "$player_pid"
 # Every recorded pose reaches the sandbox (its heartbeat counts them).
-"$state_check" ELAHA --received "$recorded" --seconds 60 ||
+"$state_check" ELAHA --good "$recorded" --seconds 60 ||
   { echo "not all $recorded logged poses arrived"; status=1; }
 stop "$sandbox_pid"
 cat "$run_log"

@@ -4,8 +4,11 @@
 //   state_check ROBOT X Y Z TOLERANCE_M [--seconds S]
 //       <ROBOT>/STATE: the robot, moved by an external pose, within
 //       TOLERANCE_M of the world position (X, Y, Z);
-//   state_check ROBOT --received N [--seconds S]
-//       <ROBOT>/STATUS: at least N messages received on <ROBOT>/POSE.
+//   state_check ROBOT --seq N [--seconds S]
+//       <ROBOT>/STATE: computed from the pose input with seq N or later;
+//   state_check ROBOT --good N [--seconds S]
+//       <ROBOT>/STATUS: at least N good messages (received and not rejected)
+//       on <ROBOT>/POSE.
 
 #include <chrono>
 #include <cmath>
@@ -23,10 +26,11 @@ struct Watch {
   std::string robot;
   double expected[3]{0, 0, 0};
   double tolerance{0};
-  long long want_received{-1};  // >= 0: watch STATUS instead
+  long long want_good{-1};  // >= 0: watch STATUS instead
+  long long want_seq{-1};   // >= 0: watch STATE for this input seq
   bool any{false}, there{false};
   double p[3]{0, 0, 0};
-  long long received{0};
+  long long good{0};
 
   void OnState(const lcm::ReceiveBuffer* buffer, const std::string&) {
     sandbox_msgs::robot_state_t m;
@@ -38,7 +42,11 @@ struct Watch {
     }
     any = true;
     for (int k = 0; k < 3; ++k) p[k] = m.position[k];
-    there = there || Error() <= tolerance;
+    if (want_seq >= 0) {
+      there = there || m.input_seq >= want_seq;
+    } else {
+      there = there || Error() <= tolerance;
+    }
   }
   void OnStatus(const lcm::ReceiveBuffer* buffer, const std::string&) {
     sandbox_msgs::status_t m;
@@ -48,9 +56,11 @@ struct Watch {
       return;
     }
     for (int c = 0; c < m.num_channels; ++c) {
-      if (m.channels[std::size_t(c)] == robot + "/POSE") received = m.received[std::size_t(c)];
+      if (m.channels[std::size_t(c)] == robot + "/POSE") {
+        good = m.received[std::size_t(c)] - m.rejected[std::size_t(c)];
+      }
     }
-    there = there || received >= want_received;
+    there = there || good >= want_good;
   }
   double Error() const {
     return std::hypot(p[0] - expected[0], p[1] - expected[1], p[2] - expected[2]);
@@ -58,18 +68,20 @@ struct Watch {
 };
 
 int main(int argc, char** argv) {
-  const bool status = argc >= 4 && !std::strcmp(argv[2], "--received");
-  if (argc < 6 && !status) {
+  const bool status = argc >= 4 && !std::strcmp(argv[2], "--good");
+  const bool seq = argc >= 4 && !std::strcmp(argv[2], "--seq");
+  if (argc < 6 && !status && !seq) {
     std::fprintf(stderr,
                  "usage: state_check ROBOT X Y Z TOLERANCE_M [--seconds S]\n"
-                 "       state_check ROBOT --received N [--seconds S]\n");
+                 "       state_check ROBOT --seq N [--seconds S]\n"
+                 "       state_check ROBOT --good N [--seconds S]\n");
     return 2;
   }
   Watch watch;
   watch.robot = argv[1];
   int next = 6;
-  if (status) {
-    watch.want_received = std::atoll(argv[3]);
+  if (status || seq) {
+    (status ? watch.want_good : watch.want_seq) = std::atoll(argv[3]);
     next = 4;
   } else {
     for (int k = 0; k < 3; ++k) watch.expected[k] = std::atof(argv[2 + k]);
@@ -86,8 +98,11 @@ int main(int argc, char** argv) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   while (!watch.there && std::chrono::steady_clock::now() < end) lcm.handleTimeout(50);
   if (status) {
-    std::printf("state_check: %s/POSE %lld received, expected %lld\n", watch.robot.c_str(),
-                watch.received, watch.want_received);
+    std::printf("state_check: %s/POSE %lld good messages received, expected %lld\n",
+                watch.robot.c_str(), watch.good, watch.want_good);
+  } else if (seq) {
+    std::printf("state_check: %s/STATE %s input seq %lld\n", watch.robot.c_str(),
+                watch.there ? "reached" : "did not reach", watch.want_seq);
   } else {
     std::printf(
         "state_check: robot at (%.3f, %.3f, %.3f), expected (%.3f, %.3f, %.3f), off by %.4f m\n",

@@ -125,6 +125,19 @@ TEST(UdpInputsTest, DoublesInTheConfiguredLayout) {
   usleep(20000);
   EXPECT_FALSE(input.Apply(&state));
   EXPECT_EQ(input.socket().last_reject_reason(), "expected 9 doubles (72 bytes), got 64 bytes");
+  // A good packet and then garbage before the next tick: the good one applies.
+  std::uint8_t moved[72];
+  std::memcpy(moved, bytes, sizeof(moved));
+  const double x = 7.0;
+  std::uint8_t b[8];
+  std::memcpy(b, &x, 8);
+  for (int k = 0; k < 8; ++k) moved[k] = b[7 - k];
+  Send(port, moved, sizeof(moved));
+  Send(port, bytes, 10);
+  usleep(20000);
+  ASSERT_TRUE(input.Apply(&state));
+  EXPECT_TRUE(state.pose().translation().isApprox(Vector3d(7, 2, 3)));
+  EXPECT_EQ(input.socket().rejected(), 2);
 }
 
 TEST(UdpInputsTest, BridgeSettingsMistakes) {

@@ -1,0 +1,224 @@
+// Writes the seed corpora of the fuzz targets into DIR/<target>/ (scripts/fuzz
+// runs it; nothing it writes is committed): small valid inputs of every kind
+// each target reads, for the fuzzer to mutate.
+//
+//   make_fuzz_seeds DIR SOURCE_DIR
+
+#include <assimp/scene.h>
+
+#include <assimp/Exporter.hpp>
+#include <assimp/Importer.hpp>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
+
+#include "bridge/lcm_link.h"
+#include "bridge/net_fdm.h"
+#include "sandbox_msgs/actor_placements_t.hpp"
+#include "sandbox_msgs/bone_values_t.hpp"
+#include "sandbox_msgs/camera_command_t.hpp"
+#include "sandbox_msgs/robot_pose_t.hpp"
+#include "sandbox_msgs/status_t.hpp"
+
+namespace fs = std::filesystem;
+using Bytes = std::string;
+
+namespace {
+
+void Write(const fs::path& file, const Bytes& bytes) {
+  fs::create_directories(file.parent_path());
+  std::ofstream(file, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+Bytes Read(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+template <typename Message>
+Bytes Encode(const Message& message) {
+  Bytes bytes(std::size_t(message.getEncodedSize()), '\0');
+  message.encode(bytes.data(), 0, int(bytes.size()));
+  return bytes;
+}
+
+// The LCM messages the sandbox reads, valid, of several sizes.
+void LcmSeeds(const fs::path& dir) {
+  sandbox_msgs::robot_pose_t pose{};
+  pose.seq = 1, pose.position[2] = 60, pose.orientation[0] = 1;
+  Write(dir / "pose", Encode(pose));
+  sandbox_msgs::bone_values_t bones{};
+  bones.num_values = 45;
+  bones.values.assign(45, 0.05);
+  Write(dir / "bones", Encode(bones));
+  bones.num_values = 2, bones.values = {0.1, 0.2};
+  Write(dir / "bones_short", Encode(bones));
+  sandbox_msgs::actor_placements_t actors{};
+  actors.num_actors = 1, actors.names = {"gate"};
+  actors.num_positions = 3, actors.positions = {1, 2, 3};
+  actors.num_orientations = 4, actors.orientations = {1, 0, 0, 0};
+  Write(dir / "actors", Encode(actors));
+  sandbox_msgs::camera_command_t camera{};
+  camera.active_camera = "belly", camera.zoom = 2;
+  Write(dir / "camera", Encode(camera));
+  sandbox_msgs::status_t status{};
+  status.num_channels = 1, status.channels = {"ELAHA/POSE"}, status.received = {3};
+  status.superseded = {0}, status.rejected = {1}, status.stale = {0};
+  status.last_reject_reason = {"non-finite pose"};
+  Write(dir / "status", Encode(status));
+}
+
+void UdpSeeds(const fs::path& dir) {
+  sandbox::bridge::NetFdm fdm;
+  fdm.latitude_rad = 0.82, fdm.longitude_rad = 0.14, fdm.altitude_m = 600, fdm.elevator = 0.5f;
+  const std::vector<std::uint8_t> packet = sandbox::bridge::EncodeNetFdm(fdm);
+  Write(dir / "net_fdm", Bytes(packet.begin(), packet.end()));
+  // Layout 0 (position, quaternion, bones): the first byte picks it.
+  std::vector<double> values = {1, 2, 3, 1, 0, 0, 0};
+  values.resize(7 + 45, 0.0);
+  Bytes doubles(1, '\0');
+  doubles.append(reinterpret_cast<const char*>(values.data()), values.size() * 8);
+  Write(dir / "doubles", doubles);
+  Bytes rpy(1, '\1');
+  const double pose[6] = {1, 2, 3, 0.1, 0.2, 0.3};
+  rpy.append(reinterpret_cast<const char*>(pose), sizeof(pose));
+  Write(dir / "doubles_rpy", rpy);
+}
+
+void LogSeeds(const fs::path& dir) {
+  fs::create_directories(dir);
+  sandbox::bridge::LogWriter log((dir / "flight").string());
+  sandbox_msgs::robot_pose_t pose{};
+  pose.orientation[0] = 1;
+  for (int i = 0; i < 3; ++i) {
+    pose.seq = i;
+    const Bytes bytes = Encode(pose);
+    log.Write("ELAHA/POSE", bytes.data(), unsigned(bytes.size()), 1000 * i);
+  }
+  log.Close();
+}
+
+// PNG's CRC-32, for the zip below.
+std::uint32_t Crc32(const Bytes& bytes) {
+  std::uint32_t crc = 0xffffffffu;
+  for (const char c : bytes) {
+    crc ^= std::uint8_t(c);
+    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
+  }
+  return ~crc;
+}
+
+Bytes Little(std::uint32_t v, int n) {
+  Bytes out;
+  for (int i = 0; i < n; ++i) out += char((v >> (8 * i)) & 0xff);
+  return out;
+}
+
+// A zip holding one stored (uncompressed) file.
+Bytes StoredZip(const std::string& name, const Bytes& data) {
+  const std::uint32_t crc = Crc32(data), size = std::uint32_t(data.size());
+  const Bytes local = Little(0x04034b50, 4) + Little(20, 2) + Little(0, 2) + Little(0, 2) +
+                      Little(0, 4) + Little(crc, 4) + Little(size, 4) + Little(size, 4) +
+                      Little(std::uint32_t(name.size()), 2) + Little(0, 2) + name;
+  const Bytes central = Little(0x02014b50, 4) + Little(20, 2) + Little(20, 2) + Little(0, 2) +
+                        Little(0, 2) + Little(0, 4) + Little(crc, 4) + Little(size, 4) +
+                        Little(size, 4) + Little(std::uint32_t(name.size()), 2) + Little(0, 2) +
+                        Little(0, 2) + Little(0, 2) + Little(0, 2) + Little(0, 4) + Little(0, 4) +
+                        name;
+  const std::uint32_t central_at = std::uint32_t(local.size() + data.size());
+  return local + data + central + Little(0x06054b50, 4) + Little(0, 2) + Little(0, 2) +
+         Little(1, 2) + Little(1, 2) + Little(std::uint32_t(central.size()), 4) +
+         Little(central_at, 4) + Little(0, 2);
+}
+
+// Level files: a textured box exported by assimp in each format it writes,
+// and hand-made files of the rest. The first byte picks the format.
+void LevelFileSeeds(const fs::path& dir) {
+  const char* formats[] = {"obj", "ply", "stl", "off", "gltf", "glb", "dae", "fbx", "3ds",
+                           "x",   "3mf", "pk3", "ter", "png", "pgm"};
+  auto index = [&](const std::string& format) {
+    for (std::size_t i = 0; i < std::size(formats); ++i) {
+      if (format == formats[i]) return char(i);
+    }
+    std::fprintf(stderr, "make_fuzz_seeds: no format %s\n", format.c_str());
+    std::exit(1);
+  };
+  auto seed = [&](const std::string& format, const std::string& name, const Bytes& bytes) {
+    Write(dir / format / name, Bytes(1, index(format)) + bytes);
+  };
+  const char* obj =
+      "mtllib none.mtl\no box\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\n"
+      "v 0 1 1\nvt 0 0\nvt 1 0\nvt 1 1\nvn 0 0 1\nf 1/1/1 4/2/1 3/3/1 2/1/1\nf 5 6 7 8\n"
+      "f 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+  seed("obj", "box.obj", obj);
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFileFromMemory(obj, std::strlen(obj), 0, "obj");
+  if (scene == nullptr) {
+    std::fprintf(stderr, "make_fuzz_seeds: %s\n", importer.GetErrorString());
+    std::exit(1);
+  }
+  Assimp::Exporter exporter;
+  const std::pair<const char*, const char*> exports[] = {
+      {"ply", "ply"}, {"plyb", "ply"},  {"stl", "stl"}, {"stlb", "stl"}, {"gltf2", "gltf"},
+      {"glb2", "glb"}, {"collada", "dae"}, {"fbx", "fbx"}, {"fbxa", "fbx"}, {"3ds", "3ds"},
+      {"x", "x"},     {"3mf", "3mf"}};
+  for (const auto& [id, format] : exports) {
+    const aiExportDataBlob* blob = exporter.ExportToBlob(scene, id);
+    if (blob == nullptr) {
+      std::fprintf(stderr, "make_fuzz_seeds: no %s export: %s\n", id, exporter.GetErrorString());
+      continue;
+    }
+    seed(format, std::string("box.") + id,
+         Bytes(static_cast<const char*>(blob->data), blob->size));
+  }
+  seed("off", "box.off",
+       "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n");
+  // A Quake 3 map's skeleton: "IBSP", version 46, 17 lumps of nothing.
+  Bytes bsp = "IBSP" + Little(46, 4);
+  for (int lump = 0; lump < 17; ++lump) bsp += Little(8 + 17 * 8, 4) + Little(0, 4);
+  seed("pk3", "empty.pk3", StoredZip("maps/empty.bsp", bsp));
+  // Terragen: 3 x 3 points.
+  Bytes ter = "TERRAGENTERRAIN SIZE" + Little(2, 2) + Little(0, 2) + "ALTW" + Little(256, 2) +
+              Little(1, 2);
+  for (int i = 0; i < 9; ++i) ter += Little(std::uint32_t(i * 100), 2);
+  seed("ter", "hills.ter", ter + "EOF ");
+  cv::Mat grey(8, 8, CV_8UC1);
+  for (int i = 0; i < 64; ++i) grey.data[i] = std::uint8_t(i * 4);
+  std::vector<std::uint8_t> png;
+  cv::imencode(".png", grey, png);
+  seed("png", "hills.png", Bytes(png.begin(), png.end()));
+  seed("pgm", "hills.pgm", "P5\n4 4\n255\n" + Bytes(16, '\x40'));
+}
+
+void ManifestSeeds(const fs::path& dir, const fs::path& source) {
+  for (const char* file : {"assets/sample/level.toml", "assets/robots/robots.toml",
+                           "tests/data/kuka_iiwa.toml", "tests/data/net_fdm_wing.toml",
+                           "tests/data/px4_uneven_ground.toml"}) {
+    Write(dir / fs::path(file).filename(), Read(source / file));
+  }
+  Write(dir / "limits.toml",
+        "[level]\nname = \"l\"\nmax_triangles = 100\nmax_file_mb = 1\n"
+        "[[actor]]\nname = \"a\"\nheightmap = \"h.png\"\nsize = [1, 2, 3]\n"
+        "quaternion_wxyz = [1, 0, 0, 0]\nscale = [1, 2, 3]\nup = \"y\"\nunit_scale = 0.01\n");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 3) {
+    std::fprintf(stderr, "usage: make_fuzz_seeds DIR SOURCE_DIR\n");
+    return 2;
+  }
+  const fs::path dir = argv[1];
+  ManifestSeeds(dir / "manifest", argv[2]);
+  LcmSeeds(dir / "lcm_inputs");
+  UdpSeeds(dir / "udp");
+  LogSeeds(dir / "lcm_log");
+  LevelFileSeeds(dir / "level_file");
+  std::printf("make_fuzz_seeds: seeds in %s\n", dir.string().c_str());
+  return 0;
+}
