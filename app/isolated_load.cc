@@ -89,6 +89,7 @@ void CheckLoadsInIsolation(const std::string& file, const scene::AssetConversion
   // What the child says, line by line, until it ends (or takes twice its CPU
   // time in wall time: then it is waiting on something and is killed).
   std::string said, reading, error;
+  bool started = false;
   const auto deadline = std::chrono::steady_clock::now() +
                         std::chrono::seconds(2 * limits.max_import_s + 10);
   bool timed_out = false;
@@ -111,6 +112,7 @@ void CheckLoadsInIsolation(const std::string& file, const scene::AssetConversion
     said.append(buffer, std::size_t(n));
     for (std::size_t end; (end = said.find('\n')) != std::string::npos; said.erase(0, end + 1)) {
       const std::string line = said.substr(0, end);
+      if (line == "started") started = true;
       if (line.rfind("reading ", 0) == 0) reading = line.substr(8);
       if (line.rfind("error ", 0) == 0) error = line.substr(6);
     }
@@ -126,6 +128,13 @@ void CheckLoadsInIsolation(const std::string& file, const scene::AssetConversion
   }
   if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return;
   if (WIFEXITED(status) && !error.empty()) throw scene::LevelError(error);
+  if (!started) {
+    throw scene::LevelError(file + ": the process that loads it apart could not start (" +
+                            (WIFSIGNALED(status) ? SignalName(WTERMSIG(status))
+                                                 : "exit code " + std::to_string(WEXITSTATUS(status))) +
+                            "); [level] max_import_mb = " + std::to_string(limits.max_import_mb) +
+                            " may be below what the program itself needs (about 600)");
+  }
   if (WIFSIGNALED(status) && WTERMSIG(status) == SIGXCPU) {
     throw scene::LevelError(where + ": importing it took more than " +
                             std::to_string(limits.max_import_s) +
@@ -135,7 +144,9 @@ void CheckLoadsInIsolation(const std::string& file, const scene::AssetConversion
     throw scene::LevelError(where + ": the importer crashed on it (" +
                             SignalName(WTERMSIG(status)) +
                             "); the file is corrupt or shows a bug of assimp 5.2.5 "
-                            "(docs/reliability.md)");
+                            "(docs/reliability.md), or needed more than its [level] "
+                            "max_import_mb = " +
+                            std::to_string(limits.max_import_mb));
   }
   throw scene::LevelError(where + ": loading it apart failed (exit code " +
                           std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")");
@@ -148,6 +159,7 @@ int RunLoadLevelChild(const std::vector<std::string>& args, std::ostream& out) {
     if (args[i] == "--unit-scale") options.conversion.unit_scale_m = std::stod(args[i + 1]);
   }
   if (args.empty()) return 2;
+  out << "started" << std::endl;
   std::string reading = args[0];
   options.on_file = [&out, &reading](const std::filesystem::path& file) {
     reading = file.string();

@@ -22,7 +22,8 @@ namespace sandbox::app {
 void CheckLoadsInIsolation(const std::string& file, const scene::AssetConversion& conversion);
 
 // The child: `sandbox __load-level FILE [--up AXIS] [--unit-scale M]`. Writes
-// "reading PATH" before each file, then "ok" or "error MESSAGE", to `out`.
+// "started", "reading PATH" before each file, then "ok" or "error MESSAGE",
+// to `out`.
 int RunLoadLevelChild(const std::vector<std::string>& args, std::ostream& out);
 
 }  // namespace sandbox::app

@@ -415,15 +415,17 @@ void SandboxLoop::SubmitDueFrames(double t, TickRecord* record) {
 
 void SandboxLoop::PublishStatusIfDue(double t, std::int64_t now_utime) {
   // Which inputs are stale now (camera commands come only when someone steers).
-  std::vector<bool> stale;
+  bool changed = false;
+  stale_.resize(3 * robots_.size());
+  std::size_t i = 0;
   for (const RobotRun& robot : robots_) {
     for (const bridge::LatestInput* in :
          {&robot.inputs->pose(), &robot.inputs->bones(), &robot.inputs->actors()}) {
-      stale.push_back(in->Stale(now_utime, robot.config.stale_after_s));
+      const bool stale = in->Stale(now_utime, robot.config.stale_after_s);
+      changed = changed || stale != stale_[i];
+      stale_[i++] = stale;
     }
   }
-  const bool changed = stale != stale_;
-  stale_ = std::move(stale);
   if (t < next_status_s_ && !changed) return;
   next_status_s_ = t + 1.0;
   const double rate_now = t > 0.0 ? double(tick_) / t : 0.0;

@@ -2,6 +2,8 @@
 // writes its frames at its own rate, each listed in its index, with depth
 // where the manifest asks for it; bad options fail with a clear message.
 
+#include <sys/stat.h>
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -270,6 +272,34 @@ void CheckStopsCleanlyOn(const std::string& signal) {
 TEST(RunCommandTest, CtrlCFinishesVideosIndexesAndTheSummary) { CheckStopsCleanlyOn("INT"); }
 
 TEST(RunCommandTest, SigtermFinishesVideosIndexesAndTheSummary) { CheckStopsCleanlyOn("TERM"); }
+
+// A recording that cannot be written is reported at once and in the summary,
+// and the run says output was lost (exit 3); a FIFO is refused for the log
+// and for the replay, whose open would block.
+TEST(RunCommandTest, ARecordingThatCannotBeWrittenIsReported) {
+  const auto full = RunSandbox("run --duration 0.5 --lcm-url memq:// --record /dev/full");
+  EXPECT_EQ(full.exit_code, 3) << full.out;
+  EXPECT_NE(full.out.find("sandbox run: recording stopped: cannot write '/dev/full' after "),
+            std::string::npos)
+      << full.out;
+  EXPECT_NE(full.out.find("No space left on device"), std::string::npos) << full.out;
+  EXPECT_NE(full.out.find("(INCOMPLETE: cannot write '/dev/full'"), std::string::npos) << full.out;
+  sandbox::testing::TempDir dir;
+  const std::string fifo = (dir.path() / "pipe").string();
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  const auto record = RunSandbox("run --duration 0.1 --lcm-url memq:// --record " + fifo);
+  EXPECT_EQ(record.exit_code, 1) << record.out;
+  EXPECT_NE(record.out.find("cannot write the log '" + fifo + "': not a regular file"),
+            std::string::npos)
+      << record.out;
+  const auto replay = RunSandbox("run --replay " + fifo);
+  EXPECT_EQ(replay.exit_code, 1) << replay.out;
+  EXPECT_NE(replay.out.find("cannot read the LCM log '" + fifo + "': is a FIFO, not a regular file"),
+            std::string::npos)
+      << replay.out;
+  // /dev/null takes a recording.
+  EXPECT_EQ(RunSandbox("run --duration 0.1 --lcm-url memq:// --record /dev/null").exit_code, 0);
+}
 
 // Waits end at the end of --duration or on a signal, however long the period.
 TEST(RunCommandTest, AnyWaitEndsAtTheDurationOrOnASignal) {

@@ -1,8 +1,8 @@
 // Fuzz target: level files through the level loader (assimp for scene files;
 // our own readers for heightmap images and Terragen terrains). The bytes are
-// written to a file in memory-backed /dev/shm with the extension of one
-// format, chosen by the first byte among SANDBOX_FUZZ_FORMATS (a comma
-// list, e.g. "obj,ply"; default: all of kFormats). Every input loads or
+// written to a file in memory-backed /dev/shm (else the temporary folder)
+// with the extension of one format, chosen by the first byte among
+// SANDBOX_FUZZ_FORMATS (a comma list, e.g. "obj,ply"; default: all of kFormats). Every input loads or
 // gives one LevelError. A crash inside assimp stops this process: such
 // formats are listed in docs/reliability.md, and `sandbox --isolate`
 // contains them.
@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -44,8 +45,10 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;
   const std::string& format = Formats()[data[0] % Formats().size()];
-  const std::string file =
-      "/dev/shm/sandbox-fuzz-" + std::to_string(getpid()) + "." + format;
+  static const std::string folder =
+      std::filesystem::is_directory("/dev/shm") ? "/dev/shm"
+                                                : std::filesystem::temp_directory_path().string();
+  const std::string file = folder + "/sandbox-fuzz-" + std::to_string(getpid()) + "." + format;
   {
     std::ofstream out(file, std::ios::binary | std::ios::trunc);
     out.write(reinterpret_cast<const char*>(data + 1), std::streamsize(size - 1));
