@@ -37,6 +37,9 @@ TEST(ReplayTest, TwoReplaysGiveOneTickPerPoseAndIdenticalFrameIndexesAndScans) {
                                 " --scans-every 0.5");
     ASSERT_EQ(run.exit_code, 0) << run.out;
     EXPECT_NE(run.out.find("sandbox run: 120 ticks"), std::string::npos) << run.out;
+    // A replay runs flat out: it never asks for real-time priority (it would
+    // starve the machine); only paced runs do, and say so on their first line.
+    EXPECT_EQ(run.out.substr(0, run.out.find('\n')).find("priority"), std::string::npos) << run.out;
     EXPECT_NE(run.out.find("0 dropped, 0 failed"), std::string::npos) << run.out;  // lossless
   }
   // Cameras due by input time: chase 30 fps over 2.38 s of input is 72 frames.
