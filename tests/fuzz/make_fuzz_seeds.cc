@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -36,7 +37,9 @@ void Write(const fs::path& file, const Bytes& bytes) {
 
 Bytes Read(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::ostringstream contents;
+  contents << in.rdbuf();
+  return contents.str();
 }
 
 template <typename Message>

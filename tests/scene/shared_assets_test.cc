@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include "scene/collision_world.h"
 #include "scene/level.h"
@@ -81,6 +83,32 @@ TEST_F(SharedAssetsTest, Quake3MapHasRealTrianglesOnceRebuiltAndIsZUpInInches) {
     const auto hit = world.CastRay(from, box.center());
     ASSERT_TRUE(hit.has_value()) << from.transpose();
     EXPECT_TRUE(box.exteriorDistance(hit->point_W) < 0.01) << hit->point_W.transpose();
+  }
+}
+
+// A bit flipped in the map's compressed data: assimp's zip reader fails its
+// own check (ai_assert) on the CRC, which used to abort the process; now the
+// import fails with that check's text, and the program goes on.
+TEST_F(SharedAssetsTest, ABitFlippedQuake3MapIsAnErrorNotAnAbort) {
+  const fs::path map = Shared("q3-de4th-run1/de4th_run1.pk3");
+  std::ifstream in(map, std::ios::binary);
+  std::ostringstream contents;
+  contents << in.rdbuf();
+  std::string bytes = contents.str();
+  ASSERT_GT(bytes.size(), 500000u);
+  bytes[500000] = char(bytes[500000] ^ 0x10);  // inside the .bsp's deflated data
+  testing::TempDir dir;
+  const fs::path flipped = dir.Write("flipped.pk3", bytes);
+  try {
+    LoadLevel(flipped);
+    FAIL() << "the flipped map loaded";
+  } catch (const LevelError& error) {
+    EXPECT_EQ(std::string(error.what()).rfind(flipped.string() +
+                                                  ": assimp could not read it: assimp's check "
+                                                  "'unzCloseCurrentFile(zip_handle) == UNZ_OK' failed",
+                                              0),
+              0u)
+        << error.what();
   }
 }
 
