@@ -68,8 +68,9 @@ int RunBenchFrames(const std::vector<std::string>& args, std::ostream& out, std:
   }
   try {
     auto whole = [&](const std::string& option, int fallback) {
-      return parsed->values.count(option) ? int(ParseWhole(parsed->Value(option), option, 1, 1000000))
-                                          : fallback;
+      return parsed->values.count(option)
+                 ? int(ParseWhole(parsed->Value(option), option, 1, 1000000))
+                 : fallback;
     };
     const int frames = whole("--frames", 500), runs = whole("--runs", 3);
     const std::filesystem::path dir = parsed->Value("--out", "bench-frames");

@@ -38,7 +38,7 @@ void ApplyBones(const std::string& spec, const RobotModel& model, RobotState* st
     }
     if (bone < 0 || bone >= static_cast<int>(model.bones.size())) {
       throw UsageError("--bones: robot '" + model.name + "' has no bone '" + bone_word + "' (" +
-                         std::to_string(model.bones.size()) + " bones)");
+                       std::to_string(model.bones.size()) + " bones)");
     }
     const scene::Bone& b = model.bones[static_cast<std::size_t>(bone)];
     std::vector<double> values;
@@ -46,10 +46,10 @@ void ApplyBones(const std::string& spec, const RobotModel& model, RobotState* st
     while (words >> word) values.push_back(ParseNumber(word, "--bones " + bone_word));
     if (static_cast<int>(values.size()) != b.num_values) {
       throw UsageError("--bones: bone '" + b.name + "' takes " + std::to_string(b.num_values) +
-                         (b.rotation == scene::BoneRotation::kQuaternion
-                              ? " values (quaternion w x y z)"
-                              : " values (angles in degrees)") +
-                         ", got " + std::to_string(values.size()));
+                       (b.rotation == scene::BoneRotation::kQuaternion
+                            ? " values (quaternion w x y z)"
+                            : " values (angles in degrees)") +
+                       ", got " + std::to_string(values.size()));
     }
     if (b.rotation == scene::BoneRotation::kAngles) {
       for (double& v : values) v *= scene::kDegToRad;

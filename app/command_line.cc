@@ -77,7 +77,7 @@ Eigen::Isometry3d ParsePose(const std::string& text, const std::string& option) 
   const std::vector<double> v = ParseNumbers(text, option);
   if (v.size() != 3 && v.size() != 6) {
     throw UsageError(option + " takes X,Y,Z or X,Y,Z,ROLL,PITCH,YAW, got " +
-                       std::to_string(v.size()) + " numbers");
+                     std::to_string(v.size()) + " numbers");
   }
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
   X.translation() = Eigen::Vector3d(v[0], v[1], v[2]);

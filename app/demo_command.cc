@@ -177,7 +177,7 @@ int RunDemo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       run_args.insert(run_args.end(), {"--lcm-url", "memq://"});
       // The pilot keeps its own sequence number (it outlives this block).
       hooks.before_tick = [&status, seq = std::int64_t{0}](bridge::LcmLink& link,
-                                                         double wall_s) mutable {
+                                                           double wall_s) mutable {
         status.Poll(link);
         sandbox_msgs::robot_pose_t pose;
         sandbox_msgs::bone_values_t bones;

@@ -86,7 +86,8 @@ void FramePipeline::Submit(RenderJob job) {
       room_.wait(lock, [&] { return render_queue_.size() < config_.queue_capacity; });
       render_queue_.push_back(std::move(job));
     } else {
-      dropped_render_ += PushNewestPerCamera(&render_queue_, std::move(job), config_.queue_capacity);
+      dropped_render_ +=
+          PushNewestPerCamera(&render_queue_, std::move(job), config_.queue_capacity);
     }
   }
   render_wake_.notify_one();

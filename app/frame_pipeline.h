@@ -113,9 +113,9 @@ class FramePipeline {
       failed_{0};
   std::string first_error_;
   struct Video;
-  std::map<std::string, std::unique_ptr<Video>> videos_;           // write thread only
+  std::map<std::string, std::unique_ptr<Video>> videos_;     // write thread only
   std::map<std::string, std::unique_ptr<RowFile>> indexes_;  // write thread only
-  std::chrono::steady_clock::time_point retry_after_{};            // write thread only
+  std::chrono::steady_clock::time_point retry_after_{};      // write thread only
   std::thread render_thread_, write_thread_;
 };
 

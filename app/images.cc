@@ -57,7 +57,8 @@ sensors::TextureDecoder OpenCvTextureDecoder(const scene::LoadLimits& limits) {
                  : std::string();
     };
     if (embedded != nullptr && embedded->height > 0) {  // raw RGBA texels
-      if (std::string problem = too_big(std::uint64_t(embedded->width), std::uint64_t(embedded->height));
+      if (std::string problem =
+              too_big(std::uint64_t(embedded->width), std::uint64_t(embedded->height));
           !problem.empty()) {
         return problem;
       }
@@ -78,7 +79,8 @@ sensors::TextureDecoder OpenCvTextureDecoder(const scene::LoadLimits& limits) {
       }
       file_bytes.resize(scene::FileBytes(path));
       std::ifstream in(path, std::ios::binary);
-      if (!in.read(reinterpret_cast<char*>(file_bytes.data()), std::streamsize(file_bytes.size()))) {
+      if (!in.read(reinterpret_cast<char*>(file_bytes.data()),
+                   std::streamsize(file_bytes.size()))) {
         return "cannot be read";
       }
       bytes = &file_bytes;

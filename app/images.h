@@ -5,7 +5,6 @@
 #include <string>
 
 #include "scene/load_limits.h"
-
 #include "sensors/renderer.h"
 
 namespace sandbox::app {

@@ -55,7 +55,8 @@ void CheckLoadsInIsolation(const std::string& file, const scene::AssetConversion
   if (length <= 0) throw scene::LevelError(file + ": cannot find this program to load it apart");
   self[length] = '\0';
   std::vector<std::string> argv_strings = {self, "__load-level", file};
-  if (conversion.up) argv_strings.insert(argv_strings.end(), {"--up", scene::ToString(*conversion.up)});
+  if (conversion.up)
+    argv_strings.insert(argv_strings.end(), {"--up", scene::ToString(*conversion.up)});
   if (conversion.unit_scale_m) {
     std::ostringstream scale;
     scale.precision(17);
@@ -90,8 +91,8 @@ void CheckLoadsInIsolation(const std::string& file, const scene::AssetConversion
   // time in wall time: then it is waiting on something and is killed).
   std::string said, reading, error;
   bool started = false;
-  const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::seconds(2 * limits.max_import_s + 10);
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::seconds(2 * limits.max_import_s + 10);
   bool timed_out = false;
   for (;;) {
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
@@ -130,8 +131,9 @@ void CheckLoadsInIsolation(const std::string& file, const scene::AssetConversion
   if (WIFEXITED(status) && !error.empty()) throw scene::LevelError(error);
   if (!started) {
     throw scene::LevelError(file + ": the process that loads it apart could not start (" +
-                            (WIFSIGNALED(status) ? SignalName(WTERMSIG(status))
-                                                 : "exit code " + std::to_string(WEXITSTATUS(status))) +
+                            (WIFSIGNALED(status)
+                                 ? SignalName(WTERMSIG(status))
+                                 : "exit code " + std::to_string(WEXITSTATUS(status))) +
                             "); [level] max_import_mb = " + std::to_string(limits.max_import_mb) +
                             " may be below what the program itself needs (about 600)");
   }

@@ -9,8 +9,8 @@
 
 #include "app/bone_values.h"
 #include "app/command_line.h"
-#include "app/loaded_level.h"
 #include "app/defaults.h"
+#include "app/loaded_level.h"
 #include "scene/level.h"
 #include "scene/robot_state.h"
 
@@ -87,9 +87,8 @@ void WriteBoneFrames(const fs::path& file, const RobotState& state) {
 }  // namespace
 
 int RunPose(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  const auto parsed =
-      ParseArgs(args, "pose", {"--robot", "--robot-pose", "--bones", "--out"}, {"--isolate"}, kUsage,
-                err);
+  const auto parsed = ParseArgs(args, "pose", {"--robot", "--robot-pose", "--bones", "--out"},
+                                {"--isolate"}, kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
     out << kUsage;
@@ -104,7 +103,8 @@ int RunPose(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     return 2;
   }
   try {
-    const LoadedLevel loaded = LoadCheckedLevel(level_file, {}, parsed->flags.count("--isolate") > 0);
+    const LoadedLevel loaded =
+        LoadCheckedLevel(level_file, {}, parsed->flags.count("--isolate") > 0);
     const scene::Level& level = loaded.level;
     if (level.robots.empty()) throw CommandError(level_file + ": the level declares no [[robot]]");
     const int robot = robot_name.empty() ? 0 : level.FindRobot(robot_name);

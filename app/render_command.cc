@@ -7,9 +7,9 @@
 
 #include "app/bone_values.h"
 #include "app/command_line.h"
-#include "app/loaded_level.h"
 #include "app/defaults.h"
 #include "app/images.h"
+#include "app/loaded_level.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
 #include "sensors/cameras.h"
@@ -108,8 +108,7 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
     if (!level.robots.empty()) {
       const int index =
           parsed->Value("--robot").empty() ? 0 : level.FindRobot(parsed->Value("--robot"));
-      if (index < 0)
-        throw UsageError("the level has no robot '" + parsed->Value("--robot") + "'");
+      if (index < 0) throw UsageError("the level has no robot '" + parsed->Value("--robot") + "'");
       robot_index = index;
       robot = std::make_unique<scene::RobotState>(level.robots[std::size_t(index)]);
       if (camera != "fixed" && !robot->SetPose(X_at)) {
@@ -141,9 +140,8 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
     if (robot) robots.push_back(robot.get());
     sensors::Overlay overlay;
     if (parsed->flags.count("--overlay")) {
-      const double stub_m = parsed->values.count("--stub")
-                                ? ParseNumber(parsed->Value("--stub"), "--stub")
-                                : 0.0;
+      const double stub_m =
+          parsed->values.count("--stub") ? ParseNumber(parsed->Value("--stub"), "--stub") : 0.0;
       BuildOverlay(level, robot_index, robot.get(), stub_m, &overlay);
     }
     renderer->Render(view, {}, robots, {}, &frame, &overlay);

@@ -37,7 +37,8 @@ bool RowFile::Flush() {
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) {
       // Cut back to the last whole row; these rows are lost.
-      if (error_.empty()) error_ = "cannot write " + path_ + ": " + std::strerror(errno ? errno : EIO);
+      if (error_.empty())
+        error_ = "cannot write " + path_ + ": " + std::strerror(errno ? errno : EIO);
       if (::ftruncate(fd_, whole_bytes_) != 0 || ::lseek(fd_, whole_bytes_, SEEK_SET) < 0) {
         // The file keeps a cut row; nothing more can be done about it here.
       }

@@ -90,8 +90,7 @@ RunOptions ParseRunOptions(const ParsedArgs& args) {
   options.frames.depth_format = args.Value("--depth", "png");
   if (options.frames.depth_format != "png" && options.frames.depth_format != "npy" &&
       options.frames.depth_format != "exr") {
-    throw UsageError("--depth must be png, npy or exr, got '" + options.frames.depth_format +
-                       "'");
+    throw UsageError("--depth must be png, npy or exr, got '" + options.frames.depth_format + "'");
   }
   options.scans_every_s = number("--scans-every", 0.0);
   if (args.values.count("--scans-every") &&

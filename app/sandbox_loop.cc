@@ -230,9 +230,9 @@ int SandboxLoop::Run() {
     PublishStatusIfDue(t, now);
     ReportRecordingFailure();
     if (const auto stall = options_.stalls_ms.find(tick_); stall != options_.stalls_ms.end()) {
-      StopSignal::SleepUntil(Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                                std::chrono::duration<double, std::milli>(
-                                                    stall->second)));
+      StopSignal::SleepUntil(Clock::now() +
+                             std::chrono::duration_cast<Clock::duration>(
+                                 std::chrono::duration<double, std::milli>(stall->second)));
     }
     ++tick_;
     // 6. Record the tick; wait for the next (or the end of the run, or a stop).

@@ -8,8 +8,8 @@
 #include <sstream>
 
 #include "app/command_line.h"
-#include "app/loaded_level.h"
 #include "app/defaults.h"
+#include "app/loaded_level.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
 #include "sensors/face_scanner.h"
@@ -113,7 +113,8 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     const double res = resolution.empty() ? 1.0 : Positive(resolution, "--resolution");
     const double extent = half_extent.empty() ? 25.0 : Positive(half_extent, "--half-extent");
 
-    const LoadedLevel loaded = LoadCheckedLevel(level_file, {}, parsed->flags.count("--isolate") > 0);
+    const LoadedLevel loaded =
+        LoadCheckedLevel(level_file, {}, parsed->flags.count("--isolate") > 0);
     const scene::Level& level = loaded.level;
     const scene::CollisionWorld world(level);
     sensors::RayCaster caster;

@@ -48,8 +48,8 @@ int RunTopics(const std::vector<std::string>& args, std::ostream& out, std::ostr
         << "mean bytes"
         << "\n";
     for (const auto& [channel, s] : stats) {
-      out << std::left << std::setw(24) << bridge::Printable(channel, 64) << std::setw(20)
-          << s.type << std::right << std::setw(10) << s.messages << std::setw(10) << std::fixed
+      out << std::left << std::setw(24) << bridge::Printable(channel, 64) << std::setw(20) << s.type
+          << std::right << std::setw(10) << s.messages << std::setw(10) << std::fixed
           << std::setprecision(1) << s.rate_hz() << std::setw(12) << std::setprecision(0)
           << double(s.bytes) / double(s.messages) << "\n";
     }

@@ -45,7 +45,8 @@ class WireReader {
   // `count` items of `item_bytes` each.
   void Array(std::int64_t count, std::size_t item_bytes, const char* field) {
     const auto bytes = std::uint64_t(count) * item_bytes;
-    if (error_.empty() && bytes > size_ - at_) return Fail(std::string(field) + " runs past the end");
+    if (error_.empty() && bytes > size_ - at_)
+      return Fail(std::string(field) + " runs past the end");
     at_ += std::size_t(bytes);
   }
   // `count` strings: an int32 length that counts the terminating '\0', then
@@ -190,8 +191,8 @@ std::string DecodeChecked(const std::uint8_t* data, std::size_t size, Message* m
   return "";
 }
 
-#define SANDBOX_CHECKED_DECODE(Type)                                                      \
-  template std::string CheckLayout<Type>(const std::uint8_t*, std::size_t);               \
+#define SANDBOX_CHECKED_DECODE(Type)                                        \
+  template std::string CheckLayout<Type>(const std::uint8_t*, std::size_t); \
   template std::string DecodeChecked<Type>(const std::uint8_t*, std::size_t, Type*);
 
 SANDBOX_CHECKED_DECODE(actor_placements_t)

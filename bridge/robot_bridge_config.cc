@@ -107,8 +107,9 @@ std::vector<RobotBridgeConfig> RobotBridgeConfigs(const scene::Level& level) {
                                       config.channel_prefix + "' of robot '" + it->second +
                                       "'; give one of them its own 'channel_prefix'");
     }
-    for (const auto& [key, value] : {std::pair<const char*, int>{"net_fdm_port", config.net_fdm_port},
-                                     {"udp_doubles_port", config.udp_doubles_port}}) {
+    for (const auto& [key, value] :
+         {std::pair<const char*, int>{"net_fdm_port", config.net_fdm_port},
+          {"udp_doubles_port", config.udp_doubles_port}}) {
       if (value == 0) continue;
       if (const auto [it, fresh] = ports.emplace(value, model.name); !fresh) {
         read.Fail(key, "port " + std::to_string(value) + " is taken by robot '" + it->second + "'");

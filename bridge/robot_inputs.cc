@@ -97,8 +97,8 @@ std::string RobotInputs::ParseBones(const std::uint8_t* data, std::size_t size,
            std::to_string(message.num_values);
   }
   for (const scene::Bone& bone : model.bones) {
-    const std::string problem =
-        scene::BoneValuesProblem(bone, &message.values[std::size_t(bone.first_value)], bone.num_values);
+    const std::string problem = scene::BoneValuesProblem(
+        bone, &message.values[std::size_t(bone.first_value)], bone.num_values);
     if (!problem.empty()) return problem;
   }
   *values = std::move(message.values);
@@ -126,8 +126,7 @@ std::string RobotInputs::ParsePlacements(const std::uint8_t* data, std::size_t s
     if (!AllFinite(p, 3) || !AllFinite(o, 4)) return "non-finite placement";
     const Eigen::Quaterniond q(o[0], o[1], o[2], o[3]);
     if (std::abs(q.norm() - 1.0) > 1e-3) return "non-unit quaternion";
-    placements->X_WA.emplace_back(actor,
-                                  Eigen::Translation3d(p[0], p[1], p[2]) * q.normalized());
+    placements->X_WA.emplace_back(actor, Eigen::Translation3d(p[0], p[1], p[2]) * q.normalized());
   }
   return "";
 }

@@ -14,7 +14,9 @@
 namespace sandbox::bridge {
 
 UdpLatest::UdpLatest(const std::string& address, int port, MessageCheck check)
-    : name_("udp:" + address + ":" + std::to_string(port)), check_(std::move(check)), buffer_(65536) {
+    : name_("udp:" + address + ":" + std::to_string(port)),
+      check_(std::move(check)),
+      buffer_(65536) {
   socket_ = ::socket(AF_INET, SOCK_DGRAM, 0);
   sockaddr_in where{};
   where.sin_family = AF_INET;

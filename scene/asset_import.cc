@@ -355,8 +355,9 @@ void CheckGlbHeader(const fs::path& file) {
     throw LevelError(file.string() + ": not a binary glTF (no 12-byte 'glTF' header)");
   }
   if (LittleEndian32(header + 8) != size) {
-    throw LevelError(file.string() + ": its header says " + std::to_string(LittleEndian32(header + 8)) +
-                     " bytes, the file has " + std::to_string(size));
+    throw LevelError(file.string() + ": its header says " +
+                     std::to_string(LittleEndian32(header + 8)) + " bytes, the file has " +
+                     std::to_string(size));
   }
   // Every chunk within the file.
   std::uint64_t at = 12;

@@ -33,7 +33,6 @@ struct AssimpScene {
 AssimpScene ReadAssimpScene(Assimp::Importer& importer, const std::filesystem::path& file,
                             const AssetConversion& conversion, const LoadLimits& limits);
 
-
 // The triangles of `mesh`; counts skipped points and lines in `non_triangles`.
 Mesh ConvertMesh(const aiMesh& mesh, std::size_t* non_triangles);
 

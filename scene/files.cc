@@ -13,14 +13,16 @@ namespace sandbox::scene {
 std::string RegularFileProblem(const std::filesystem::path& file) {
   struct stat info {};
   if (::stat(file.c_str(), &info) != 0) {
-    return errno == ENOENT ? "no such file" : std::string("cannot be read: ") + std::strerror(errno);
+    return errno == ENOENT ? "no such file"
+                           : std::string("cannot be read: ") + std::strerror(errno);
   }
   if (S_ISDIR(info.st_mode)) return "is a folder, not a file";
   if (S_ISFIFO(info.st_mode)) return "is a FIFO, not a regular file";
   if (S_ISSOCK(info.st_mode)) return "is a socket, not a regular file";
   if (S_ISCHR(info.st_mode) || S_ISBLK(info.st_mode)) return "is a device, not a regular file";
   if (!S_ISREG(info.st_mode)) return "is not a regular file";
-  if (::access(file.c_str(), R_OK) != 0) return std::string("cannot be read: ") + std::strerror(errno);
+  if (::access(file.c_str(), R_OK) != 0)
+    return std::string("cannot be read: ") + std::strerror(errno);
   return "";
 }
 

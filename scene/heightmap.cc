@@ -27,8 +27,7 @@ std::vector<std::uint8_t> ReadAll(const fs::path& file, const LoadLimits& limits
 void CheckSamples(const fs::path& file, std::uint64_t cols, std::uint64_t rows,
                   const LoadLimits& limits) {
   LoadLimits::Check(file,
-                    "a grid of " + std::to_string(cols) + " x " + std::to_string(rows) +
-                        " samples",
+                    "a grid of " + std::to_string(cols) + " x " + std::to_string(rows) + " samples",
                     cols * rows, limits.max_heightmap_samples, "max_heightmap_samples");
 }
 
@@ -159,7 +158,8 @@ std::vector<float> ReadPgm(const fs::path& file, int* cols, int* rows, const Loa
   // values at most 65535).
   auto number = [&](const char* what) {
     const std::string text = token();
-    if (text.empty() || text.size() > 6 || text.find_first_not_of("0123456789") != std::string::npos) {
+    if (text.empty() || text.size() > 6 ||
+        text.find_first_not_of("0123456789") != std::string::npos) {
       throw LevelError(file.string() + ": PGM header: " + what + " '" + text.substr(0, 16) +
                        "' is not a number up to 999999");
     }

@@ -35,7 +35,7 @@ ImportedAsset ImportTerragen(const std::filesystem::path& file, const AssetConve
 // height of the brightest value). The first channel is the height. The size
 // the image header states is checked against limits.max_heightmap_samples
 // before the image is decoded.
-ImportedAsset ImportHeightmapImage(const std::filesystem::path& file,
-                                   const Eigen::Vector3d& size_m, const LoadLimits& limits = {});
+ImportedAsset ImportHeightmapImage(const std::filesystem::path& file, const Eigen::Vector3d& size_m,
+                                   const LoadLimits& limits = {});
 
 }  // namespace sandbox::scene

@@ -108,8 +108,8 @@ Level LoadManifest(const fs::path& file, const LoadOptions& options) {
                     ? ImportHeightmapImage(spec.file, spec.heightmap_size_m, level.limits)
                     : ImportAsset(spec.file, spec.placement.conversion, level.limits);
       } catch (const LevelError& error) {
-        throw LevelError(file.string() + ":" + std::to_string(spec.line) + ": actor '" +
-                         spec.name + "': " + error.what());
+        throw LevelError(file.string() + ":" + std::to_string(spec.line) + ": actor '" + spec.name +
+                         "': " + error.what());
       }
       AdoptMaterialsAndWarnings(&asset, &level);
       read = read_once.emplace(AssetKey(spec), std::move(asset)).first;
@@ -197,8 +197,8 @@ Level LoadLevel(const fs::path& file, const LoadOptions& options) {
   if (const std::string problem = RegularFileProblem(file); !problem.empty()) {
     throw LevelError(file.string() + ": " + problem);
   }
-  Level level = LowerExtension(file) == ".toml" ? LoadManifest(file, options)
-                                                : LoadSceneFile(file, options);
+  Level level =
+      LowerExtension(file) == ".toml" ? LoadManifest(file, options) : LoadSceneFile(file, options);
   CheckTriangles(file, level);
   for (Actor& actor : level.actors) ComputeBounds(&actor);
   return level;

@@ -12,7 +12,7 @@
 namespace sandbox::scene {
 
 struct LoadLimits {
-  std::uint64_t max_file_mb{2048};               // any one file the level reads
+  std::uint64_t max_file_mb{2048};                // any one file the level reads
   std::uint64_t max_heightmap_samples{1u << 24};  // one heightmap's points (4096 x 4096)
   std::uint64_t max_texture_pixels{1u << 26};     // one texture, decoded (8192 x 8192)
   std::uint64_t max_triangles{50'000'000};        // the whole level, robots included

@@ -263,8 +263,7 @@ class OsMesaRenderer : public Renderer {
           lightmaps_[int(m)] = UploadTexture(image, GL_CLAMP_TO_EDGE);
         } else {
           warnings_.push_back("material '" + material.name + "': its lightmap cannot be read (" +
-                              (problem.empty() ? "empty" : problem) +
-                              "); lit by the sun instead");
+                              (problem.empty() ? "empty" : problem) + "); lit by the sun instead");
         }
       }
     }

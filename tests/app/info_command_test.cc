@@ -76,9 +76,9 @@ TEST(InfoCommandTest, BadLevelsExitOneWithOneMessage) {
 // with the same message.
 TEST(InfoCommandTest, WhatRunRefusesInfoRefusesWithTheSameMessage) {
   sandbox::testing::TempDir dir;
-  const std::string robots = (std::filesystem::path(SANDBOX_SOURCE_DIR) /
-                              "assets/robots/generated/flying_wing.gltf")
-                                 .string();
+  const std::string robots =
+      (std::filesystem::path(SANDBOX_SOURCE_DIR) / "assets/robots/generated/flying_wing.gltf")
+          .string();
   auto level = [&](const std::string& name, const std::string& robot_tables) {
     return dir.Write(name, robot_tables).string();
   };
@@ -87,13 +87,13 @@ TEST(InfoCommandTest, WhatRunRefusesInfoRefusesWithTheSameMessage) {
   };
   const std::vector<std::pair<std::string, std::string>> cases = {
       // Two robots on one channel prefix.
-      {level("prefix.toml", robot("A", "") + robot("B", "[robot.bridge]\nchannel_prefix = \"A\"\n")),
+      {level("prefix.toml",
+             robot("A", "") + robot("B", "[robot.bridge]\nchannel_prefix = \"A\"\n")),
        ":8: robot 'B' bridge: robot 'B' would use the channel prefix 'A' of robot 'A'; give one "
        "of them its own 'channel_prefix'"},
       // A port taken by another robot, and a bind address that is none.
-      {level("ports.toml",
-             robot("A", "[robot.bridge]\nnet_fdm_port = 5600\n") +
-                 robot("B", "[robot.bridge]\nudp_doubles_port = 5600\n")),
+      {level("ports.toml", robot("A", "[robot.bridge]\nnet_fdm_port = 5600\n") +
+                               robot("B", "[robot.bridge]\nudp_doubles_port = 5600\n")),
        ":10: robot 'B' bridge: port 5600 is taken by robot 'A'"},
       {level("address.toml", robot("A", "[robot.bridge]\nbind_address = \"localhost\"\n")),
        ":5: robot 'A' bridge: 'bind_address' must be an IPv4 address like 127.0.0.1, got "
@@ -103,8 +103,9 @@ TEST(InfoCommandTest, WhatRunRefusesInfoRefusesWithTheSameMessage) {
              robot("A", "[robot.bridge]\nudp_doubles_layout = [\"position\", \"position\"]\n")),
        ":5: robot 'A' bridge: 'udp_doubles_layout' names 'position' twice"},
       // A camera of 100000 pixels a side.
-      {level("camera.toml", robot("A", "[[robot.camera]]\nname = \"c\"\ntype = \"chase\"\n"
-                                       "width = 100000\n")),
+      {level("camera.toml", robot("A",
+                                  "[[robot.camera]]\nname = \"c\"\ntype = \"chase\"\n"
+                                  "width = 100000\n")),
        ":4: camera 'c': resolution must be 1 to 8192 pixels a side, got 100000 x 480"}};
   for (const auto& [file, message] : cases) {
     const CommandRun info = Sandbox("info " + file);

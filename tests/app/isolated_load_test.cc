@@ -71,11 +71,10 @@ TEST(IsolatedLoadTest, AnImportOverItsMemoryLimitIsAnErrorNamingTheLimit) {
   // A 2048 x 2048 heightmap takes about 300 MB as a mesh; the program itself
   // about 600 MB of address space. 700 MB is too little for both.
   dir.Write("land.pgm", "P5\n2048 2048\n255\n" + std::string(2048 * 2048, '\x40'));
-  const std::string tight =
-      dir.Write("tight.toml",
-                "[level]\nmax_import_mb = 700\n[[actor]]\nname = \"land\"\n"
-                "heightmap = \"land.pgm\"\nsize = [100, 100, 10]\n")
-          .string();
+  const std::string tight = dir.Write("tight.toml",
+                                      "[level]\nmax_import_mb = 700\n[[actor]]\nname = \"land\"\n"
+                                      "heightmap = \"land.pgm\"\nsize = [100, 100, 10]\n")
+                                .string();
   const auto limited = RunSandbox("info " + tight + " --isolate");
   EXPECT_EQ(limited.exit_code, 1) << limited.out;
   EXPECT_NE(limited.out.find("land.pgm: importing it needed more than 700 MB ([level] "

@@ -2,9 +2,8 @@
 // writes its frames at its own rate, each listed in its index, with depth
 // where the manifest asks for it; bad options fail with a clear message.
 
-#include <sys/stat.h>
-
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -132,8 +131,8 @@ TEST(RunCommandTest, PayloadDepthBackProjectsOntoTheTerrainThroughTheIndexedPose
   sandbox::testing::TempDir dir;
   const std::string log = (dir.path() / "hover.lcmlog").string();
   sandbox::testing::WriteFlightLog(log, 3, 20'000, 0.0);  // over the origin, 60 m up
-  const auto run = RunSandbox("run --replay " + log + " --frames png --out " +
-                              (dir.path() / "out").string());
+  const auto run =
+      RunSandbox("run --replay " + log + " --frames png --out " + (dir.path() / "out").string());
   ASSERT_EQ(run.exit_code, 0) << run.out;
   const std::vector<IndexRow> rows = ReadIndex(dir.path() / "out" / "belly.csv");
   ASSERT_FALSE(rows.empty());
@@ -294,8 +293,9 @@ TEST(RunCommandTest, ARecordingThatCannotBeWrittenIsReported) {
       << record.out;
   const auto replay = RunSandbox("run --replay " + fifo);
   EXPECT_EQ(replay.exit_code, 1) << replay.out;
-  EXPECT_NE(replay.out.find("cannot read the LCM log '" + fifo + "': is a FIFO, not a regular file"),
-            std::string::npos)
+  EXPECT_NE(
+      replay.out.find("cannot read the LCM log '" + fifo + "': is a FIFO, not a regular file"),
+      std::string::npos)
       << replay.out;
   // /dev/null takes a recording.
   EXPECT_EQ(RunSandbox("run --duration 0.1 --lcm-url memq:// --record /dev/null").exit_code, 0);
@@ -306,8 +306,8 @@ TEST(RunCommandTest, AnyWaitEndsAtTheDurationOrOnASignal) {
   const auto slow = RunSandbox("run --rate 0.01 --duration 1 --lcm-url memq://");
   ASSERT_EQ(slow.exit_code, 0) << slow.out;
   std::smatch elapsed;
-  ASSERT_TRUE(std::regex_search(slow.out, elapsed,
-                                std::regex(R"(sandbox run: 1 ticks in ([0-9.]+) s)")))
+  ASSERT_TRUE(
+      std::regex_search(slow.out, elapsed, std::regex(R"(sandbox run: 1 ticks in ([0-9.]+) s)")))
       << slow.out;
   EXPECT_LT(std::stod(elapsed[1]), 30.0);  // not the 100 s period
   // SIGINT in the middle of a 100 s wait, once the loop has started.
@@ -346,8 +346,8 @@ TEST(RunCommandTest, BadFrameOptionsFailClearly) {
             std::string::npos)
       << stall.out;
   for (const char* value : {"-3", "1e-9", "1e9", "nan", "''"}) {
-    const auto rate = RunSandbox("run --duration 0.1 --lcm-url memq:// --rate " +
-                                 std::string(value));
+    const auto rate =
+        RunSandbox("run --duration 0.1 --lcm-url memq:// --rate " + std::string(value));
     EXPECT_EQ(rate.exit_code, 2) << value;
     EXPECT_NE(rate.out.find("--rate"), std::string::npos) << rate.out;
   }

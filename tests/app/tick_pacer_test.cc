@@ -5,12 +5,12 @@
 
 #include "app/tick_pacer.h"
 
-#include "app/rate_schedule.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
+
+#include "app/rate_schedule.h"
 
 namespace sandbox::app {
 namespace {

@@ -207,8 +207,7 @@ TEST(CheckedDecodeTest, HostileCountsAreRefusedBeforeTheGeneratedDecoderSeesThem
   actors.num_orientations = 4, actors.orientations = {1, 0, 0, 0};
   const Bytes good = Encode(actors);
   const std::size_t length_at = 8 + 16 + 4;  // fingerprint, utime, seq, num_actors
-  for (const auto& [length, reason] :
-       std::vector<std::pair<std::int32_t, std::string>>{
+  for (const auto& [length, reason] : std::vector<std::pair<std::int32_t, std::string>>{
            {0, "names has a string without its '\\0'"},
            {-5, "names is negative"},
            {1 << 30, "names runs past the end"},

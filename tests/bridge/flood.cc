@@ -66,8 +66,10 @@ Bytes Bad(int kind, std::mt19937& random) {
   camera.zoom = 1;
   switch (kind) {
     case 0:  // NaN, or a long quaternion
-      if (what % 2) pose.position[0] = std::nan("");
-      else pose.orientation[1] = 1;
+      if (what % 2)
+        pose.position[0] = std::nan("");
+      else
+        pose.orientation[1] = 1;
       return Encode(pose);
     case 1:  // a negative or huge count, or the wrong number of values
       bones.num_values = 3, bones.values = {0, 0, 0};

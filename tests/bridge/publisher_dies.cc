@@ -21,9 +21,9 @@
 #include <lcm/lcm-cpp.hpp>
 #include <string>
 
-#include "bridge/checked_decode.h"
 #include "sandbox_msgs/robot_state_t.hpp"
 #include "sandbox_msgs/status_t.hpp"
+#include "tests/bridge/receive.h"
 
 extern char** environ;
 
@@ -52,9 +52,7 @@ struct Watch {
 
   void OnState(const lcm::ReceiveBuffer* buffer, const std::string&) {
     sandbox_msgs::robot_state_t m;
-    if (!sandbox::bridge::DecodeChecked(static_cast<const std::uint8_t*>(buffer->data),
-                                        buffer->data_size, &m)
-             .empty()) {
+    if (!sandbox::testing::Decode(buffer, &m)) {
       return;
     }
     last_state = m;
@@ -67,9 +65,7 @@ struct Watch {
   }
   void OnStatus(const lcm::ReceiveBuffer* buffer, const std::string&) {
     sandbox_msgs::status_t m;
-    if (!sandbox::bridge::DecodeChecked(static_cast<const std::uint8_t*>(buffer->data),
-                                        buffer->data_size, &m)
-             .empty()) {
+    if (!sandbox::testing::Decode(buffer, &m)) {
       return;
     }
     for (int c = 0; c < m.num_channels; ++c) {

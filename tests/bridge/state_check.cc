@@ -18,9 +18,9 @@
 #include <lcm/lcm-cpp.hpp>
 #include <string>
 
-#include "bridge/checked_decode.h"
 #include "sandbox_msgs/robot_state_t.hpp"
 #include "sandbox_msgs/status_t.hpp"
+#include "tests/bridge/receive.h"
 
 struct Watch {
   std::string robot;
@@ -34,9 +34,7 @@ struct Watch {
 
   void OnState(const lcm::ReceiveBuffer* buffer, const std::string&) {
     sandbox_msgs::robot_state_t m;
-    if (!sandbox::bridge::DecodeChecked(static_cast<const std::uint8_t*>(buffer->data),
-                                        buffer->data_size, &m)
-             .empty() ||
+    if (!sandbox::testing::Decode(buffer, &m) ||
         m.input_seq <= 0) {  // not a state, or still the spawn pose
       return;
     }
@@ -50,9 +48,7 @@ struct Watch {
   }
   void OnStatus(const lcm::ReceiveBuffer* buffer, const std::string&) {
     sandbox_msgs::status_t m;
-    if (!sandbox::bridge::DecodeChecked(static_cast<const std::uint8_t*>(buffer->data),
-                                        buffer->data_size, &m)
-             .empty()) {
+    if (!sandbox::testing::Decode(buffer, &m)) {
       return;
     }
     for (int c = 0; c < m.num_channels; ++c) {
@@ -106,8 +102,8 @@ int main(int argc, char** argv) {
   } else {
     std::printf(
         "state_check: robot at (%.3f, %.3f, %.3f), expected (%.3f, %.3f, %.3f), off by %.4f m\n",
-        watch.p[0], watch.p[1], watch.p[2], watch.expected[0], watch.expected[1],
-        watch.expected[2], watch.Error());
+        watch.p[0], watch.p[1], watch.p[2], watch.expected[0], watch.expected[1], watch.expected[2],
+        watch.Error());
   }
   return watch.there ? 0 : 1;
 }

@@ -2,10 +2,9 @@
 // our own readers for heightmap images and Terragen terrains). The bytes are
 // written to a file in memory-backed /dev/shm (else the temporary folder)
 // with the extension of one format, chosen by the first byte among
-// SANDBOX_FUZZ_FORMATS (a comma list, e.g. "obj,ply"; default: all of kFormats). Every input loads or
-// gives one LevelError. A crash inside assimp stops this process: such
-// formats are listed in docs/reliability.md, and `sandbox --isolate`
-// contains them.
+// SANDBOX_FUZZ_FORMATS (a comma list, e.g. "obj,ply"; default: all of kFormats). Every input loads
+// or gives one LevelError. A crash inside assimp stops this process: such formats are listed in
+// docs/reliability.md, and `sandbox --isolate` contains them.
 
 #include <unistd.h>
 
@@ -22,8 +21,8 @@
 
 namespace {
 
-const char* kFormats[] = {"obj", "ply", "stl", "off", "gltf", "glb", "dae", "fbx", "3ds",
-                          "x",   "3mf", "pk3", "ter", "png", "pgm"};
+const char* kFormats[] = {"obj", "ply", "stl", "off", "gltf", "glb", "dae", "fbx",
+                          "3ds", "x",   "3mf", "pk3", "ter",  "png", "pgm"};
 
 std::vector<std::string>& Formats() {
   static std::vector<std::string> formats;
@@ -45,9 +44,9 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;
   const std::string& format = Formats()[data[0] % Formats().size()];
-  static const std::string folder =
-      std::filesystem::is_directory("/dev/shm") ? "/dev/shm"
-                                                : std::filesystem::temp_directory_path().string();
+  static const std::string folder = std::filesystem::is_directory("/dev/shm")
+                                        ? "/dev/shm"
+                                        : std::filesystem::temp_directory_path().string();
   const std::string file = folder + "/sandbox-fuzz-" + std::to_string(getpid()) + "." + format;
   {
     std::ofstream out(file, std::ios::binary | std::ios::trunc);

@@ -39,7 +39,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   bridge::RobotBridgeConfig config;
   config.udp_doubles_layout = layouts[data[0] % layouts.size()];
   config.udp_doubles_big_endian = (data[0] & 0x10) != 0;
-  config.pose.convention = (data[0] & 0x20) != 0 ? bridge::Convention::kNed : bridge::Convention::kEnu;
+  config.pose.convention =
+      (data[0] & 0x20) != 0 ? bridge::Convention::kNed : bridge::Convention::kEnu;
   Wing& wing = TheWing();
   Eigen::Isometry3d X_WB;
   std::vector<double> bones;

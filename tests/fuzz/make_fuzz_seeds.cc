@@ -141,8 +141,8 @@ Bytes StoredZip(const std::string& name, const Bytes& data) {
 // Level files: a textured box exported by assimp in each format it writes,
 // and hand-made files of the rest. The first byte picks the format.
 void LevelFileSeeds(const fs::path& dir) {
-  const char* formats[] = {"obj", "ply", "stl", "off", "gltf", "glb", "dae", "fbx", "3ds",
-                           "x",   "3mf", "pk3", "ter", "png", "pgm"};
+  const char* formats[] = {"obj", "ply", "stl", "off", "gltf", "glb", "dae", "fbx",
+                           "3ds", "x",   "3mf", "pk3", "ter",  "png", "pgm"};
   auto index = [&](const std::string& format) {
     for (std::size_t i = 0; i < std::size(formats); ++i) {
       if (format == formats[i]) return char(i);
@@ -166,27 +166,25 @@ void LevelFileSeeds(const fs::path& dir) {
   }
   Assimp::Exporter exporter;
   const std::pair<const char*, const char*> exports[] = {
-      {"ply", "ply"}, {"plyb", "ply"},  {"stl", "stl"}, {"stlb", "stl"}, {"gltf2", "gltf"},
-      {"glb2", "glb"}, {"collada", "dae"}, {"fbx", "fbx"}, {"fbxa", "fbx"}, {"3ds", "3ds"},
-      {"x", "x"},     {"3mf", "3mf"}};
+      {"ply", "ply"},    {"plyb", "ply"}, {"stl", "stl"},     {"stlb", "stl"},
+      {"gltf2", "gltf"}, {"glb2", "glb"}, {"collada", "dae"}, {"fbx", "fbx"},
+      {"fbxa", "fbx"},   {"3ds", "3ds"},  {"x", "x"},         {"3mf", "3mf"}};
   for (const auto& [id, format] : exports) {
     const aiExportDataBlob* blob = exporter.ExportToBlob(scene, id);
     if (blob == nullptr) {
       std::fprintf(stderr, "make_fuzz_seeds: no %s export: %s\n", id, exporter.GetErrorString());
       continue;
     }
-    seed(format, std::string("box.") + id,
-         Bytes(static_cast<const char*>(blob->data), blob->size));
+    seed(format, std::string("box.") + id, Bytes(static_cast<const char*>(blob->data), blob->size));
   }
-  seed("off", "box.off",
-       "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n");
+  seed("off", "box.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n");
   // A Quake 3 map's skeleton: "IBSP", version 46, 17 lumps of nothing.
   Bytes bsp = "IBSP" + Little(46, 4);
   for (int lump = 0; lump < 17; ++lump) bsp += Little(8 + 17 * 8, 4) + Little(0, 4);
   seed("pk3", "empty.pk3", StoredZip("maps/empty.bsp", bsp));
   // Terragen: 3 x 3 points.
-  Bytes ter = "TERRAGENTERRAIN SIZE" + Little(2, 2) + Little(0, 2) + "ALTW" + Little(256, 2) +
-              Little(1, 2);
+  Bytes ter =
+      "TERRAGENTERRAIN SIZE" + Little(2, 2) + Little(0, 2) + "ALTW" + Little(256, 2) + Little(1, 2);
   for (int i = 0; i < 9; ++i) ter += Little(std::uint32_t(i * 100), 2);
   seed("ter", "hills.ter", ter + "EOF ");
   cv::Mat grey(8, 8, CV_8UC1);
@@ -198,9 +196,9 @@ void LevelFileSeeds(const fs::path& dir) {
 }
 
 void ManifestSeeds(const fs::path& dir, const fs::path& source) {
-  for (const char* file : {"assets/sample/level.toml", "assets/robots/robots.toml",
-                           "tests/data/kuka_iiwa.toml", "tests/data/net_fdm_wing.toml",
-                           "tests/data/px4_uneven_ground.toml"}) {
+  for (const char* file :
+       {"assets/sample/level.toml", "assets/robots/robots.toml", "tests/data/kuka_iiwa.toml",
+        "tests/data/net_fdm_wing.toml", "tests/data/px4_uneven_ground.toml"}) {
     Write(dir / fs::path(file).filename(), Read(source / file));
   }
   Write(dir / "limits.toml",

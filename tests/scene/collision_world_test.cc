@@ -236,7 +236,8 @@ TEST(CollisionWorldTest, ThousandsOfActorsAtOneSpotComeAndGoAtOnce) {
   dir.Write("box.obj", testing::ObjBox("box", 1, 1, 1));
   std::string manifest;
   for (int i = 0; i < 4000; ++i) {
-    manifest += "[[actor]]\nname = \"a" + std::to_string(i) + "\"\nfile = \"box.obj\"\n"
+    manifest += "[[actor]]\nname = \"a" + std::to_string(i) +
+                "\"\nfile = \"box.obj\"\n"
                 "movable = true\n";
   }
   const Level level = LoadLevel(dir.Write("many.toml", manifest));

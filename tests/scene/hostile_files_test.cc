@@ -2,31 +2,23 @@
 // before they are opened or before what they claim is allocated, and the
 // limits a manifest sets named in the message.
 
-#include <sys/stat.h>
-
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cstdint>
 #include <string>
 
 #include "scene/level.h"
 #include "scene/manifest.h"
+#include "tests/scene/load_error.h"
 #include "tests/scene/obj_text.h"
 #include "tests/test_util.h"
 
 namespace sandbox::scene {
 namespace {
 
+using testing::LoadError;
 using testing::TempDir;
-
-std::string LoadError(const std::filesystem::path& file) {
-  try {
-    LoadLevel(file);
-  } catch (const LevelError& error) {
-    return error.what();
-  }
-  return "no error";
-}
 
 // PNG's CRC-32 (ISO-HDLC), bit by bit.
 std::uint32_t Crc32(const std::string& bytes) {
@@ -49,7 +41,8 @@ std::string Chunk(const std::string& type, const std::string& data) {
 // A PNG whose header says `width` x `height` 8-bit grey pixels, followed by
 // a few bytes of image data (far too few: the header lies).
 std::string LyingPng(std::uint32_t width, std::uint32_t height) {
-  const std::string ihdr = BigEndian32(width) + BigEndian32(height) + std::string("\x08\x00\x00\x00\x00", 5);
+  const std::string ihdr =
+      BigEndian32(width) + BigEndian32(height) + std::string("\x08\x00\x00\x00\x00", 5);
   return std::string("\x89PNG\r\n\x1a\n", 8) + Chunk("IHDR", ihdr) +
          Chunk("IDAT", std::string("\x78\x9c\x63\x00\x00\x00\x01\x00\x01", 9)) + Chunk("IEND", "");
 }
@@ -112,7 +105,8 @@ TEST(HostileFilesTest, AGlbWhoseHeaderLiesIsRefused) {
                                   std::string("\x00\x00\x00\xc0", 4) +
                                   std::string("\x00\x00\x00\x80JSON{}", 10);
   const auto total = dir.Write("total.glb", lying_total);
-  EXPECT_EQ(LoadError(total), total.string() + ": its header says 3221225472 bytes, the file has 22");
+  EXPECT_EQ(LoadError(total),
+            total.string() + ": its header says 3221225472 bytes, the file has 22");
   std::string lying_chunk = std::string("glTF\x02\0\0\0", 8) + std::string("\x16\0\0\0", 4) +
                             std::string("\x00\x00\x00\x80JSON{}", 10);
   const auto chunk = dir.Write("chunk.glb", lying_chunk);
@@ -140,9 +134,10 @@ TEST(HostileFilesTest, ManifestNumbersBeyondTwoToThe53AreAnErrorNotZero) {
 TEST(HostileFilesTest, ALevelOverItsTriangleOrFileLimitNamesTheKey) {
   TempDir dir;
   dir.Write("box.obj", testing::ObjBox("box", 1, 1, 1));  // 12 triangles
-  const auto small = dir.Write(
-      "small.toml", "[level]\nmax_triangles = 20\n[[actor]]\nname = \"a\"\nfile = \"box.obj\"\n"
-                    "[[actor]]\nname = \"b\"\nfile = \"box.obj\"\n");
+  const auto small =
+      dir.Write("small.toml",
+                "[level]\nmax_triangles = 20\n[[actor]]\nname = \"a\"\nfile = \"box.obj\"\n"
+                "[[actor]]\nname = \"b\"\nfile = \"box.obj\"\n");
   EXPECT_EQ(LoadError(small), (dir.path() / "box.obj").string() +
                                   ": the level has 24 triangles, over the limit of 20 ([level] "
                                   "max_triangles in a level manifest)");

@@ -8,6 +8,7 @@
 #include <assimp/Exporter.hpp>
 #include <assimp/Importer.hpp>
 
+#include "tests/scene/load_error.h"
 #include "tests/scene/obj_text.h"
 #include "tests/test_util.h"
 
@@ -130,14 +131,7 @@ TEST(LevelTest, FbxSaysItsAxesAndUnit) {
   ExpectNear(level.bounds_W().max(), {0.01, 0, 0.02}, "max");
 }
 
-std::string LoadError(const std::filesystem::path& file) {
-  try {
-    LoadLevel(file);
-  } catch (const LevelError& error) {
-    return error.what();
-  }
-  return "no error";
-}
+using testing::LoadError;
 
 TEST(LevelTest, BadFilesGiveOneClearMessage) {
   TempDir dir;
@@ -152,7 +146,8 @@ TEST(LevelTest, BadFilesGiveOneClearMessage) {
   EXPECT_EQ(LoadError(corrupt),
             corrupt.string() + ": its header says 1651663207 bytes, the file has 15");
   // A header that tells the truth about garbage: assimp's own error.
-  const auto garbage = dir.Write("garbage.glb", std::string("glTF\x02\0\0\0\x14\0\0\0garbage!", 20));
+  const auto garbage =
+      dir.Write("garbage.glb", std::string("glTF\x02\0\0\0\x14\0\0\0garbage!", 20));
   EXPECT_EQ(LoadError(garbage).rfind(garbage.string() + ": ", 0), 0u) << LoadError(garbage);
 
   const auto empty = dir.Write("empty.obj", "");

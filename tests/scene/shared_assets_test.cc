@@ -78,8 +78,8 @@ TEST_F(SharedAssetsTest, Quake3MapHasRealTrianglesOnceRebuiltAndIsZUpInInches) {
   // Rays from outside towards the middle hit the map's outer surfaces.
   const CollisionWorld world(level);
   const Eigen::AlignedBox3d box = level.bounds_W();
-  for (const Vector3d& from : {Vector3d(-200, 0, 50), Vector3d(200, 0, 50), Vector3d(0, -200, 50),
-                               Vector3d(0, 0, 300)}) {
+  for (const Vector3d& from :
+       {Vector3d(-200, 0, 50), Vector3d(200, 0, 50), Vector3d(0, -200, 50), Vector3d(0, 0, 300)}) {
     const auto hit = world.CastRay(from, box.center());
     ASSERT_TRUE(hit.has_value()) << from.transpose();
     EXPECT_TRUE(box.exteriorDistance(hit->point_W) < 0.01) << hit->point_W.transpose();
@@ -103,10 +103,10 @@ TEST_F(SharedAssetsTest, ABitFlippedQuake3MapIsAnErrorNotAnAbort) {
     LoadLevel(flipped);
     FAIL() << "the flipped map loaded";
   } catch (const LevelError& error) {
-    EXPECT_EQ(std::string(error.what()).rfind(flipped.string() +
-                                                  ": assimp could not read it: assimp's check "
-                                                  "'unzCloseCurrentFile(zip_handle) == UNZ_OK' failed",
-                                              0),
+    EXPECT_EQ(std::string(error.what())
+                  .rfind(flipped.string() + ": assimp could not read it: assimp's check "
+                                            "'unzCloseCurrentFile(zip_handle) == UNZ_OK' failed",
+                         0),
               0u)
         << error.what();
   }
