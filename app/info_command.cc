@@ -224,10 +224,8 @@ int RunInfo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
 
   // A scene file is someone else's: assimp reads it apart first (a crash
   // becomes an error). A manifest's own assets are read apart with --isolate.
-  std::string extension = std::filesystem::path(file).extension().string();
-  for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
-  const bool isolate = parsed->flags.count("--isolate") > 0 || extension != ".toml";
-  if (isolate) {
+  // Apart from the timed load below, whose figures are the level's own.
+  if (parsed->flags.count("--isolate") > 0 || !IsManifest(file)) {
     try {
       CheckLoadsInIsolation(file, conversion);
     } catch (const scene::LevelError& error) {
@@ -240,7 +238,7 @@ int RunInfo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     LoadFigures figures;
     const auto start = Clock::now();
     // The checks `sandbox run` makes, too: what info accepts, run accepts.
-    const LoadedLevel loaded_level = LoadCheckedLevel(file, conversion);
+    const LoadedLevel loaded_level = LoadCheckedLevel(file, conversion, Isolation::kNever);
     const Level& level = loaded_level.level;
     const std::vector<sensors::MountedSensor>& sensors = loaded_level.sensors;
     const auto loaded = Clock::now();

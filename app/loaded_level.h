@@ -19,12 +19,22 @@ struct LoadedLevel {
   std::vector<bridge::RobotBridgeConfig> bridges;  // one per robot, in Level::robots order
 };
 
+// Which levels are first loaded in a child process (isolated_load.h), where
+// a crash inside assimp is an error rather than the end of the program.
+enum class Isolation {
+  kSceneFiles,  // a scene file given as the level (someone else's file), not a manifest
+  kAlways,      // --isolate: a manifest's assets too
+  kNever,       // already done by the caller
+};
+
+// True for a level manifest (.toml), false for a scene file.
+bool IsManifest(const std::string& file);
+
 // Loads `file` (a scene file read with `conversion`, or a manifest) and makes
-// every check above. With `isolate`, first loads it in a child process
-// (isolated_load.h): a crash inside assimp is then an error, not the end.
-// Throws scene::LevelError naming the file, the line and what is wrong.
+// every check above, loading it apart first as `isolation` says. Throws
+// scene::LevelError naming the file, the line and what is wrong.
 LoadedLevel LoadCheckedLevel(const std::string& file, const scene::AssetConversion& conversion = {},
-                             bool isolate = false);
+                             Isolation isolation = Isolation::kSceneFiles);
 // In this process, with every load option (the isolated child's call).
 LoadedLevel LoadCheckedLevel(const std::string& file, const scene::LoadOptions& options);
 

@@ -32,7 +32,7 @@ const char* kUsage =
     "                or a file with one entry a line ('#' starts a comment)\n"
     "  --out         the posed mesh (ASCII PLY, world frame); bone frames go to\n"
     "                MESH.bones.csv beside it\n"
-    "  --isolate     read the level in a separate process first (a crash of assimp is an error)\n";
+    "  --isolate     read a manifest's files apart first (scene files always are)\n";
 
 void WritePly(const fs::path& file, const RobotState& state) {
   const RobotModel& model = state.model();
@@ -104,7 +104,9 @@ int RunPose(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   }
   try {
     const LoadedLevel loaded =
-        LoadCheckedLevel(level_file, {}, parsed->flags.count("--isolate") > 0);
+        LoadCheckedLevel(
+        level_file, {},
+        parsed->flags.count("--isolate") > 0 ? Isolation::kAlways : Isolation::kSceneFiles);
     const scene::Level& level = loaded.level;
     if (level.robots.empty()) throw CommandError(level_file + ": the level declares no [[robot]]");
     const int robot = robot_name.empty() ? 0 : level.FindRobot(robot_name);

@@ -35,7 +35,8 @@ const char* kUsage =
     "            25 m) scanned in full at the pose, occupied samples red and free green,\n"
     "            bone frames and movable actors' bounds\n"
     "  --stub    draw samples as stubs of M metres along their rays instead of points\n"
-    "  --isolate read the level in a separate process first (a crash of assimp is an error)\n";
+    "  --isolate read a manifest's files apart first, so that a crash of assimp is an error\n"
+    "            (a scene file as LEVEL always is read so)\n";
 
 // The overlay at one robot state: its face scanners scanned in full.
 void BuildOverlay(const scene::Level& level, int robot_index, const scene::RobotState* robot,
@@ -100,8 +101,9 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
     view.fov_y_rad =
         (parsed->values.count("--fov") ? ParseNumber(parsed->Value("--fov"), "--fov") : 60.0) *
         M_PI / 180.0;
-    const LoadedLevel loaded = LoadCheckedLevel(parsed->level.value_or(kDefaultLevel), {},
-                                                parsed->flags.count("--isolate") > 0);
+    const LoadedLevel loaded = LoadCheckedLevel(
+        parsed->level.value_or(kDefaultLevel), {},
+        parsed->flags.count("--isolate") > 0 ? Isolation::kAlways : Isolation::kSceneFiles);
     const scene::Level& level = loaded.level;
     std::unique_ptr<scene::RobotState> robot;
     int robot_index = -1;

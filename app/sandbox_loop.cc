@@ -81,7 +81,8 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
       hooks_(std::move(hooks)),
       out_(out),
       err_(err),
-      loaded_(LoadCheckedLevel(options.level, {}, options.isolate)),
+      loaded_(LoadCheckedLevel(options.level, {},
+                               options.isolate ? Isolation::kAlways : Isolation::kSceneFiles)),
       world_(level_),
       log_(options.replay() ? std::make_unique<bridge::LogReader>(options.replay_file) : nullptr),
       // A replay feeds its inputs through an in-process link: nothing on the network.

@@ -25,7 +25,7 @@ const char* kUsage =
     "                    [--resolution R] [--half-extent E] [--aligned body|world]\n"
     "                    [--see-robots] [--isolate] --out FILE.csv|FILE.ply\n"
     "  LEVEL          a level (default: the bundled sample level)\n"
-    "  --isolate      read the level in a separate process first (a crash of assimp is an error)\n"
+    "  --isolate      read a manifest's files apart first (scene files always are)\n"
     "  --at           sensor pose: metres, roll/pitch/yaw in degrees\n"
     "  --sensor       face (default): the six-face scanner, all faces; ground: height map\n"
     "                 below; lidar: 16 x 1024 beams, -15..15 degrees, 100 m; ray: one ray down\n"
@@ -114,7 +114,9 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     const double extent = half_extent.empty() ? 25.0 : Positive(half_extent, "--half-extent");
 
     const LoadedLevel loaded =
-        LoadCheckedLevel(level_file, {}, parsed->flags.count("--isolate") > 0);
+        LoadCheckedLevel(
+        level_file, {},
+        parsed->flags.count("--isolate") > 0 ? Isolation::kAlways : Isolation::kSceneFiles);
     const scene::Level& level = loaded.level;
     const scene::CollisionWorld world(level);
     sensors::RayCaster caster;

@@ -1,6 +1,6 @@
-// Loading a level apart (--isolate, and `info` on any scene file): a file
-// that crashes assimp is an error naming it, not the end of the program;
-// what loads there loads here.
+// Loading a level apart (--isolate, and any scene file given as the level):
+// a file that crashes assimp is an error naming it, not the end of the
+// program; what loads there loads here.
 
 #include <gtest/gtest.h>
 
@@ -26,9 +26,14 @@ TEST(IsolatedLoadTest, AFileThatCrashesTheImporterIsAnErrorNamingIt) {
   sandbox::testing::TempDir dir;
   const std::string off = dir.Write("crash.off", kCrashingOff).string();
   const std::string crashed = off + ": the importer crashed on it (Segmentation fault, signal 11)";
+  // A scene file given as the level is always read apart first.
   const auto info = RunSandbox("info " + off);
   EXPECT_EQ(info.exit_code, 1) << info.out;
   EXPECT_EQ(info.out.rfind("sandbox info: " + crashed, 0), 0u) << info.out;
+  const auto render = RunSandbox("render " + off + " --camera fixed --at 0,0,5 --out " +
+                                 (dir.path() / "frame.png").string());
+  EXPECT_EQ(render.exit_code, 1) << render.out;
+  EXPECT_EQ(render.out.rfind("sandbox render: " + crashed, 0), 0u) << render.out;
   // In a manifest: named as the file the child was reading.
   const std::string level =
       dir.Write("level.toml", "[[actor]]\nname = \"a\"\nfile = \"crash.off\"\n").string();

@@ -5,6 +5,7 @@
 //   make_fuzz_seeds DIR SOURCE_DIR
 
 #include <assimp/scene.h>
+#include <unistd.h>
 
 #include <assimp/Exporter.hpp>
 #include <assimp/Importer.hpp>
@@ -170,12 +171,18 @@ void LevelFileSeeds(const fs::path& dir) {
       {"gltf2", "gltf"}, {"glb2", "glb"}, {"collada", "dae"}, {"fbx", "fbx"},
       {"fbxa", "fbx"},   {"3ds", "3ds"},  {"x", "x"},         {"3mf", "3mf"}};
   for (const auto& [id, format] : exports) {
-    const aiExportDataBlob* blob = exporter.ExportToBlob(scene, id);
-    if (blob == nullptr) {
+    // To a file and back (assimp 5.2.5's 3MF exporter ignores ExportToBlob),
+    // in a folder of its own (glTF writes its buffer beside it).
+    const fs::path folder =
+        fs::temp_directory_path() / ("make_fuzz_seeds_" + std::to_string(getpid()));
+    fs::create_directories(folder);
+    const fs::path file = folder / (std::string("box.") + format);
+    if (exporter.Export(scene, id, file.string()) == AI_SUCCESS) {
+      seed(format, std::string("box.") + id, Read(file));
+    } else {
       std::fprintf(stderr, "make_fuzz_seeds: no %s export: %s\n", id, exporter.GetErrorString());
-      continue;
     }
-    seed(format, std::string("box.") + id, Bytes(static_cast<const char*>(blob->data), blob->size));
+    fs::remove_all(folder);
   }
   seed("off", "box.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n");
   // A Quake 3 map's skeleton: "IBSP", version 46, 17 lumps of nothing.
