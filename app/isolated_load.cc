@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "app/command_line.h"
+#include "app/images.h"
 #include "app/loaded_level.h"
 #include "scene/manifest.h"
 
@@ -173,7 +174,23 @@ int RunLoadLevelChild(const std::vector<std::string>& args, std::ostream& out) {
     out << "error " << message << std::endl;
   };
   try {
-    LoadCheckedLevel(args[0], options);
+    const LoadedLevel loaded = LoadCheckedLevel(args[0], options);
+    // The textures too, as the renderer will decode them (OpenCV, libpng, ...).
+    const scene::Level& level = loaded.level;
+    const sensors::TextureDecoder decode = OpenCvTextureDecoder(level.limits);
+    for (const scene::Material& material : level.materials) {
+      sensors::RgbaImage image;
+      if (!material.base_color_texture_path.empty()) {
+        options.on_file(material.base_color_texture_path);
+        decode(nullptr, material.base_color_texture_path, &image);
+      }
+      for (const int t :
+           {material.base_color_texture_embedded, material.lightmap_texture_embedded}) {
+        if (t < 0 || t >= int(level.textures.size())) continue;
+        options.on_file(level.name + " (a texture embedded in it)");
+        decode(&level.textures[std::size_t(t)], "", &image);
+      }
+    }
     out << "ok" << std::endl;
     return 0;
   } catch (const scene::LevelError& error) {

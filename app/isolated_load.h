@@ -3,10 +3,11 @@
 // files, and some files crash it (a segmentation fault in an importer) or
 // make it take all the memory: loaded in this process, such a file would end
 // the program. The child (this program again: `sandbox __load-level`) loads
-// the level, with its checks, under the level's limits on address space and
-// CPU time ([level] max_import_mb, max_import_s); its crash, a limit or an
-// error becomes a LevelError naming the file it was reading. On success the
-// caller loads the level itself (the same input gives the same result).
+// the level, with its checks, and decodes its textures as the renderer will,
+// under the level's limits on address space and CPU time ([level]
+// max_import_mb, max_import_s); its crash, a limit or an error becomes a
+// LevelError naming the file it was reading. On success the caller loads the
+// level itself (the same input gives the same result).
 //
 // Threads: the calling thread; it waits for the child.
 
