@@ -68,11 +68,10 @@ struct Watch {
     if (!sandbox::testing::Decode(buffer, &m)) {
       return;
     }
-    for (int c = 0; c < m.num_channels; ++c) {
-      if (m.channels[std::size_t(c)] == robot + "/POSE") {
-        pose_stale = m.stale[std::size_t(c)];
-        status_utime = m.utime;
-      }
+    const int c = sandbox::testing::StatusColumn(m, robot + "/POSE");
+    if (c >= 0) {
+      pose_stale = m.stale[std::size_t(c)];
+      status_utime = m.utime;
     }
   }
 };

@@ -51,11 +51,8 @@ struct Watch {
     if (!sandbox::testing::Decode(buffer, &m)) {
       return;
     }
-    for (int c = 0; c < m.num_channels; ++c) {
-      if (m.channels[std::size_t(c)] == robot + "/POSE") {
-        good = m.received[std::size_t(c)] - m.rejected[std::size_t(c)];
-      }
-    }
+    const int c = sandbox::testing::StatusColumn(m, robot + "/POSE");
+    if (c >= 0) good = m.received[std::size_t(c)] - m.rejected[std::size_t(c)];
     there = there || good >= want_good;
   }
   double Error() const {
