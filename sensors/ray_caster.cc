@@ -10,12 +10,13 @@
 #endif
 
 #include "scene/collision_world_internal.h"
+#include "sensors/walk_stack.h"
 
 namespace sandbox::sensors {
 namespace {
 
 constexpr int kRaysPerChunk = 256;
-constexpr float kBarycentricSlack = 1e-6f;  // closes cracks between neighbouring triangles
+constexpr int kStackInPlace = RayCaster::kStackInPlace;
 
 // One Bullet object as a ray sees it: where it is, its BVH nodes and triangles.
 struct Target {
@@ -24,6 +25,8 @@ struct Target {
   Eigen::Matrix3f R_LB;                // local from Bullet frame
   Eigen::Vector3f p_LB;
   Eigen::Matrix3f R_BL;
+  btTransform X_BL;                    // Bullet frame from local: where triangles are tested
+  bool identity{false};                // X_BL is exactly the identity
   const btQuantizedBvhNode* nodes{nullptr};
   Eigen::Vector3f bvh_min, quantization;  // quantized = (local - bvh_min) * quantization
   struct Part {
@@ -56,6 +59,8 @@ std::vector<Target> CollectTargets(const scene::CollisionWorld& world, const Ray
       for (int c = 0; c < 3; ++c) t.R_BL(r, c) = float(X.getBasis()[r][c]);
     }
     t.R_LB = t.R_BL.transpose();
+    t.X_BL = X;
+    t.identity = X.getBasis() == btMatrix3x3::getIdentity() && X.getOrigin() == btVector3(0, 0, 0);
     t.p_LB = -(t.R_LB * ToEigen(X.getOrigin()));
     btQuantizedBvh* bvh = object.shape->getOptimizedBvh();
     t.nodes = &bvh->getQuantizedNodeArray()[0];
@@ -88,33 +93,82 @@ inline float EnterBox(const btQuantizedBvhNode& node, const Eigen::Vector3f& qo,
   return t_enter <= t_exit ? t_enter : std::numeric_limits<float>::infinity();
 }
 
-// Möller-Trumbore, both faces; updates t_max and the normal on a closer hit.
-inline bool HitTriangle(const Target& target, int part_id, int triangle, const Eigen::Vector3f& o,
-                        const Eigen::Vector3f& d, float* t_max, Eigen::Vector3f* normal) {
+// A triangle's corners in the Bullet frame, transformed as Bullet transforms
+// points (so that any caster fed Bullet's world triangles sees the same ones).
+inline void Corners(const Target& target, int part_id, int triangle, Eigen::Vector3f corner[3]) {
   const Target::Part& part = target.parts[static_cast<std::size_t>(part_id)];
   const auto* index = reinterpret_cast<const std::uint32_t*>(
       part.indices + std::ptrdiff_t(triangle) * part.index_stride);
-  auto vertex = [&](std::uint32_t i) {
-    const auto* p =
-        reinterpret_cast<const float*>(part.vertices + std::ptrdiff_t(i) * part.vertex_stride);
-    return Eigen::Vector3f(p[0], p[1], p[2]);
-  };
-  const Eigen::Vector3f v0 = vertex(index[0]);
-  const Eigen::Vector3f e1 = vertex(index[1]) - v0, e2 = vertex(index[2]) - v0;
-  const Eigen::Vector3f p = d.cross(e2);
-  const float det = e1.dot(p);
-  if (std::abs(det) < 1e-20f) return false;
-  const float inverse = 1.0f / det;
-  const Eigen::Vector3f s = o - v0;
-  const float u = s.dot(p) * inverse;
-  if (u < -kBarycentricSlack || u > 1.0f + kBarycentricSlack) return false;
-  const Eigen::Vector3f q = s.cross(e1);
-  const float v = d.dot(q) * inverse;
-  if (v < -kBarycentricSlack || u + v > 1.0f + kBarycentricSlack) return false;
-  const float t = e2.dot(q) * inverse;
-  if (t < 0.0f || t >= *t_max) return false;
+  for (int k = 0; k < 3; ++k) {
+    const auto* p = reinterpret_cast<const float*>(part.vertices +
+                                                   std::ptrdiff_t(index[k]) * part.vertex_stride);
+    if (target.identity) {
+      corner[k] = Eigen::Vector3f(p[0], p[1], p[2]);
+    } else {
+      corner[k] = ToEigen(target.X_BL * btVector3(p[0], p[1], p[2]));
+    }
+  }
+}
+
+// The triangle normal from its edges (e0 + e1 + e2 = 0), each component
+// from whichever of e0 x e1 and e1 x e2 suffers less cancellation.
+inline Eigen::Vector3f StableNormal(const Eigen::Vector3f& a, const Eigen::Vector3f& b,
+                                    const Eigen::Vector3f& c) {
+  const float ab_x = a.z() * b.y(), ab_y = a.x() * b.z(), ab_z = a.y() * b.x();
+  const float bc_x = b.z() * c.y(), bc_y = b.x() * c.z(), bc_z = b.y() * c.x();
+  return {std::abs(ab_x) < std::abs(bc_x) ? a.y() * b.z() - ab_x : b.y() * c.z() - bc_x,
+          std::abs(ab_y) < std::abs(bc_y) ? a.z() * b.x() - ab_y : b.z() * c.x() - bc_y,
+          std::abs(ab_z) < std::abs(bc_z) ? a.x() * b.y() - ab_z : b.x() * c.y() - bc_z};
+}
+
+// Whether the ray, up to t, meets the triangle's own bounding box (with two
+// ulps of slack on the distances). A hit the edge test admits within its
+// rounding tolerance but that lies outside the triangle's box is no hit: a ray
+// passing a hair outside an outer edge misses, as a watertight caster's box
+// test has it.
+inline bool MeetsCornerBox(const Eigen::Vector3f corner[3], const Eigen::Vector3f& o,
+                           const Eigen::Vector3f& d, float t) {
+  float t_enter = 0.0f, t_exit = t;
+  for (int k = 0; k < 3; ++k) {
+    const float lo = std::min({corner[0][k], corner[1][k], corner[2][k]});
+    const float hi = std::max({corner[0][k], corner[1][k], corner[2][k]});
+    if (d[k] == 0.0f) {  // along the slab: inside it all the way, or never
+      if (o[k] < lo || o[k] > hi) return false;
+      continue;
+    }
+    const float t1 = (lo - o[k]) / d[k], t2 = (hi - o[k]) / d[k];
+    t_enter = std::max(t_enter, std::min(t1, t2));
+    t_exit = std::min(t_exit, std::max(t1, t2));
+  }
+  constexpr float kSlack = 2.0f * std::numeric_limits<float>::epsilon();
+  return t_enter * (1.0f - kSlack) <= t_exit * (1.0f + kSlack);
+}
+
+// The watertight ray-triangle test (docs/sensors.md, "Grazing and origin
+// rules"): corners relative to the ray origin, a signed edge function per edge
+// (the same value, negated, for the neighbour sharing the edge), both faces.
+// A ray parallel to the plane (in it or not) misses; one whose origin lies on
+// the triangle hits at 0. Updates t_max and the normal on a closer hit.
+inline bool HitTriangle(const Target& target, int part_id, int triangle, const Eigen::Vector3f& o,
+                        const Eigen::Vector3f& d, float* t_max, Eigen::Vector3f* normal) {
+  Eigen::Vector3f corner[3];
+  Corners(target, part_id, triangle, corner);
+  const Eigen::Vector3f v0 = corner[0] - o, v1 = corner[1] - o, v2 = corner[2] - o;
+  const Eigen::Vector3f e0 = v2 - v0, e1 = v0 - v1, e2 = v1 - v2;
+  const float u = e0.cross(v2 + v0).dot(d);
+  const float v = e1.cross(v0 + v1).dot(d);
+  const float w = e2.cross(v1 + v2).dot(d);
+  const float eps = std::numeric_limits<float>::epsilon() * std::abs(u + v + w);
+  const bool inside = std::min({u, v, w}) >= -eps || std::max({u, v, w}) <= eps;
+  if (!inside) return false;
+  const Eigen::Vector3f n = StableNormal(e0, e1, e2);
+  const float den = 2.0f * n.dot(d);
+  if (den == 0.0f) return false;
+  const float t = 2.0f * v0.dot(n) / den;
+  if (!(t >= 0.0f && t < *t_max)) return false;
+  if (!MeetsCornerBox(corner, o, d, t)) return false;
   *t_max = t;
-  *normal = e1.cross(e2);
+  *normal = n;
   return true;
 }
 
@@ -134,19 +188,17 @@ bool WalkTarget(const Target& target, const Eigen::Vector3f& o_B, const Eigen::V
     int node;
     float t_enter;
   };
-  Entry stack[128];
-  int top = 0;
+  WalkStack<Entry, kStackInPlace> stack;
   bool hit = false;
-  Eigen::Vector3f normal_L;
   const btQuantizedBvhNode* nodes = target.nodes;
-  if (EnterBox(nodes[0], qo, inverse, *t_max) <= *t_max) stack[top++] = {0, 0.0f};
-  while (top > 0) {
-    const Entry entry = stack[--top];
+  if (EnterBox(nodes[0], qo, inverse, *t_max) <= *t_max) stack.Push({0, 0.0f});
+  while (!stack.empty()) {
+    const Entry entry = stack.Pop();
     if (entry.t_enter > *t_max) continue;
     const btQuantizedBvhNode& node = nodes[entry.node];
     if (node.isLeafNode()) {
       const int packed = node.m_escapeIndexOrTriangleIndex;
-      hit |= HitTriangle(target, packed >> 21, packed & ((1 << 21) - 1), o, d, t_max, &normal_L);
+      hit |= HitTriangle(target, packed >> 21, packed & ((1 << 21) - 1), o_B, d_B, t_max, normal_B);
       continue;
     }
     const int left = entry.node + 1;
@@ -157,10 +209,9 @@ bool WalkTarget(const Target& target, const Eigen::Vector3f& o_B, const Eigen::V
     const bool left_first = t_left <= t_right;
     const Entry near_child = left_first ? Entry{left, t_left} : Entry{right, t_right};
     const Entry far_child = left_first ? Entry{right, t_right} : Entry{left, t_left};
-    if (std::isfinite(far_child.t_enter) && top < 127) stack[top++] = far_child;
-    if (std::isfinite(near_child.t_enter) && top < 127) stack[top++] = near_child;
+    if (std::isfinite(far_child.t_enter)) stack.Push(far_child);
+    if (std::isfinite(near_child.t_enter)) stack.Push(near_child);
   }
-  if (hit) *normal_B = target.R_BL * normal_L;
   return hit;
 }
 
@@ -213,57 +264,97 @@ inline __m128 EnterBox4(const btQuantizedBvhNode& node, const __m128 qo[3], cons
   return _mm_cmple_ps(t_enter, t_exit);
 }
 
-// Möller-Trumbore for four rays against one triangle; updates the lanes it hits.
-inline void HitTriangle4(const Target& target, int part_id, int triangle, const __m128 o[3],
-                         const __m128 d[3], __m128 lanes, Packet* packet, __m128* t_max) {
-  const Target::Part& part = target.parts[static_cast<std::size_t>(part_id)];
-  const auto* index = reinterpret_cast<const std::uint32_t*>(
-      part.indices + std::ptrdiff_t(triangle) * part.index_stride);
-  auto vertex = [&](std::uint32_t i) {
-    return reinterpret_cast<const float*>(part.vertices + std::ptrdiff_t(i) * part.vertex_stride);
+struct Vec4 {  // a vector per lane
+  __m128 x, y, z;
+};
+inline Vec4 Sub(const Vec4& a, const Vec4& b) { return {Sub(a.x, b.x), Sub(a.y, b.y), Sub(a.z, b.z)}; }
+inline Vec4 Add(const Vec4& a, const Vec4& b) { return {Add(a.x, b.x), Add(a.y, b.y), Add(a.z, b.z)}; }
+inline __m128 Dot(const Vec4& a, const Vec4& b) {
+  return Add(Add(Mul(a.x, b.x), Mul(a.y, b.y)), Mul(a.z, b.z));
+}
+inline Vec4 Cross(const Vec4& a, const Vec4& b) {
+  return {Sub(Mul(a.y, b.z), Mul(a.z, b.y)), Sub(Mul(a.z, b.x), Mul(a.x, b.z)),
+          Sub(Mul(a.x, b.y), Mul(a.y, b.x))};
+}
+inline __m128 Abs(__m128 x) { return _mm_andnot_ps(_mm_set1_ps(-0.0f), x); }
+inline __m128 Select(__m128 mask, __m128 a, __m128 b) {
+  return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
+}
+// StableNormal, per lane.
+inline Vec4 StableNormal4(const Vec4& a, const Vec4& b, const Vec4& c) {
+  const __m128 ab_x = Mul(a.z, b.y), ab_y = Mul(a.x, b.z), ab_z = Mul(a.y, b.x);
+  const __m128 bc_x = Mul(b.z, c.y), bc_y = Mul(b.x, c.z), bc_z = Mul(b.y, c.x);
+  return {Select(_mm_cmplt_ps(Abs(ab_x), Abs(bc_x)), Sub(Mul(a.y, b.z), ab_x),
+                 Sub(Mul(b.y, c.z), bc_x)),
+          Select(_mm_cmplt_ps(Abs(ab_y), Abs(bc_y)), Sub(Mul(a.z, b.x), ab_y),
+                 Sub(Mul(b.z, c.x), bc_y)),
+          Select(_mm_cmplt_ps(Abs(ab_z), Abs(bc_z)), Sub(Mul(a.x, b.y), ab_z),
+                 Sub(Mul(b.x, c.y), bc_z))};
+}
+
+// MeetsCornerBox, per lane.
+inline __m128 MeetsCornerBox4(const Eigen::Vector3f corner[3], const Vec4& o, const Vec4& d,
+                              __m128 t) {
+  const __m128 origin[3] = {o.x, o.y, o.z}, direction[3] = {d.x, d.y, d.z};
+  __m128 t_enter = _mm_setzero_ps(), t_exit = t;
+  for (int k = 0; k < 3; ++k) {
+    const float lo = std::min({corner[0][k], corner[1][k], corner[2][k]});
+    const float hi = std::max({corner[0][k], corner[1][k], corner[2][k]});
+    const __m128 low = _mm_set1_ps(lo), high = _mm_set1_ps(hi);
+    const __m128 t1 = _mm_div_ps(Sub(low, origin[k]), direction[k]);
+    const __m128 t2 = _mm_div_ps(Sub(high, origin[k]), direction[k]);
+    // Lanes along the slab (zero direction): inside it all the way, or never.
+    const __m128 along = _mm_cmpeq_ps(direction[k], _mm_setzero_ps());
+    const __m128 within = _mm_and_ps(_mm_cmpge_ps(origin[k], low), _mm_cmple_ps(origin[k], high));
+    const __m128 infinity = _mm_set1_ps(std::numeric_limits<float>::infinity());
+    const __m128 near = Select(along, Select(within, Sub(_mm_setzero_ps(), infinity), infinity),
+                               _mm_min_ps(t1, t2));
+    const __m128 far = Select(along, Select(within, infinity, Sub(_mm_setzero_ps(), infinity)),
+                              _mm_max_ps(t1, t2));
+    t_enter = _mm_max_ps(t_enter, near);
+    t_exit = _mm_min_ps(t_exit, far);
+  }
+  const float slack = 2.0f * std::numeric_limits<float>::epsilon();
+  return _mm_cmple_ps(Mul(t_enter, _mm_set1_ps(1.0f - slack)),
+                      Mul(t_exit, _mm_set1_ps(1.0f + slack)));
+}
+
+// HitTriangle for the four rays of a packet (Bullet frame); updates the lanes it hits.
+inline void HitTriangle4(const Target& target, int part_id, int triangle, const Vec4& o,
+                         const Vec4& d, __m128 lanes, Packet* packet, __m128* t_max) {
+  Eigen::Vector3f corner[3];
+  Corners(target, part_id, triangle, corner);
+  auto relative = [&o](const Eigen::Vector3f& p) {
+    return Sub(Vec4{_mm_set1_ps(p.x()), _mm_set1_ps(p.y()), _mm_set1_ps(p.z())}, o);
   };
-  const float* a = vertex(index[0]);
-  const float* b = vertex(index[1]);
-  const float* c = vertex(index[2]);
-  const float e1s[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-  const float e2s[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-  const __m128 e1[3] = {_mm_set1_ps(e1s[0]), _mm_set1_ps(e1s[1]), _mm_set1_ps(e1s[2])};
-  const __m128 e2[3] = {_mm_set1_ps(e2s[0]), _mm_set1_ps(e2s[1]), _mm_set1_ps(e2s[2])};
-  // p = d x e2, det = e1 . p
-  const __m128 px = Sub(Mul(d[1], e2[2]), Mul(d[2], e2[1]));
-  const __m128 py = Sub(Mul(d[2], e2[0]), Mul(d[0], e2[2]));
-  const __m128 pz = Sub(Mul(d[0], e2[1]), Mul(d[1], e2[0]));
-  const __m128 det = Add(Add(Mul(e1[0], px), Mul(e1[1], py)), Mul(e1[2], pz));
-  const __m128 inverse = _mm_div_ps(_mm_set1_ps(1.0f), det);
-  const __m128 sx = Sub(o[0], _mm_set1_ps(a[0])), sy = Sub(o[1], _mm_set1_ps(a[1])),
-               sz = Sub(o[2], _mm_set1_ps(a[2]));
-  const __m128 u = Mul(Add(Add(Mul(sx, px), Mul(sy, py)), Mul(sz, pz)), inverse);
-  // q = s x e1
-  const __m128 qx = Sub(Mul(sy, e1[2]), Mul(sz, e1[1]));
-  const __m128 qy = Sub(Mul(sz, e1[0]), Mul(sx, e1[2]));
-  const __m128 qz = Sub(Mul(sx, e1[1]), Mul(sy, e1[0]));
-  const __m128 v = Mul(Add(Add(Mul(d[0], qx), Mul(d[1], qy)), Mul(d[2], qz)), inverse);
-  const __m128 t = Mul(Add(Add(Mul(e2[0], qx), Mul(e2[1], qy)), Mul(e2[2], qz)), inverse);
-  const __m128 slack = _mm_set1_ps(kBarycentricSlack);
-  const __m128 one = _mm_set1_ps(1.0f + kBarycentricSlack);
-  __m128 hit =
-      _mm_and_ps(lanes, _mm_cmpgt_ps(_mm_andnot_ps(_mm_set1_ps(-0.0f), det), _mm_set1_ps(1e-20f)));
-  hit = _mm_and_ps(hit, _mm_cmpge_ps(u, _mm_sub_ps(_mm_setzero_ps(), slack)));
-  hit = _mm_and_ps(hit, _mm_cmple_ps(u, one));
-  hit = _mm_and_ps(hit, _mm_cmpge_ps(v, _mm_sub_ps(_mm_setzero_ps(), slack)));
-  hit = _mm_and_ps(hit, _mm_cmple_ps(Add(u, v), one));
+  const Vec4 v0 = relative(corner[0]), v1 = relative(corner[1]), v2 = relative(corner[2]);
+  const Vec4 e0 = Sub(v2, v0), e1 = Sub(v0, v1), e2 = Sub(v1, v2);
+  const __m128 u = Dot(Cross(e0, Add(v2, v0)), d);
+  const __m128 v = Dot(Cross(e1, Add(v0, v1)), d);
+  const __m128 w = Dot(Cross(e2, Add(v1, v2)), d);
+  const __m128 eps =
+      Mul(_mm_set1_ps(std::numeric_limits<float>::epsilon()), Abs(Add(Add(u, v), w)));
+  const __m128 low = _mm_min_ps(_mm_min_ps(u, v), w), high = _mm_max_ps(_mm_max_ps(u, v), w);
+  __m128 hit = _mm_and_ps(lanes, _mm_or_ps(_mm_cmpge_ps(low, Sub(_mm_setzero_ps(), eps)),
+                                           _mm_cmple_ps(high, eps)));
+  if (_mm_movemask_ps(hit) == 0) return;
+  const Vec4 n = StableNormal4(e0, e1, e2);
+  const __m128 den = Mul(_mm_set1_ps(2.0f), Dot(n, d));
+  const __m128 t = _mm_div_ps(Mul(_mm_set1_ps(2.0f), Dot(v0, n)), den);
+  hit = _mm_and_ps(hit, _mm_cmpneq_ps(den, _mm_setzero_ps()));
   hit = _mm_and_ps(hit, _mm_cmpge_ps(t, _mm_setzero_ps()));
   hit = _mm_and_ps(hit, _mm_cmplt_ps(t, *t_max));
+  if (_mm_movemask_ps(hit) == 0) return;
+  hit = _mm_and_ps(hit, MeetsCornerBox4(corner, o, d, t));
   const int mask = _mm_movemask_ps(hit);
   if (mask == 0) return;
-  *t_max = _mm_or_ps(_mm_and_ps(hit, t), _mm_andnot_ps(hit, *t_max));
-  const Eigen::Vector3f normal_L =
-      Eigen::Vector3f(e1s[0], e1s[1], e1s[2]).cross(Eigen::Vector3f(e2s[0], e2s[1], e2s[2]));
-  const Eigen::Vector3f normal_B = target.R_BL * normal_L;
+  *t_max = Select(hit, t, *t_max);
+  alignas(16) float nx[4], ny[4], nz[4];
+  _mm_store_ps(nx, n.x), _mm_store_ps(ny, n.y), _mm_store_ps(nz, n.z);
   for (int lane = 0; lane < 4; ++lane) {
     if (mask & (1 << lane)) {
       packet->body[lane] = target.body;
-      packet->normal[lane] = normal_B;
+      packet->normal[lane] = Eigen::Vector3f(nx[lane], ny[lane], nz[lane]);
     }
   }
 }
@@ -297,18 +388,19 @@ void WalkTarget4(const Target& target, Packet* packet) {
   }
   const bool positive = lane0_qd[axis] > 0.0f;
   __m128 t_max = packet->t_max;
+  const Vec4 o_B{packet->ox, packet->oy, packet->oz}, d_B{packet->dx, packet->dy, packet->dz};
   const btQuantizedBvhNode* nodes = target.nodes;
-  int stack[128];
-  int top = 0;
-  stack[top++] = 0;
-  while (top > 0) {
-    const int index = stack[--top];
+  WalkStack<int, kStackInPlace> stack;
+  stack.Push(0);
+  while (!stack.empty()) {
+    const int index = stack.Pop();
     const btQuantizedBvhNode& node = nodes[index];
     const __m128 lanes = _mm_and_ps(packet->active, EnterBox4(node, qo, inverse, t_max));
     if (_mm_movemask_ps(lanes) == 0) continue;
     if (node.isLeafNode()) {
       const int packed = node.m_escapeIndexOrTriangleIndex;
-      HitTriangle4(target, packed >> 21, packed & ((1 << 21) - 1), o, d, lanes, packet, &t_max);
+      HitTriangle4(target, packed >> 21, packed & ((1 << 21) - 1), o_B, d_B, lanes, packet,
+                   &t_max);
       continue;
     }
     const int left = index + 1;
@@ -316,14 +408,8 @@ void WalkTarget4(const Target& target, Packet* packet) {
     // The child whose box starts further along the dominant axis is walked second.
     const bool right_is_further =
         (nodes[right].m_quantizedAabbMin[axis] >= nodes[left].m_quantizedAabbMin[axis]) == positive;
-    if (top > 125) continue;  // deeper than any tree Bullet builds
-    if (right_is_further) {
-      stack[top++] = right;
-      stack[top++] = left;
-    } else {
-      stack[top++] = left;
-      stack[top++] = right;
-    }
+    stack.Push(right_is_further ? right : left);
+    stack.Push(right_is_further ? left : right);
   }
   packet->t_max = t_max;
 }

@@ -3,6 +3,12 @@
 // Thread-safe by construction: every ray walks Bullet's quantized BVH nodes
 // and the level's own triangle arrays read-only, with its own stack; nothing
 // of Bullet's mutable query state (btCollisionWorld::rayTest) is used.
+//
+// Hits are watertight (docs/sensors.md, "Grazing and origin rules"): each
+// triangle is tested in the Bullet frame with its corners placed as Bullet
+// places them; a ray through a shared edge hits one of the two triangles, a
+// ray lying in a triangle's plane does not hit it, and a ray whose origin lies
+// on a triangle hits it at distance 0.
 
 #include <Eigen/Core>
 #include <atomic>
@@ -63,6 +69,9 @@ class RayCaster {
             RayHits* hits);
 
   int threads() const { return static_cast<int>(workers_.size()) + 1; }
+  // Entries a BVH walk keeps on its own stack before it grows on the heap
+  // (a deeper tree costs an allocation per walk, never a dropped node).
+  static constexpr int kStackInPlace = 32;
   // Rays cast since construction (frame statistics).
   std::int64_t rays_cast() const { return rays_cast_; }
 

@@ -9,6 +9,9 @@
 
 #include "assets/generators/sample_terrain.h"
 #include "scene/level.h"
+#include "sensors/face_scanner.h"
+#include "sensors/walk_stack.h"
+#include "tests/scene/obj_text.h"
 #include "tests/test_util.h"
 
 namespace sandbox::sensors {
@@ -135,6 +138,111 @@ TEST_F(RayCasterTest, FiltersAndThreadCountsChangeNothingElse) {
     EXPECT_NE(no_robot.body[i], robot_body);
     EXPECT_NE(static_only.body[i], robot_body);
     EXPECT_NE(static_only.body[i], gate);
+  }
+}
+
+}  // namespace
+}  // namespace sandbox::sensors
+
+namespace sandbox::sensors {
+namespace {
+
+TEST(WalkStackTest, GrowsPastItsPlaceAndGivesEveryEntryBack) {
+  WalkStack<int, 4> stack;
+  for (int i = 0; i < 1000; ++i) stack.Push(i);
+  EXPECT_TRUE(stack.on_heap());
+  EXPECT_EQ(stack.size(), 1000);
+  for (int i = 999; i >= 0; --i) ASSERT_EQ(stack.Pop(), i);
+  EXPECT_TRUE(stack.empty());
+}
+
+// An axis-aligned room, 12 x 12 x 8 m from (-6, -6, 0), with a 2 m pillar
+// from (1, 1, 0) to (3, 3, 8), as OBJ boxes (whole-metre corners, exact in float).
+scene::Level Room(const testing::TempDir& dir) {
+  dir.Write("room.obj", testing::ObjBox("room", 12, 12, 8, -6, -6, 0) +
+                            testing::ObjBox("pillar", 2, 2, 8, 1, 1, 0, 9));
+  return scene::LoadLevel(dir.Write("room.toml", "[[actor]]\nname = \"room\"\nfile = \"room.obj\"\n"));
+}
+
+// The first hit of a ray on the room's box faces, computed here in double
+// from the rules (docs/sensors.md): faces are closed rectangles; a ray lying
+// in a face's plane does not hit it; one whose origin lies on a face hits it
+// at 0; nothing at or beyond the ray's length. Returns the length for none.
+double ExpectedHit(const Vector3d& o, const Vector3d& d, double length) {
+  struct Box {
+    Vector3d lo, hi;
+  };
+  const Box boxes[2] = {{{-6, -6, 0}, {6, 6, 8}}, {{1, 1, 0}, {3, 3, 8}}};
+  double best = length;
+  for (const Box& box : boxes) {
+    for (int axis = 0; axis < 3; ++axis) {
+      for (const double plane : {box.lo[axis], box.hi[axis]}) {
+        if (d[axis] == 0.0) continue;  // parallel: in the plane or not, no hit
+        const double t = (plane - o[axis]) / d[axis];
+        if (t < 0.0 || t >= best) continue;
+        const Vector3d p = o + t * d;
+        bool inside = true;
+        for (int k = 0; k < 3; ++k) {
+          if (k != axis) inside = inside && p[k] >= box.lo[k] && p[k] <= box.hi[k];
+        }
+        if (inside) best = t;
+      }
+    }
+  }
+  return best;
+}
+
+TEST(RayRulesTest, GrazingAndOriginRulesHoldInAnAxisAlignedRoom) {
+  testing::TempDir dir;
+  const scene::Level level = Room(dir);
+  const scene::CollisionWorld world(level);
+  RayCaster caster(2);
+  struct Case {
+    Vector3d at;
+    double resolution_m, half_extent_m;
+  };
+  // At whole metres in the room; on its +x wall (origins on a surface, rays
+  // along the wall's plane); on the pillar's corner edge.
+  for (const Case& c : {Case{{0, 0, 2}, 0.25, 6}, Case{{6, 1, 3}, 0.5, 8},
+                        Case{{3, 3, 4}, 0.5, 5}, Case{{-2, 1, 0}, 0.25, 4}}) {
+    SCOPED_TRACE(::testing::PrintToString(c.at.transpose()));
+    FaceScannerConfig config;
+    config.refresh = Refresh::kFull;
+    config.resolution_m = c.resolution_m;
+    config.half_extent_m = c.half_extent_m;
+    const FaceScanner scanner(config);
+    RayBatch rays;
+    rays.origin_W = c.at;
+    for (const auto& part : scanner.DueAt(0)) {
+      scanner.AppendRays(part, Eigen::Isometry3d(Eigen::Translation3d(c.at)), &rays);
+    }
+    RayHits hits;
+    caster.Cast(world, rays, {}, &hits);
+    int in_plane = 0, on_surface = 0, mismatches = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      const Vector3d o = c.at + rays.start[i].cast<double>();
+      const Vector3d d = rays.direction[i].cast<double>();
+      const double expected = ExpectedHit(o, d, rays.length_m[i]);
+      const bool expect_hit = expected < rays.length_m[i];
+      const bool hit = hits.body[i] != RayHits::kNoHit;
+      if (hit != expect_hit || (hit && std::abs(hits.distance_m[i] - expected) > 1e-5)) {
+        if (++mismatches <= 5) {
+          ADD_FAILURE() << "ray from " << o.transpose() << " along " << d.transpose() << ": "
+                        << (hit ? "hit at " + std::to_string(hits.distance_m[i]) : "miss")
+                        << ", expected "
+                        << (expect_hit ? "hit at " + std::to_string(expected) : "miss");
+        }
+      }
+      on_surface += expect_hit && expected == 0.0;
+      for (int axis = 0; axis < 3; ++axis) {
+        in_plane += d[axis] == 0.0 && (o[axis] == -6 || o[axis] == 6 || o[axis] == 1 ||
+                                       o[axis] == 3 || o[axis] == 0 || o[axis] == 8);
+      }
+    }
+    EXPECT_EQ(mismatches, 0);
+    // The cases do exercise the rules.
+    EXPECT_GT(in_plane, 20);
+    if (c.at.x() == 6 || c.at == Vector3d(3, 3, 4)) EXPECT_GT(on_surface, 20);
   }
 }
 
