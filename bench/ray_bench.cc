@@ -33,12 +33,30 @@ namespace fs = std::filesystem;
 using namespace sandbox;
 using Clock = std::chrono::steady_clock;
 
-// The world's collision triangles in Embree, in Bullet's frame (world minus origin).
+// How Embree casts: one ray at a time (rtcIntersect1), packets of 4/8/16
+// coherent rays (rtcIntersect4/8/16 with the coherent flag), or a stream of
+// coherent rays (rtcIntersect1M).
+enum class EmbreeMode { kOne, kPacket4, kPacket8, kPacket16, kStream };
+const char* Name(EmbreeMode mode) {
+  switch (mode) {
+    case EmbreeMode::kOne: return "1";
+    case EmbreeMode::kPacket4: return "4";
+    case EmbreeMode::kPacket8: return "8";
+    case EmbreeMode::kPacket16: return "16";
+    case EmbreeMode::kStream: return "1M";
+  }
+  return "?";
+}
+
+// The world's collision triangles in Embree, in Bullet's frame (world minus
+// origin). `robust`: RTC_SCENE_FLAG_ROBUST, Embree's watertight mode (the
+// reference for hits); without it, its fastest mode (the reference for speed).
 class EmbreeScene {
  public:
-  explicit EmbreeScene(const scene::CollisionWorld& world) {
+  EmbreeScene(const scene::CollisionWorld& world, bool robust) {
     device_ = rtcNewDevice(nullptr);
     scene_ = rtcNewScene(device_);
+    if (robust) rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
     for (const scene::MeshObject& object : world.internals().objects) {
       const btTransform& X = object.object->getWorldTransform();
       const IndexedMeshArray& parts = object.mesh_interface->getIndexedMeshArray();
@@ -70,32 +88,105 @@ class EmbreeScene {
     rtcReleaseScene(scene_);
     rtcReleaseDevice(device_);
   }
+  EmbreeScene(const EmbreeScene&) = delete;
+  EmbreeScene& operator=(const EmbreeScene&) = delete;
 
   // Casts rays [first, end); writes distance (or length) and whether it hit.
-  void Cast(const sensors::RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t first,
-            std::size_t end, std::vector<float>* distance, std::vector<char>* hit) const {
+  void Cast(EmbreeMode mode, const sensors::RayBatch& rays, const Eigen::Vector3f& origin_B,
+            std::size_t first, std::size_t end, std::vector<float>* distance,
+            std::vector<char>* hit) const {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    for (std::size_t i = first; i < end; ++i) {
-      RTCRayHit rh;
-      const Eigen::Vector3f o = origin_B + rays.start[i];
-      rh.ray.org_x = o.x(), rh.ray.org_y = o.y(), rh.ray.org_z = o.z();
-      rh.ray.dir_x = rays.direction[i].x(), rh.ray.dir_y = rays.direction[i].y();
-      rh.ray.dir_z = rays.direction[i].z();
-      rh.ray.tnear = 0.0f;
-      rh.ray.tfar = rays.length_m[i];
-      rh.ray.mask = 0xFFFFFFFFu;
-      rh.ray.flags = 0;
-      rh.ray.time = 0.0f;
-      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-      rtcIntersect1(scene_, &context, &rh);
-      (*hit)[i] = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-      (*distance)[i] = (*hit)[i] ? rh.ray.tfar : rays.length_m[i];
+    if (mode != EmbreeMode::kOne) context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    switch (mode) {
+      case EmbreeMode::kOne:
+        for (std::size_t i = first; i < end; ++i) {
+          RTCRayHit rh = RayHit(rays, origin_B, i);
+          rtcIntersect1(scene_, &context, &rh);
+          Store(rays, i, rh.hit.geomID, rh.ray.tfar, distance, hit);
+        }
+        break;
+      case EmbreeMode::kPacket4:
+        CastPackets<4, RTCRayHit4>(rtcIntersect4, &context, rays, origin_B, first, end, distance,
+                                   hit);
+        break;
+      case EmbreeMode::kPacket8:
+        CastPackets<8, RTCRayHit8>(rtcIntersect8, &context, rays, origin_B, first, end, distance,
+                                   hit);
+        break;
+      case EmbreeMode::kPacket16:
+        CastPackets<16, RTCRayHit16>(rtcIntersect16, &context, rays, origin_B, first, end,
+                                     distance, hit);
+        break;
+      case EmbreeMode::kStream: {
+        std::vector<RTCRayHit> stream;
+        stream.reserve(end - first);
+        for (std::size_t i = first; i < end; ++i) stream.push_back(RayHit(rays, origin_B, i));
+        rtcIntersect1M(scene_, &context, stream.data(), unsigned(stream.size()), sizeof(RTCRayHit));
+        for (std::size_t i = first; i < end; ++i) {
+          const RTCRayHit& rh = stream[i - first];
+          Store(rays, i, rh.hit.geomID, rh.ray.tfar, distance, hit);
+        }
+        break;
+      }
     }
   }
 
  private:
+  static RTCRayHit RayHit(const sensors::RayBatch& rays, const Eigen::Vector3f& origin_B,
+                          std::size_t i) {
+    RTCRayHit rh;
+    const Eigen::Vector3f o = origin_B + rays.start[i];
+    rh.ray.org_x = o.x(), rh.ray.org_y = o.y(), rh.ray.org_z = o.z();
+    rh.ray.dir_x = rays.direction[i].x(), rh.ray.dir_y = rays.direction[i].y();
+    rh.ray.dir_z = rays.direction[i].z();
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = rays.length_m[i];
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.ray.flags = 0;
+    rh.ray.time = 0.0f;
+    rh.ray.id = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    return rh;
+  }
+  static void Store(const sensors::RayBatch& rays, std::size_t i, unsigned geom_id, float tfar,
+                    std::vector<float>* distance, std::vector<char>* hit) {
+    (*hit)[i] = geom_id != RTC_INVALID_GEOMETRY_ID;
+    (*distance)[i] = (*hit)[i] ? tfar : rays.length_m[i];
+  }
+  template <int N, typename RayHitN, typename Intersect>
+  void CastPackets(Intersect intersect, RTCIntersectContext* context,
+                   const sensors::RayBatch& rays, const Eigen::Vector3f& origin_B,
+                   std::size_t first, std::size_t end, std::vector<float>* distance,
+                   std::vector<char>* hit) const {
+    for (std::size_t i = first; i < end; i += N) {
+      alignas(64) RayHitN packet;
+      alignas(64) int valid[N];
+      for (int l = 0; l < N; ++l) {
+        const std::size_t r = i + std::size_t(l);
+        valid[l] = r < end ? -1 : 0;
+        const std::size_t k = std::min(r, end - 1);
+        const Eigen::Vector3f o = origin_B + rays.start[k];
+        packet.ray.org_x[l] = o.x(), packet.ray.org_y[l] = o.y(), packet.ray.org_z[l] = o.z();
+        packet.ray.dir_x[l] = rays.direction[k].x(), packet.ray.dir_y[l] = rays.direction[k].y();
+        packet.ray.dir_z[l] = rays.direction[k].z();
+        packet.ray.tnear[l] = 0.0f;
+        packet.ray.tfar[l] = rays.length_m[k];
+        packet.ray.mask[l] = 0xFFFFFFFFu;
+        packet.ray.flags[l] = 0;
+        packet.ray.time[l] = 0.0f;
+        packet.ray.id[l] = 0;
+        packet.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
+        packet.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+      }
+      intersect(valid, scene_, context, &packet);
+      for (int l = 0; l < N && i + std::size_t(l) < end; ++l) {
+        Store(rays, i + std::size_t(l), packet.hit.geomID[l], packet.ray.tfar[l], distance, hit);
+      }
+    }
+  }
+
   RTCDevice device_;
   RTCScene scene_;
 };
@@ -134,7 +225,8 @@ bool DisagreeWhenMoved(const scene::CollisionWorld& world, const EmbreeScene& em
   caster.Cast(world, moved, {}, &ours);
   std::vector<float> distance(2);
   std::vector<char> hit(2);
-  embree.Cast(moved, (moved.origin_W - world.origin()).cast<float>(), 0, 2, &distance, &hit);
+  embree.Cast(EmbreeMode::kOne, moved, (moved.origin_W - world.origin()).cast<float>(), 0, 2,
+              &distance, &hit);
   for (int k = 0; k < 2; ++k) {
     if ((ours.body[std::size_t(k)] != sensors::RayHits::kNoHit) != bool(hit[std::size_t(k)]))
       return true;
@@ -142,8 +234,90 @@ bool DisagreeWhenMoved(const scene::CollisionWorld& world, const EmbreeScene& em
   return false;
 }
 
+// Embree's rate in `mode` on `threads` threads: each thread casts its share
+// over and over until a common deadline, with no synchronisation between
+// calls (the most favourable way to count for it); all rays cast over the
+// wall time.
+double EmbreeRate(const EmbreeScene& embree, EmbreeMode mode, const sensors::RayBatch& rays,
+                  const Eigen::Vector3f& origin_B, int threads, double seconds) {
+  const std::size_t n = rays.size();
+  std::vector<float> distance(n);
+  std::vector<char> hit(n);
+  embree.Cast(mode, rays, origin_B, 0, n, &distance, &hit);  // warm up
+  std::vector<double> rays_cast(std::size_t(threads), 0.0);
+  const auto start = Clock::now();
+  const auto deadline = start + std::chrono::duration<double>(seconds);
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t) {
+    pool.emplace_back([&, t] {
+      // Interleaved chunks of 256 rays (the caster's own chunk), so that each
+      // thread gets a like mix.
+      std::vector<float> my_distance(n);
+      std::vector<char> my_hit(n);
+      do {
+        for (std::size_t first = 256 * std::size_t(t); first < n;
+             first += 256 * std::size_t(threads)) {
+          const std::size_t end = std::min(n, first + 256);
+          embree.Cast(mode, rays, origin_B, first, end, &my_distance, &my_hit);
+          rays_cast[std::size_t(t)] += double(end - first);
+        }
+      } while (Clock::now() < deadline);
+    });
+  }
+  for (std::thread& worker : pool) worker.join();
+  double total = 0.0;
+  for (const double count : rays_cast) total += count;
+  return total / std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// The two Embree scenes of a level: the fastest, and the watertight reference.
+struct Reference {
+  const EmbreeScene& fast;
+  const EmbreeScene& watertight;
+};
+
+// Hits of ours against the watertight reference: rays that hit in one and
+// miss in the other, those of them that are not grazing an edge, the largest
+// distance difference where both hit; the first few mismatches printed when
+// `show` is set.
+struct Agreement {
+  int mismatches{0}, off_edge{0};
+  double worst_mm{0.0};
+};
+Agreement Agree(const scene::CollisionWorld& world, const EmbreeScene& watertight,
+                const sensors::RayBatch& rays, const sensors::RayHits& ours, int show) {
+  const std::size_t n = rays.size();
+  std::vector<float> distance(n);
+  std::vector<char> hit(n);
+  watertight.Cast(EmbreeMode::kOne, rays, (rays.origin_W - world.origin()).cast<float>(), 0, n,
+                  &distance, &hit);
+  Agreement agreement;
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool ours_hit = ours.body[i] != sensors::RayHits::kNoHit;
+    const double diff_mm = 1e3 * std::abs(double(ours.distance_m[i]) - distance[i]);
+    if (ours_hit != bool(hit[i]) || (ours_hit && diff_mm > 1.0)) {
+      if (agreement.mismatches < show) {
+        const Eigen::Vector3d o = rays.origin_W + rays.start[i].cast<double>();
+        std::printf("  ray %zu from (%.6g, %.6g, %.6g) along (%.6g, %.6g, %.6g): ours %s %.6g, "
+                    "Embree %s %.6g\n",
+                    i, o.x(), o.y(), o.z(), rays.direction[i].x(), rays.direction[i].y(),
+                    rays.direction[i].z(), ours_hit ? "hit at" : "miss", ours.distance_m[i],
+                    hit[i] ? "hit at" : "miss", distance[i]);
+      }
+    }
+    if (ours_hit != bool(hit[i])) {
+      ++agreement.mismatches;
+      agreement.off_edge += DisagreeWhenMoved(world, watertight, rays, i) ? 1 : 0;
+    } else if (ours_hit) {
+      if (diff_mm > 1.0) ++agreement.mismatches;
+      agreement.worst_mm = std::max(agreement.worst_mm, diff_mm);
+    }
+  }
+  return agreement;
+}
+
 void Compare(const char* level, const char* name, const scene::CollisionWorld& world,
-             const EmbreeScene& embree, const sensors::RayBatch& rays, double seconds) {
+             const Reference& embree, const sensors::RayBatch& rays, double seconds, int show) {
   const std::size_t n = rays.size();
   const Eigen::Vector3f origin_B = (rays.origin_W - world.origin()).cast<float>();
   for (const int threads : {1, 2}) {
@@ -151,47 +325,16 @@ void Compare(const char* level, const char* name, const scene::CollisionWorld& w
     sensors::RayHits ours;
     const double ours_rate =
         n * CallsPerSecond(seconds, [&] { caster.Cast(world, rays, {}, &ours); });
-    // Embree: each thread casts its share over and over until a common
-    // deadline, with no synchronisation between calls (the most favourable
-    // way to count for it); the rate is all rays cast over the wall time.
-    std::vector<float> distance(n);
-    std::vector<char> hit(n);
-    embree.Cast(rays, origin_B, 0, n, &distance, &hit);  // warm up
-    std::vector<double> rays_cast(std::size_t(threads), 0.0);
-    const auto start = Clock::now();
-    const auto deadline = start + std::chrono::duration<double>(seconds);
-    {
-      std::vector<std::thread> pool;
-      for (int t = 0; t < threads; ++t) {
-        pool.emplace_back([&, t] {
-          // Interleaved chunks of 64 rays, so that each thread gets a like mix.
-          do {
-            for (std::size_t first = 64 * std::size_t(t); first < n;
-                 first += 64 * std::size_t(threads)) {
-              const std::size_t end = std::min(n, first + 64);
-              embree.Cast(rays, origin_B, first, end, &distance, &hit);
-              rays_cast[std::size_t(t)] += double(end - first);
-            }
-          } while (Clock::now() < deadline);
-        });
-      }
-      for (std::thread& worker : pool) worker.join();
+    const double one_rate = EmbreeRate(embree.fast, EmbreeMode::kOne, rays, origin_B, threads,
+                                       seconds);
+    double best_rate = 0.0;
+    EmbreeMode best = EmbreeMode::kOne;
+    for (const EmbreeMode mode : {EmbreeMode::kPacket4, EmbreeMode::kPacket8,
+                                  EmbreeMode::kPacket16, EmbreeMode::kStream}) {
+      const double rate = EmbreeRate(embree.fast, mode, rays, origin_B, threads, seconds);
+      if (rate > best_rate) best_rate = rate, best = mode;
     }
-    double total = 0.0;
-    for (const double count : rays_cast) total += count;
-    const double embree_rate = total / std::chrono::duration<double>(Clock::now() - start).count();
-    embree.Cast(rays, origin_B, 0, n, &distance, &hit);  // all rays, for the comparison
-    int mismatches = 0, off_edge = 0;
-    double worst_mm = 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-      const bool ours_hit = ours.body[i] != sensors::RayHits::kNoHit;
-      if (ours_hit != bool(hit[i])) {
-        ++mismatches;
-        off_edge += DisagreeWhenMoved(world, embree, rays, i) ? 1 : 0;
-      } else if (ours_hit) {
-        worst_mm = std::max(worst_mm, 1e3 * std::abs(double(ours.distance_m[i]) - distance[i]));
-      }
-    }
+    const Agreement agreement = Agree(world, embree.watertight, rays, ours, threads == 1 ? show : 0);
     // Bullet's own btCollisionWorld::rayTest, one ray at a time (one thread only:
     // it is not thread-safe), for perspective.
     std::string ray_test = "-";
@@ -205,59 +348,124 @@ void Compare(const char* level, const char* name, const scene::CollisionWorld& w
             }
           });
       char text[32];
-      std::snprintf(text, sizeof(text), "%.2f (%.2fx)", rate / 1e6, rate / embree_rate);
+      std::snprintf(text, sizeof(text), "%.2f (%.2fx)", rate / 1e6, rate / one_rate);
       ray_test = text;
     }
-    std::printf("%-12s %-14s %7zu %2d %12.2f %12.2f %7.2fx %6d (%d) %11.3f %16s\n", level, name, n,
-                threads, ours_rate / 1e6, embree_rate / 1e6, ours_rate / embree_rate, mismatches,
-                off_edge, worst_mm, ray_test.c_str());
+    std::printf("%-12s %-14s %7zu %2d %7.2f %7.2f %6.2fx %7.2f %-3s %6.2fx %6d (%d) %8.3f %14s\n",
+                level, name, n, threads, ours_rate / 1e6, one_rate / 1e6, ours_rate / one_rate,
+                best_rate / 1e6, Name(best), ours_rate / best_rate, agreement.mismatches,
+                agreement.off_edge, agreement.worst_mm, ray_test.c_str());
+    std::fflush(stdout);
   }
 }
 
+struct FaceCase {
+  double resolution_m{1.0}, half_extent_m{25.0};
+};
+
 void RunLevel(const char* name, const fs::path& file, const Eigen::Isometry3d& X_WS,
-              double seconds) {
+              const FaceCase& face_case, double seconds, int show) {
   const scene::Level level = scene::LoadLevel(file);
   const scene::CollisionWorld world(level);
-  const EmbreeScene embree(world);
+  const EmbreeScene fast(world, false), watertight(world, true);
+  const Reference embree{fast, watertight};
   sensors::FaceScannerConfig face_config;
   face_config.refresh = sensors::Refresh::kFull;
+  face_config.resolution_m = face_case.resolution_m;
+  face_config.half_extent_m = face_case.half_extent_m;
   const sensors::FaceScanner face(face_config);
   sensors::RayBatch face_rays;
   face_rays.origin_W = X_WS.translation();
   for (const auto& part : face.DueAt(0)) face.AppendRays(part, X_WS, &face_rays);
-  Compare(name, "face scan", world, embree, face_rays, seconds);
+  Compare(name, "face scan", world, embree, face_rays, seconds, show);
   const sensors::Lidar lidar16(sensors::LidarConfig::Uniform(16, -15, 15, 1024, 100.0));
-  Compare(name, "lidar 16x1024", world, embree, lidar16.Rays(X_WS, X_WS), seconds);
+  Compare(name, "lidar 16x1024", world, embree, lidar16.Rays(X_WS, X_WS), seconds, show);
   const sensors::Lidar lidar64(sensors::LidarConfig::Uniform(64, -25, 15, 2048, 100.0));
-  Compare(name, "lidar 64x2048", world, embree, lidar64.Rays(X_WS, X_WS), seconds);
+  Compare(name, "lidar 64x2048", world, embree, lidar64.Rays(X_WS, X_WS), seconds, show);
+}
+
+// "x,y,z[,yaw_deg]" as a pose.
+bool ParsePose(const char* text, Eigen::Isometry3d* X_WS) {
+  double v[4] = {0, 0, 0, 0};
+  int count = 0;
+  for (const char* p = text; count < 4 && *p != '\0';) {
+    char* end = nullptr;
+    v[count++] = std::strtod(p, &end);
+    if (end == p) return false;
+    p = *end == ',' ? end + 1 : end;
+    if (*end != ',' && *end != '\0') return false;
+  }
+  if (count < 3) return false;
+  *X_WS = Eigen::Translation3d(v[0], v[1], v[2]) *
+          Eigen::AngleAxisd(v[3] * M_PI / 180.0, Eigen::Vector3d::UnitZ());
+  return true;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   double seconds = 0.3;
+  int show = 0;
+  const char* level = nullptr;
+  Eigen::Isometry3d X_WS = Eigen::Isometry3d::Identity();
+  FaceCase face_case;
+  bool posed = false;
   for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--seconds") == 0 && i + 1 < argc) {
+    const bool more = i + 1 < argc;
+    if (std::strcmp(argv[i], "--seconds") == 0 && more) {
       seconds = std::max(0.01, std::atof(argv[++i]));
+    } else if (std::strcmp(argv[i], "--level") == 0 && more) {
+      level = argv[++i];
+    } else if (std::strcmp(argv[i], "--at") == 0 && more) {
+      posed = ParsePose(argv[++i], &X_WS);
+      if (!posed) break;
+    } else if (std::strcmp(argv[i], "--resolution") == 0 && more) {
+      face_case.resolution_m = std::atof(argv[++i]);
+    } else if (std::strcmp(argv[i], "--half-extent") == 0 && more) {
+      face_case.half_extent_m = std::atof(argv[++i]);
+    } else if (std::strcmp(argv[i], "--show") == 0 && more) {
+      show = std::atoi(argv[++i]);
     } else {
-      std::fprintf(stderr, "usage: bench_rays [--seconds S]\n");
-      return 2;
+      level = nullptr, posed = false, argc = -1;
+      break;
     }
   }
-  std::printf("%-12s %-14s %7s %2s %12s %12s %8s %12s %11s %16s\n", "level", "rays", "count", "th",
-              "ours Mray/s", "Embree Mray/s", "ratio", "mismatches", "max diff mm",
-              "rayTest Mray/s");
-  RunLevel("sample", fs::path(SANDBOX_SOURCE_DIR) / "assets/sample/level.toml",
-           Eigen::Translation3d(20, -25, 22) * Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()),
-           seconds);
-  const fs::path dir = fs::temp_directory_path() / "sandbox-bench-rays";
-  const fs::path million = bench::WriteMillionTriangleLevel(dir);
-  RunLevel("1M-triangle", million, Eigen::Isometry3d(Eigen::Translation3d(500, 250, 8)), seconds);
-  fs::remove_all(dir);
+  if (argc < 0 || (level != nullptr) != posed) {
+    std::fprintf(stderr,
+                 "usage: bench_rays [--seconds S] [--level FILE --at x,y,z[,yaw_deg] "
+                 "[--resolution R] [--half-extent E]] [--show N]\n"
+                 "  without --level: the sample level and a generated 1M-triangle terrain\n"
+                 "  --show N: print the first N rays that disagree with watertight Embree\n");
+    return 2;
+  }
+  std::printf("%-12s %-14s %7s %2s %7s %7s %7s %11s %7s %12s %8s %14s\n", "level", "rays",
+              "count", "th", "ours", "Embree1", "ratio", "Embree best", "ratio", "mismatches",
+              "diff mm", "rayTest");
+  try {
+    if (level != nullptr) {
+      const std::string name = fs::path(level).stem().string().substr(0, 12);
+      RunLevel(name.c_str(), level, X_WS, face_case, seconds, show);
+    } else {
+      RunLevel("sample", fs::path(SANDBOX_SOURCE_DIR) / "assets/sample/level.toml",
+               Eigen::Translation3d(20, -25, 22) * Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()),
+               face_case, seconds, show);
+      const fs::path dir = fs::temp_directory_path() / "sandbox-bench-rays";
+      const fs::path million = bench::WriteMillionTriangleLevel(dir);
+      RunLevel("1M-triangle", million, Eigen::Isometry3d(Eigen::Translation3d(500, 250, 8)),
+               face_case, seconds, show);
+      fs::remove_all(dir);
+    }
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "bench_rays: %s\n", error.what());
+    return 1;
+  }
   std::printf(
-      "\nsame rays, same triangles, same thread count; mismatches: hit in one, miss in "
-      "the other,\n(in brackets: those that stay when the ray moves 1 mm sideways, i.e. "
-      "not a ray grazing an edge);\nmax diff: largest hit distance difference where both "
-      "hit\n");
+      "\nMray/s; same rays, same triangles, same thread count. Embree1: rtcIntersect1; Embree "
+      "best: the fastest\nof rtcIntersect4/8/16 with the coherent flag and rtcIntersect1M (its "
+      "packet width or 1M shown);\nratio: ours over it. Mismatches against Embree's watertight "
+      "mode (RTC_SCENE_FLAG_ROBUST): hit\nin one and miss in the other, or hit distances more "
+      "than 1 mm apart (in brackets: those that stay\nwhen the ray moves 1 mm sideways, i.e. "
+      "not a ray grazing an edge); diff mm: the largest hit\ndistance difference where both "
+      "hit. rayTest: Bullet's btCollisionWorld::rayTest (ratio to Embree1).\n");
   return 0;
 }
