@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 
 #include "sensors/face_scanner.h"
@@ -14,7 +15,7 @@ void GroundScannerConfig::ValidateOrThrow() const {
   grid.half_extent_m = half_extent_m;
   grid.ValidateOrThrow();
   if (!(std::isfinite(depth_m) && depth_m > 0.0)) {
-    throw std::invalid_argument("depth_m must be positive, got " + std::to_string(depth_m));
+    throw std::invalid_argument("depth_m must be positive, got " + (std::ostringstream() << depth_m).str());
   }
 }
 

@@ -1,6 +1,7 @@
 #include "sensors/range_sensor.h"
 
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 namespace sandbox::sensors {
@@ -10,7 +11,7 @@ void RangeSensorConfig::ValidateOrThrow() const {
     throw std::invalid_argument("direction must be a unit vector");
   }
   if (!(std::isfinite(range_m) && range_m > 0.0)) {
-    throw std::invalid_argument("range_m must be positive, got " + std::to_string(range_m));
+    throw std::invalid_argument("range_m must be positive, got " + (std::ostringstream() << range_m).str());
   }
 }
 

@@ -133,3 +133,26 @@ TEST(RobotSensorsTest, CameraMistakesNameTheCameraAndField) {
 
 }  // namespace
 }  // namespace sandbox::sensors
+
+namespace sandbox::sensors {
+namespace {
+
+TEST(RobotSensorsTest, SettingsThatMakeNoTraversalAreRefusedAtLoad) {
+  EXPECT_EQ(Error("type = \"ray\"\nrange_m = 0\n"),
+            "level.toml:6: sensor 's': range_m must be positive, got 0");
+  EXPECT_EQ(Error("type = \"lidar\"\nrange_m = 0\n"),
+            "level.toml:6: sensor 's': range_m must be positive, got 0");
+  EXPECT_EQ(Error("type = \"ground\"\ndepth_m = 0\n"),
+            "level.toml:6: sensor 's': depth_m must be positive, got 0");
+  EXPECT_EQ(Error("type = \"ray\"\ndirection = [0, 0, 0]\n"),
+            "level.toml:6: sensor 's': direction must be a unit vector");
+  EXPECT_EQ(Error("type = \"face\"\nposition = [nan, 0, 0]\n"),
+            "level.toml:9: sensor 's': 'position' must be finite, got nan");
+  EXPECT_EQ(Error("type = \"lidar\"\nrpy_deg = [0, inf, 0]\n"),
+            "level.toml:9: sensor 's': 'rpy_deg' must be finite, got inf");
+  EXPECT_EQ(Error("type = \"ray\"\nquaternion_wxyz = [0, 0, 0, 0]\n"),
+            "level.toml:9: sensor 's': 'quaternion_wxyz' must be a unit quaternion, its norm is 0");
+}
+
+}  // namespace
+}  // namespace sandbox::sensors
