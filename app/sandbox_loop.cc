@@ -123,6 +123,13 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
     }
     sensor_runs_.push_back(std::move(run));
   }
+  // Each robot keeps its poses over its longest lidar sweep (and a tick more).
+  for (const sensors::MountedSensor& m : mounted_) {
+    if (const auto* lidar = std::get_if<sensors::LidarConfig>(&m.config)) {
+      RobotRun& robot = robots_[std::size_t(m.robot)];
+      robot.history = PoseHistory(std::max(robot.history.keep_s(), 2.0 / lidar->rotation_hz));
+    }
+  }
   for (const sensors::MountedCamera& camera : cameras_) {
     // Cameras without a rate run at 30 Hz.
     camera_runs_.push_back({&camera, sensors::ChaseCamera(camera.chase),
@@ -223,8 +230,9 @@ int SandboxLoop::Run() {
     // 1-2. Inputs applied; 3-4. sensors that are due, their outputs, the state.
     std::int64_t now = bridge::NowUtime();
     const double t = ApplyInputs(wall_s, drain_budget_s, &now, &record);
+    for (RobotRun& robot : robots_) robot.history.Add(t, robot.state->pose());
     RunDueSensors(t, now);
-    for (RobotRun& robot : robots_) robot.outputs->PublishState(*robot.state, robot.input, now);
+    PublishStates(now);
     WriteDueScans(t);
     // 5. Cameras that are due: jobs for the render thread (copies, no waiting).
     SubmitDueFrames(t, &record);
@@ -243,6 +251,7 @@ int SandboxLoop::Run() {
     bool overrun = false;
     const double next_s = pacer.Next(seconds_since_start(tick_end), &overrun);
     stats_.Add(record, overrun);
+    KeepOriginNearRobot();  // between ticks: the next tick's rays see the new origin
     if (paced && !overrun) {
       StopSignal::SleepUntil(at(timed ? std::min(next_s, options_.duration_s) : next_s));
     }
@@ -301,15 +310,21 @@ double SandboxLoop::ApplyInputs(double wall_s, double drain_budget_s, std::int64
     }
     if (applied.pose) robot.input = {applied.pose_seq, applied.pose_utime};
     bool moved = applied.pose || applied.bones;
+    // UDP inputs: the packet's own counter and time where its format has
+    // them, else the receive counter and the arrival time.
+    auto tag = [now_utime](const bridge::PacketTag& own, std::int64_t received) {
+      return bridge::InputTag{own.seq >= 0 ? own.seq : received,
+                              own.utime >= 0 ? own.utime : *now_utime};
+    };
     if (robot.net_fdm && robot.net_fdm->Apply(robot.state.get())) {
       moved = true;
       ++record->inputs;
-      robot.input = {robot.net_fdm->socket().received(), *now_utime};
+      robot.input = tag(robot.net_fdm->last_tag(), robot.net_fdm->socket().received());
     }
     if (robot.doubles && robot.doubles->Apply(robot.state.get())) {
       moved = true;
       ++record->inputs;
-      robot.input = {robot.doubles->socket().received(), *now_utime};
+      robot.input = tag(robot.doubles->last_tag(), robot.doubles->socket().received());
     }
     if (moved) {
       robot.state->Update();
@@ -339,8 +354,12 @@ void SandboxLoop::RunDueSensors(double t, std::int64_t now_utime) {
       ground->Scan(world_, caster_, filter, X_WS.translation(), &map);
       robot.outputs->PublishGround(map, robot.input, now_utime, channel);
     } else if (const auto* lidar = std::get_if<sensors::Lidar>(&run.sensor)) {
+      // The sweep began 1 / rotation_hz ago: from the mount as it is now, on
+      // the robot as it was then, to the mount now.
+      const double sweep_s = 1.0 / lidar->config().rotation_hz;
+      const Eigen::Isometry3d X_RS = robot.state->pose().inverse() * X_WS;
       sensors::LidarScan scan;
-      lidar->Sweep(world_, caster_, filter, X_WS, X_WS, &scan);
+      lidar->Sweep(world_, caster_, filter, robot.history.At(t - sweep_s) * X_RS, X_WS, &scan);
       robot.outputs->PublishLidar(scan, robot.input, now_utime, channel);
     } else if (const auto* ray = std::get_if<sensors::RangeSensorConfig>(&run.mounted->config)) {
       robot.outputs->PublishRange(run.mounted->spec.name,
@@ -348,6 +367,44 @@ void SandboxLoop::RunDueSensors(double t, std::int64_t now_utime) {
                                   robot.input, now_utime, channel);
     }
   }
+}
+
+void SandboxLoop::PublishStates(std::int64_t now_utime) {
+  for (std::size_t r = 0; r < robots_.size(); ++r) {
+    RobotRun& robot = robots_[r];
+    // The face frames of the robot's first face scanner, as its faces were
+    // last scanned (faces not scanned yet: the box as it is now).
+    const SensorRun* face_run = nullptr;
+    for (const SensorRun& run : sensor_runs_) {
+      if (run.mounted->robot == int(r) && std::holds_alternative<sensors::FaceScanner>(run.sensor)) {
+        face_run = &run;
+        break;
+      }
+    }
+    if (face_run == nullptr) {
+      robot.outputs->PublishState(*robot.state, robot.input, now_utime);
+      continue;
+    }
+    const auto& scanner = std::get<sensors::FaceScanner>(face_run->sensor);
+    bridge::RobotOutputs::FaceFrames X_WF;
+    for (int f = 0; f < 6; ++f) {
+      const sensors::ScanFace& face = face_run->face_scan.faces[std::size_t(f)];
+      X_WF[std::size_t(f)] =
+          face.tick >= 0 ? face.X_WB : scanner.BoxFrame(face_run->mounted->Pose(*robot.state));
+    }
+    robot.outputs->PublishState(*robot.state, robot.input, now_utime, &X_WF);
+  }
+}
+
+void SandboxLoop::KeepOriginNearRobot() {
+  if (robots_.empty()) return;
+  const Eigen::Vector3d p_WR = robots_.front().state->pose().translation();
+  if ((p_WR - world_.origin()).norm() <= kOriginShiftDistance_m) return;
+  const auto start = Clock::now();
+  world_.SetOrigin(p_WR.array().round().matrix());  // whole metres keep whole coordinates exact
+  const double ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  ++origin_moves_;
+  longest_origin_move_ms_ = std::max(longest_origin_move_ms_, ms);
 }
 
 void SandboxLoop::WriteDueScans(double t) {
@@ -465,6 +522,10 @@ void SandboxLoop::PrintSummary(double elapsed_s) {
   if (paced) {
     out_ << "  tick lateness: p50 " << summary.lateness_p50_ms << " ms, p99 "
          << summary.lateness_p99_ms << " ms, max " << summary.lateness_max_ms << " ms\n";
+  }
+  if (origin_moves_ > 0) {
+    out_ << "  floating origin: moved " << origin_moves_ << " times, longest "
+         << longest_origin_move_ms_ << " ms, now at (" << world_.origin().transpose() << ")\n";
   }
   if (!options_.out_dir.empty()) {
     // Files that cannot be finished (a full disk) are reported; the run's results stand.

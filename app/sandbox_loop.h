@@ -21,6 +21,7 @@
 #include "app/frame_pipeline.h"
 #include "app/live_view.h"
 #include "app/loaded_level.h"
+#include "app/pose_history.h"
 #include "app/rate_schedule.h"
 #include "app/run_hooks.h"
 #include "app/run_options.h"
@@ -50,6 +51,10 @@ class SandboxLoop {
   // The exit code of a run that finished but could not write all of its
   // output (frames, scans, the recording or the statistics).
   static constexpr int kExitOutputLost = 3;
+  // The floating origin (scene::CollisionWorld::SetOrigin) follows the first
+  // robot: when it is farther than this from the origin, the origin moves to
+  // its position rounded to whole metres, after the tick.
+  static constexpr double kOriginShiftDistance_m = 1000.0;
 
   // Runs until the duration ends, a replayed log ends, SIGINT/SIGTERM, the
   // live view's q or RequestStop(); then finishes the files and prints the
@@ -70,6 +75,7 @@ class SandboxLoop {
     std::unique_ptr<bridge::DoublesInput> doubles;
     std::unique_ptr<bridge::RobotOutputs> outputs;
     bridge::InputTag input;  // the input the outputs are tagged with
+    PoseHistory history;     // its poses over the longest lidar sweep
 
     // Every input's counters: the LCM channels, then the UDP sockets.
     std::vector<bridge::ChannelStatus> Channels(std::int64_t now_utime) const;
@@ -97,6 +103,10 @@ class SandboxLoop {
   double ApplyInputs(double wall_s, double drain_budget_s, std::int64_t* now_utime,
                      TickRecord* record);
   void RunDueSensors(double t, std::int64_t now_utime);
+  // Each robot's STATE, with its first face scanner's face frames.
+  void PublishStates(std::int64_t now_utime);
+  // Moves the floating origin to the first robot when it is far from it.
+  void KeepOriginNearRobot();
   void WriteDueScans(double t);
   void SubmitDueFrames(double t, TickRecord* record);
   // Once a second, and at once when an input turns stale or fresh.
@@ -136,6 +146,8 @@ class SandboxLoop {
   bool output_lost_{false};
   std::int64_t first_input_utime_{-1};
   double next_status_s_{0.0}, next_progress_s_{0.0};
+  std::int64_t origin_moves_{0};
+  double longest_origin_move_ms_{0.0};
   RateSchedule scan_file_schedule_{options_.scans_every_s > 0.0 ? 1.0 / options_.scans_every_s
                                                                 : 0.0};
 };

@@ -118,7 +118,9 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
         level_file, {},
         parsed->flags.count("--isolate") > 0 ? Isolation::kAlways : Isolation::kSceneFiles);
     const scene::Level& level = loaded.level;
-    const scene::CollisionWorld world(level);
+    scene::CollisionWorld world(level);
+    // The floating origin at the sensor (whole metres), as the loop keeps it near the robot.
+    world.SetOrigin(X_WS.translation().array().round().matrix());
     sensors::RayCaster caster;
     sensors::RayFilter filter;
     if (!see_robots) filter.group_mask = scene::kWorldStatic | scene::kWorldMovable;

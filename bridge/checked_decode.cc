@@ -129,7 +129,7 @@ void Layout(const ground_map_t*, WireReader& r) {
 void Layout(const lidar_scan_t*, WireReader& r) {
   r.Fixed(8 * 4 + 4, "the header");
   const std::int64_t steps = r.Count("steps");
-  r.Fixed(8 * 3, "origin");
+  r.Fixed(8 * 3 + 8 + 8 * 14, "origin and the sweep's poses");
   const std::int64_t beams = r.Count("num_beams");
   r.Array(beams, 4, "range_m");
   r.Array(beams, 1, "hit");

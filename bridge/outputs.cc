@@ -13,12 +13,11 @@ namespace sandbox::bridge {
 
 namespace {
 
-// The header every output carries: when, its sequence number, and the input
-// it was computed from.
+// The header every output carries: when, and the input it was computed from
+// (Send numbers it on its channel).
 template <typename Message>
-void Stamp(std::int64_t now_utime, std::int64_t seq, const InputTag& input, Message* message) {
+void Stamp(std::int64_t now_utime, const InputTag& input, Message* message) {
   message->utime = now_utime;
-  message->seq = seq;
   message->input_seq = input.seq;
   message->input_utime = input.utime;
 }
@@ -33,6 +32,13 @@ void Offsets(const std::vector<Eigen::Vector3d>& points_W, const Eigen::Vector3d
   }
 }
 
+// A pose as position and w, x, y, z.
+void PoseFields(const Eigen::Isometry3d& X, double position[3], double orientation[4]) {
+  const Eigen::Quaterniond q(X.linear());
+  for (int k = 0; k < 3; ++k) position[k] = X.translation()[k];
+  orientation[0] = q.w(), orientation[1] = q.x(), orientation[2] = q.y(), orientation[3] = q.z();
+}
+
 }  // namespace
 
 RobotOutputs::RobotOutputs(LcmLink& link, std::string channel_prefix,
@@ -42,7 +48,8 @@ RobotOutputs::RobotOutputs(LcmLink& link, std::string channel_prefix,
       state_translation_(state_translation) {}
 
 template <typename Message>
-void RobotOutputs::Send(const std::string& topic, const Message& message) {
+void RobotOutputs::Send(const std::string& topic, Message& message) {
+  message.seq = next_seq_[topic]++;  // each channel counts its own messages
   buffer_.resize(std::size_t(message.getEncodedSize()));
   message.encode(buffer_.data(), 0, int(buffer_.size()));
   if (link_.Publish(prefix_ + topic, buffer_.data(), unsigned(buffer_.size()))) ++published_;
@@ -77,7 +84,7 @@ void RobotOutputs::PublishFaces(const sensors::FaceScan& scan, std::int64_t tick
     const sensors::ScanFace& face = scan.faces[std::size_t(f)];
     if (face.tick != tick) continue;
     sandbox_msgs::scan_face_t message{};
-    Stamp(now_utime, seq_++, input, &message);
+    Stamp(now_utime, input, &message);
     message.tick = tick;
     message.face = std::int8_t(f);
     message.n = scan.n;
@@ -98,7 +105,7 @@ void RobotOutputs::PublishFaces(const sensors::FaceScan& scan, std::int64_t tick
 void RobotOutputs::PublishGround(const sensors::HeightMap& map, const InputTag& input,
                                  std::int64_t now_utime, const std::string& channel) {
   sandbox_msgs::ground_map_t message{};
-  Stamp(now_utime, seq_++, input, &message);
+  Stamp(now_utime, input, &message);
   message.n = map.n;
   message.resolution_m = map.resolution_m;
   message.corner[0] = map.corner_W.x(), message.corner[1] = map.corner_W.y();
@@ -111,11 +118,14 @@ void RobotOutputs::PublishGround(const sensors::HeightMap& map, const InputTag& 
 void RobotOutputs::PublishLidar(const sensors::LidarScan& scan, const InputTag& input,
                                 std::int64_t now_utime, const std::string& channel) {
   sandbox_msgs::lidar_scan_t message{};
-  Stamp(now_utime, seq_++, input, &message);
+  Stamp(now_utime, input, &message);
   message.channels = scan.channels;
   message.steps = scan.azimuth_steps;
   const Eigen::Vector3d& origin = scan.origin_W;
   for (int k = 0; k < 3; ++k) message.origin[k] = origin[k];
+  message.sweep_s = scan.sweep_s;
+  PoseFields(scan.X_WS_start, message.start_position, message.start_orientation);
+  PoseFields(scan.X_WS_end, message.end_position, message.end_orientation);
   const std::size_t n = scan.range_m.size();
   message.num_beams = int(n);
   message.range_m = scan.range_m;
@@ -130,7 +140,7 @@ void RobotOutputs::PublishRange(const std::string& sensor, const sensors::RangeR
                                 const InputTag& input, std::int64_t now_utime,
                                 const std::string& channel) {
   sandbox_msgs::range_t message{};
-  Stamp(now_utime, seq_++, input, &message);
+  Stamp(now_utime, input, &message);
   message.sensor = sensor;
   for (int k = 0; k < 3; ++k) {
     message.origin[k] = reading.origin_W[k];
@@ -145,9 +155,9 @@ void RobotOutputs::PublishRange(const std::string& sensor, const sensors::RangeR
 }
 
 void RobotOutputs::PublishState(const scene::RobotState& state, const InputTag& input,
-                                std::int64_t now_utime) {
+                                std::int64_t now_utime, const FaceFrames* X_WF) {
   sandbox_msgs::robot_state_t message{};
-  Stamp(now_utime, seq_++, input, &message);
+  Stamp(now_utime, input, &message);
   Eigen::Vector3d p;
   Eigen::Quaterniond q;
   state_translation_.FromWorld(state.pose(), &p, &q);
@@ -156,9 +166,13 @@ void RobotOutputs::PublishState(const scene::RobotState& state, const InputTag& 
   message.orientation[2] = q.y(), message.orientation[3] = q.z();
   message.num_values = int(state.bone_values().size());
   message.bone_values = state.bone_values();
-  // Face frames: at the robot origin, face f's axis along the robot's axis f.
+  // Face frames in the robot frame (the sandbox's own body axes); without a
+  // face scanner, the robot frame itself.
   for (int f = 0; f < 6; ++f) {
-    message.face_orientations[4 * f] = 1.0;
+    const Eigen::Isometry3d X_RF = X_WF != nullptr
+                                       ? Eigen::Isometry3d(state.pose().inverse() * (*X_WF)[std::size_t(f)])
+                                       : Eigen::Isometry3d::Identity();
+    PoseFields(X_RF, &message.face_positions[3 * f], &message.face_orientations[4 * f]);
   }
   Send("STATE", message);
 }
@@ -168,7 +182,6 @@ void RobotOutputs::PublishStatus(double loop_rate_hz, std::int64_t ticks, std::i
                                  std::int64_t now_utime) {
   sandbox_msgs::status_t message{};
   message.utime = now_utime;
-  message.seq = seq_++;
   message.loop_rate_hz = loop_rate_hz;
   message.ticks = ticks;
   message.overruns = overruns;

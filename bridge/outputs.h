@@ -1,9 +1,12 @@
 #pragma once
 // What the sandbox publishes for a robot: <ROBOT>/SCAN_FACE, /GROUND, /LIDAR, /RANGE,
-// /STATE and /STATUS, each tagged with the sequence number and time of the
-// pose input it was computed from. Threads: the loop thread.
+// /STATE and /STATUS, each numbered on its own channel (seq 0, 1, 2, ...) and
+// tagged with the sequence number and time of the pose input it was computed
+// from. Threads: the loop thread.
 
+#include <array>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -57,9 +60,13 @@ class RobotOutputs {
   // One single-ray sensor's reading; `sensor` tells several on one robot apart.
   void PublishRange(const std::string& sensor, const sensors::RangeReading& reading,
                     const InputTag& input, std::int64_t now_utime, const std::string& channel = "");
-  // The robot pose and bones in use, and the face scanner's face frames in
-  // the robot frame (identity rotations for a body-aligned box at the origin).
-  void PublishState(const scene::RobotState& state, const InputTag& input, std::int64_t now_utime);
+  // Face f's frame in the world: the scanner box it was last scanned in
+  // (sensors::ScanFace::X_WB).
+  using FaceFrames = std::array<Eigen::Isometry3d, 6>;
+  // The robot pose and bones in use, and the face frames `X_WF` in the robot
+  // frame at that pose (null: no face scanner; the robot frame itself).
+  void PublishState(const scene::RobotState& state, const InputTag& input, std::int64_t now_utime,
+                    const FaceFrames* X_WF = nullptr);
   void PublishStatus(double loop_rate_hz, std::int64_t ticks, std::int64_t overruns,
                      const std::vector<ChannelStatus>& channels, std::int64_t now_utime);
 
@@ -67,13 +74,14 @@ class RobotOutputs {
   std::int64_t published() const { return published_; }
 
  private:
+  // Numbers `message` on its channel and publishes it.
   template <typename Message>
-  void Send(const std::string& topic, const Message& message);
+  void Send(const std::string& topic, Message& message);
 
   LcmLink& link_;
   std::string prefix_;
   Translation state_translation_;
-  std::int64_t seq_{0};
+  std::map<std::string, std::int64_t> next_seq_;  // per channel
   std::int64_t published_{0};
   std::vector<std::uint8_t> buffer_;
 };

@@ -74,9 +74,11 @@ RobotBridgeConfig RobotBridgeConfig::FromModel(const scene::RobotModel& model) {
     config.udp_doubles_layout = read.Texts("udp_doubles_layout");
     std::set<std::string> seen;
     for (const std::string& item : config.udp_doubles_layout) {
-      if (item != "position" && item != "quaternion" && item != "rpy" && item != "bones") {
+      if (item != "position" && item != "quaternion" && item != "rpy" && item != "bones" &&
+          item != "time" && item != "seq") {
         read.Fail("udp_doubles_layout",
-                  "'udp_doubles_layout' items are position, quaternion, rpy and bones, got '" +
+                  "'udp_doubles_layout' items are time, seq, position, quaternion, rpy and "
+                  "bones, got '" +
                       item + "'");
       }
       if (!seen.insert(item).second) {

@@ -121,10 +121,11 @@ namespace {
 std::size_t ExpectedDoubles(const RobotBridgeConfig& config, int num_bone_values) {
   std::size_t expected = 0;
   for (const std::string& item : config.udp_doubles_layout) {
-    expected += item == "position"     ? 3
-                : item == "quaternion" ? 4
-                : item == "rpy"        ? 3
-                                       : std::size_t(num_bone_values);
+    expected += item == "position"                  ? 3
+                : item == "quaternion"              ? 4
+                : item == "rpy"                     ? 3
+                : item == "time" || item == "seq"   ? 1
+                                                    : std::size_t(num_bone_values);
   }
   return expected;
 }
@@ -134,7 +135,7 @@ std::size_t ExpectedDoubles(const RobotBridgeConfig& config, int num_bone_values
 std::string DecodeDoubles(const RobotBridgeConfig& config, int num_bone_values,
                           const std::uint8_t* data, std::size_t size,
                           const Eigen::Isometry3d& X_WB_before, Eigen::Isometry3d* X_WB,
-                          std::vector<double>* bones) {
+                          std::vector<double>* bones, PacketTag* tag) {
   const std::size_t expected = ExpectedDoubles(config, num_bone_values);
   if (size != 8 * expected) {
     return "expected " + std::to_string(expected) + " doubles (" + std::to_string(8 * expected) +
@@ -151,9 +152,18 @@ std::string DecodeDoubles(const RobotBridgeConfig& config, int num_bone_values,
   Eigen::Vector3d position = X_WB_before.translation();
   Eigen::Quaterniond q(X_WB_before.linear());
   bones->clear();
+  PacketTag own;
   std::size_t at = 0;
   for (const std::string& item : config.udp_doubles_layout) {
-    if (item == "position") {
+    if (item == "time") {
+      if (v[at] < 0.0 || v[at] > 9.2e12) return "time must be 0 to 9.2e12 s";
+      own.utime = std::llround(v[at++] * 1e6);
+    } else if (item == "seq") {
+      if (v[at] < 0.0 || v[at] > 9e15 || v[at] != std::floor(v[at])) {
+        return "seq must be a whole number from 0";
+      }
+      own.seq = std::int64_t(v[at++]);
+    } else if (item == "position") {
       position = Eigen::Vector3d(v[at], v[at + 1], v[at + 2]), at += 3;
     } else if (item == "quaternion") {
       q = Eigen::Quaterniond(v[at], v[at + 1], v[at + 2], v[at + 3]), at += 4;
@@ -174,6 +184,7 @@ std::string DecodeDoubles(const RobotBridgeConfig& config, int num_bone_values,
     }
   }
   *X_WB = config.pose.ToWorld(position, q);
+  if (tag != nullptr) *tag = own;
   return scene::PoseProblem(*X_WB);
 }
 
@@ -195,8 +206,9 @@ bool DoublesInput::Apply(scene::RobotState* state) {
   if (packet == nullptr) return false;
   Eigen::Isometry3d X_WB;
   std::vector<double> bones;
+  PacketTag tag;
   const std::string problem = DecodeDoubles(config_, num_values_, packet->data(), packet->size(),
-                                            state->pose(), &X_WB, &bones);
+                                            state->pose(), &X_WB, &bones, &tag);
   if (!problem.empty()) {
     socket_.Reject(problem);
     return false;
@@ -209,6 +221,7 @@ bool DoublesInput::Apply(scene::RobotState* state) {
     socket_.Reject(state->last_rejection());
     return false;
   }
+  last_tag_ = tag;
   return true;
 }
 

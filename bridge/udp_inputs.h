@@ -52,6 +52,12 @@ class UdpLatest {
   std::string last_reason_;
 };
 
+// The sequence number and time a packet carries (-1 where its format has none).
+struct PacketTag {
+  std::int64_t seq{-1};
+  std::int64_t utime{-1};
+};
+
 // FlightGear net_fdm: geodetic position and NED attitude drive the robot
 // pose; control-surface fields drive the bones the config names.
 class NetFdmInput {
@@ -59,6 +65,9 @@ class NetFdmInput {
   NetFdmInput(const RobotBridgeConfig& config);
   // Applies the newest good packet; true when the pose changed.
   bool Apply(scene::RobotState* state);
+  // The applied packet's time: its cur_time (whole seconds since 1970) in
+  // microseconds, -1 when it is 0. The format has no counter (seq -1).
+  PacketTag last_tag() const { return {-1, last_.cur_time > 0 ? 1'000'000LL * last_.cur_time : -1}; }
   const UdpLatest& socket() const { return socket_; }
   void set_log(RejectLog* log) { socket_.set_log(log); }
   const NetFdm& last_good() const { return last_; }
@@ -71,13 +80,15 @@ class NetFdmInput {
 };
 
 // A packet of doubles in `config`'s layout and byte order, decoded: the pose
-// (items the layout lacks keep X_WB_before's) and the bone values (empty when
-// the layout has none). Returns "" or why the packet is rejected (size,
-// non-finite value, non-unit quaternion, a pose that is no pose).
+// (items the layout lacks keep X_WB_before's), the bone values (empty when
+// the layout has none) and the packet's own `time` (seconds) and `seq` when
+// the layout has them (`tag`, may be null). Returns "" or why the packet is
+// rejected (size, non-finite value, non-unit quaternion, a pose that is no
+// pose, a seq or time that is negative or not whole).
 std::string DecodeDoubles(const RobotBridgeConfig& config, int num_bone_values,
                           const std::uint8_t* data, std::size_t size,
                           const Eigen::Isometry3d& X_WB_before, Eigen::Isometry3d* X_WB,
-                          std::vector<double>* bones);
+                          std::vector<double>* bones, PacketTag* tag = nullptr);
 
 // A plain vector of doubles in the configured layout and byte order.
 class DoublesInput {
@@ -87,10 +98,13 @@ class DoublesInput {
   const UdpLatest& socket() const { return socket_; }
   void set_log(RejectLog* log) { socket_.set_log(log); }
   std::size_t expected_doubles() const { return expected_; }
+  // The applied packet's `seq` and `time` (microseconds), -1 for what the layout lacks.
+  PacketTag last_tag() const { return last_tag_; }
 
  private:
   RobotBridgeConfig config_;
   UdpLatest socket_;
+  PacketTag last_tag_;
   std::size_t expected_{0};
   int num_values_{0};
 };

@@ -72,6 +72,13 @@ FaceScan FaceScanner::EmptyScan() const {
   return scan;
 }
 
+Eigen::Isometry3d FaceScanner::BoxFrame(const Eigen::Isometry3d& X_WS) const {
+  Eigen::Isometry3d X_WB = Eigen::Isometry3d::Identity();
+  if (config_.alignment == Alignment::kBody) X_WB.linear() = X_WS.linear();
+  X_WB.translation() = X_WS.translation();
+  return X_WB;
+}
+
 std::vector<FaceScanner::Part> FaceScanner::DueAt(std::int64_t tick) const {
   const auto t = static_cast<std::uint64_t>(tick < 0 ? 0 : tick);
   switch (config_.refresh) {
@@ -126,6 +133,7 @@ void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
     ScanFace& face = scan->faces[std::size_t(part.face)];
     face.tick = tick;
     face.X_WS = X_WS;
+    face.X_WB = BoxFrame(X_WS);
     for (int r = part.row_begin; r < part.row_end; ++r) {
       for (int c = 0; c < n_; ++c, ++i) {
         const std::size_t k = std::size_t(r) * std::size_t(n_) + std::size_t(c);

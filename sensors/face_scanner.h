@@ -50,6 +50,7 @@ enum Occupancy : std::int8_t { kUnvisited = -1, kFree = 0, kOccupied = 1 };
 struct ScanFace {
   std::int64_t tick{-1};  // the tick its latest rows were scanned at; -1: never
   Eigen::Isometry3d X_WS{Eigen::Isometry3d::Identity()};  // sensor pose of that scan
+  Eigen::Isometry3d X_WB{Eigen::Isometry3d::Identity()};  // the box of that scan (BoxFrame)
   std::vector<std::int8_t> occupancy;                     // n * n, Occupancy
   std::vector<Eigen::Vector3d> points_W;  // n * n: the hit, or the ray's end when free
 };
@@ -68,6 +69,11 @@ class FaceScanner {
 
   // A scan sized for this scanner with every point unvisited.
   FaceScan EmptyScan() const;
+
+  // The box's frame at sensor pose X_WS: at the sensor, with the sensor's
+  // axes (body alignment) or the world's (world alignment). Face f's rays
+  // start at u_f (-E + c res) + v_f (-E + r res) in it and run along FaceAxis(f).
+  Eigen::Isometry3d BoxFrame(const Eigen::Isometry3d& X_WS) const;
 
   // Scans what is due at `tick` (see Refresh) from sensor pose X_WS and
   // writes it into `scan`; the rest of `scan` keeps its earlier values.

@@ -88,6 +88,9 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
     scan->points_W[i] =
         rays.origin_W + (rays.start[i] + hits.distance_m[i] * rays.direction[i]).cast<double>();
   }
+  scan->sweep_s = 1.0 / config_.rotation_hz;
+  scan->X_WS_start = X_WS_start;
+  scan->X_WS_end = X_WS_end;
   scan->time_s.resize(std::size_t(config_.azimuth_steps));
   for (int k = 0; k < config_.azimuth_steps; ++k) {
     scan->time_s[std::size_t(k)] = k / (config_.azimuth_steps * config_.rotation_hz);

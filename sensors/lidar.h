@@ -39,6 +39,9 @@ struct LidarScan {
   std::vector<Eigen::Vector3d> points_W;              // the hit, or the beam's end
   std::vector<double> time_s;                         // per azimuth step, from the sweep's start
   Eigen::Vector3d origin_W{Eigen::Vector3d::Zero()};  // the sensor at the sweep's start
+  double sweep_s{0.0};                                // 1 / rotation_hz
+  Eigen::Isometry3d X_WS_start{Eigen::Isometry3d::Identity()};
+  Eigen::Isometry3d X_WS_end{Eigen::Isometry3d::Identity()};
 };
 
 class Lidar {

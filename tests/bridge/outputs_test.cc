@@ -92,6 +92,34 @@ TEST(RobotOutputsTest, StateEchoesThePoseAndTheBoneValuesInUse) {
   EXPECT_EQ(message.input_seq, 7);
 }
 
+TEST(RobotOutputsTest, EachChannelCountsItsOwnMessages) {
+  const scene::Level level = scene::LoadLevel(testing::SampleLevel());
+  scene::RobotState wing(level.robots[0]);
+  LcmLink link("memq://");
+  LatestInput range(link, "ELAHA/RANGE"), state(link, "ELAHA/STATE");
+  RobotOutputs outputs(link, "ELAHA");
+  sensors::RangeReading reading;
+  std::vector<std::int64_t> range_seqs, state_seqs;
+  for (int i = 0; i < 3; ++i) {
+    outputs.PublishRange("a", reading, InputTag{i, i}, 1000 + i);
+    outputs.PublishState(wing, InputTag{i, i}, 1000 + i);
+    outputs.PublishRange("b", reading, InputTag{i, i}, 1000 + i);  // a second sensor, same channel
+    link.Drain();
+    sandbox_msgs::range_t r;
+    const std::vector<std::uint8_t>* bytes = range.TakeNewest();
+    ASSERT_NE(bytes, nullptr);
+    ASSERT_EQ(r.decode(bytes->data(), 0, int(bytes->size())), int(bytes->size()));
+    range_seqs.push_back(r.seq);
+    sandbox_msgs::robot_state_t s;
+    bytes = state.TakeNewest();
+    ASSERT_NE(bytes, nullptr);
+    ASSERT_EQ(s.decode(bytes->data(), 0, int(bytes->size())), int(bytes->size()));
+    state_seqs.push_back(s.seq);
+  }
+  EXPECT_EQ(range_seqs, (std::vector<std::int64_t>{1, 3, 5}));  // the newest of each two
+  EXPECT_EQ(state_seqs, (std::vector<std::int64_t>{0, 1, 2}));
+}
+
 TEST(RobotOutputsTest, TwoSensorsOfATypeNeedTheirOwnChannels) {
   testing::TempDir dir;
   const std::string face =

@@ -60,6 +60,7 @@ TEST(UdpInputsTest, NetFdmDrivesPoseAndControlSurfaces) {
   fdm.altitude_m = 600.0;         // 100 m up
   fdm.psi_rad = float(M_PI / 2);  // heading east
   fdm.elevator = 0.5f;
+  fdm.cur_time = 1'700'000'000;  // the sender's clock, whole seconds since 1970
   for (const float lat_offset : {0.0f, 1.0f}) {  // two packets: the newest wins
     NetFdm sent = fdm;
     sent.latitude_rad += lat_offset * 1e-9;
@@ -70,6 +71,8 @@ TEST(UdpInputsTest, NetFdmDrivesPoseAndControlSurfaces) {
   ASSERT_TRUE(input.Apply(&state));
   EXPECT_EQ(input.socket().received(), 2);
   EXPECT_EQ(input.socket().superseded(), 1);
+  EXPECT_EQ(input.last_tag().utime, 1'700'000'000'000'000);  // the packet's own time
+  EXPECT_EQ(input.last_tag().seq, -1);                        // the format has no counter
   // North: the meridian radius of curvature at 47 degrees (plus the altitude)
   // times the latitude step.
   const double e2 = 0.00669437999014, s47 = std::sin(47.0 * M_PI / 180.0);
@@ -138,6 +141,36 @@ TEST(UdpInputsTest, DoublesInTheConfiguredLayout) {
   ASSERT_TRUE(input.Apply(&state));
   EXPECT_TRUE(state.pose().translation().isApprox(Vector3d(7, 2, 3)));
   EXPECT_EQ(input.socket().rejected(), 2);
+}
+
+TEST(UdpInputsTest, DoublesCarryTheirOwnTimeAndSequenceNumber) {
+  testing::TempDir dir;
+  const int port = TestPort(2);
+  const scene::Level level = WingLevel(dir, "udp_doubles_port = " + std::to_string(port) +
+                                                "\nudp_doubles_layout = [\"time\", \"seq\", "
+                                                "\"position\"]\n");
+  const RobotBridgeConfig config = RobotBridgeConfig::FromModel(level.robots[0]);
+  DoublesInput input(config, level.robots[0]);
+  ASSERT_EQ(input.expected_doubles(), 1u + 1u + 3u);
+  EXPECT_EQ(input.last_tag().seq, -1);  // nothing applied yet
+  scene::RobotState state(level.robots[0]);
+  const double packet[5] = {12.5, 41, 1, 2, 3};  // 12.5 s on the sender's clock, its packet 41
+  Send(port, packet, sizeof(packet));
+  usleep(20000);
+  ASSERT_TRUE(input.Apply(&state));
+  EXPECT_EQ(input.last_tag().seq, 41);
+  EXPECT_EQ(input.last_tag().utime, 12'500'000);
+  const double bad_seq[5] = {13, 41.5, 1, 2, 3};
+  Send(port, bad_seq, sizeof(bad_seq));
+  usleep(20000);
+  EXPECT_FALSE(input.Apply(&state));
+  EXPECT_EQ(input.socket().last_reject_reason(), "seq must be a whole number from 0");
+  EXPECT_EQ(input.last_tag().seq, 41);  // the last good packet's
+  const double bad_time[5] = {-1, 42, 1, 2, 3};
+  Send(port, bad_time, sizeof(bad_time));
+  usleep(20000);
+  EXPECT_FALSE(input.Apply(&state));
+  EXPECT_EQ(input.socket().last_reject_reason(), "time must be 0 to 9.2e12 s");
 }
 
 TEST(UdpInputsTest, BridgeSettingsMistakes) {
