@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
+#include <string>
 
 #if defined(__SSE2__)
-#include <emmintrin.h>
+#include <immintrin.h>
 #endif
 
 #include "scene/collision_world_internal.h"
@@ -125,18 +127,22 @@ inline Eigen::Vector3f StableNormal(const Eigen::Vector3f& a, const Eigen::Vecto
 // ulps of slack on the distances). A hit the edge test admits within its
 // rounding tolerance but that lies outside the triangle's box is no hit: a ray
 // passing a hair outside an outer edge misses, as a watertight caster's box
-// test has it.
+// test has it. A direction component of exactly 0 counts as an
+// infinitesimally positive one (Embree's convention): a ray running along the
+// box's upper bound on that axis leaves the box at once, along its lower bound
+// stays in it; of two surfaces that abut there without sharing an edge, the
+// ray meets exactly one.
+constexpr float kHuge = 1e30f;
+
 inline bool MeetsCornerBox(const Eigen::Vector3f corner[3], const Eigen::Vector3f& o,
                            const Eigen::Vector3f& d, float t) {
   float t_enter = 0.0f, t_exit = t;
   for (int k = 0; k < 3; ++k) {
     const float lo = std::min({corner[0][k], corner[1][k], corner[2][k]});
     const float hi = std::max({corner[0][k], corner[1][k], corner[2][k]});
-    if (d[k] == 0.0f) {  // along the slab: inside it all the way, or never
-      if (o[k] < lo || o[k] > hi) return false;
-      continue;
-    }
-    const float t1 = (lo - o[k]) / d[k], t2 = (hi - o[k]) / d[k];
+    // A zero component counts as an infinitesimally positive one.
+    const float inverse = d[k] == 0.0f ? kHuge : 1.0f / d[k];
+    const float t1 = (lo - o[k]) * inverse, t2 = (hi - o[k]) * inverse;
     t_enter = std::max(t_enter, std::min(t1, t2));
     t_exit = std::min(t_exit, std::max(t1, t2));
   }
@@ -269,29 +275,11 @@ struct Vec4 {  // a vector per lane
 };
 inline Vec4 Sub(const Vec4& a, const Vec4& b) { return {Sub(a.x, b.x), Sub(a.y, b.y), Sub(a.z, b.z)}; }
 inline Vec4 Add(const Vec4& a, const Vec4& b) { return {Add(a.x, b.x), Add(a.y, b.y), Add(a.z, b.z)}; }
-inline __m128 Dot(const Vec4& a, const Vec4& b) {
-  return Add(Add(Mul(a.x, b.x), Mul(a.y, b.y)), Mul(a.z, b.z));
-}
-inline Vec4 Cross(const Vec4& a, const Vec4& b) {
-  return {Sub(Mul(a.y, b.z), Mul(a.z, b.y)), Sub(Mul(a.z, b.x), Mul(a.x, b.z)),
-          Sub(Mul(a.x, b.y), Mul(a.y, b.x))};
-}
 inline __m128 Abs(__m128 x) { return _mm_andnot_ps(_mm_set1_ps(-0.0f), x); }
+inline __m128 L1(const Vec4& a) { return Add(Add(Abs(a.x), Abs(a.y)), Abs(a.z)); }
 inline __m128 Select(__m128 mask, __m128 a, __m128 b) {
   return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
 }
-// StableNormal, per lane.
-inline Vec4 StableNormal4(const Vec4& a, const Vec4& b, const Vec4& c) {
-  const __m128 ab_x = Mul(a.z, b.y), ab_y = Mul(a.x, b.z), ab_z = Mul(a.y, b.x);
-  const __m128 bc_x = Mul(b.z, c.y), bc_y = Mul(b.x, c.z), bc_z = Mul(b.y, c.x);
-  return {Select(_mm_cmplt_ps(Abs(ab_x), Abs(bc_x)), Sub(Mul(a.y, b.z), ab_x),
-                 Sub(Mul(b.y, c.z), bc_x)),
-          Select(_mm_cmplt_ps(Abs(ab_y), Abs(bc_y)), Sub(Mul(a.z, b.x), ab_y),
-                 Sub(Mul(b.z, c.x), bc_y)),
-          Select(_mm_cmplt_ps(Abs(ab_z), Abs(bc_z)), Sub(Mul(a.x, b.y), ab_z),
-                 Sub(Mul(b.x, c.y), bc_z))};
-}
-
 // MeetsCornerBox, per lane.
 inline __m128 MeetsCornerBox4(const Eigen::Vector3f corner[3], const Vec4& o, const Vec4& d,
                               __m128 t) {
@@ -300,118 +288,71 @@ inline __m128 MeetsCornerBox4(const Eigen::Vector3f corner[3], const Vec4& o, co
   for (int k = 0; k < 3; ++k) {
     const float lo = std::min({corner[0][k], corner[1][k], corner[2][k]});
     const float hi = std::max({corner[0][k], corner[1][k], corner[2][k]});
-    const __m128 low = _mm_set1_ps(lo), high = _mm_set1_ps(hi);
-    const __m128 t1 = _mm_div_ps(Sub(low, origin[k]), direction[k]);
-    const __m128 t2 = _mm_div_ps(Sub(high, origin[k]), direction[k]);
-    // Lanes along the slab (zero direction): inside it all the way, or never.
-    const __m128 along = _mm_cmpeq_ps(direction[k], _mm_setzero_ps());
-    const __m128 within = _mm_and_ps(_mm_cmpge_ps(origin[k], low), _mm_cmple_ps(origin[k], high));
-    const __m128 infinity = _mm_set1_ps(std::numeric_limits<float>::infinity());
-    const __m128 near = Select(along, Select(within, Sub(_mm_setzero_ps(), infinity), infinity),
-                               _mm_min_ps(t1, t2));
-    const __m128 far = Select(along, Select(within, infinity, Sub(_mm_setzero_ps(), infinity)),
-                              _mm_max_ps(t1, t2));
-    t_enter = _mm_max_ps(t_enter, near);
-    t_exit = _mm_min_ps(t_exit, far);
+    // A zero component counts as an infinitesimally positive one.
+    const __m128 zero = _mm_cmpeq_ps(direction[k], _mm_setzero_ps());
+    const __m128 inverse = Select(zero, _mm_set1_ps(kHuge),
+                                  _mm_div_ps(_mm_set1_ps(1.0f), direction[k]));
+    const __m128 t1 = Mul(Sub(_mm_set1_ps(lo), origin[k]), inverse);
+    const __m128 t2 = Mul(Sub(_mm_set1_ps(hi), origin[k]), inverse);
+    t_enter = _mm_max_ps(t_enter, _mm_min_ps(t1, t2));
+    t_exit = _mm_min_ps(t_exit, _mm_max_ps(t1, t2));
   }
   const float slack = 2.0f * std::numeric_limits<float>::epsilon();
   return _mm_cmple_ps(Mul(t_enter, _mm_set1_ps(1.0f - slack)),
                       Mul(t_exit, _mm_set1_ps(1.0f + slack)));
 }
 
-// HitTriangle for the four rays of a packet (Bullet frame); updates the lanes it hits.
-inline void HitTriangle4(const Target& target, int part_id, int triangle, const Vec4& o,
-                         const Vec4& d, __m128 lanes, Packet* packet, __m128* t_max) {
-  Eigen::Vector3f corner[3];
-  Corners(target, part_id, triangle, corner);
-  auto relative = [&o](const Eigen::Vector3f& p) {
-    return Sub(Vec4{_mm_set1_ps(p.x()), _mm_set1_ps(p.y()), _mm_set1_ps(p.z())}, o);
-  };
-  const Vec4 v0 = relative(corner[0]), v1 = relative(corner[1]), v2 = relative(corner[2]);
-  const Vec4 e0 = Sub(v2, v0), e1 = Sub(v0, v1), e2 = Sub(v1, v2);
-  const __m128 u = Dot(Cross(e0, Add(v2, v0)), d);
-  const __m128 v = Dot(Cross(e1, Add(v0, v1)), d);
-  const __m128 w = Dot(Cross(e2, Add(v1, v2)), d);
-  const __m128 eps =
-      Mul(_mm_set1_ps(std::numeric_limits<float>::epsilon()), Abs(Add(Add(u, v), w)));
-  const __m128 low = _mm_min_ps(_mm_min_ps(u, v), w), high = _mm_max_ps(_mm_max_ps(u, v), w);
-  __m128 hit = _mm_and_ps(lanes, _mm_or_ps(_mm_cmpge_ps(low, Sub(_mm_setzero_ps(), eps)),
-                                           _mm_cmple_ps(high, eps)));
-  if (_mm_movemask_ps(hit) == 0) return;
-  const Vec4 n = StableNormal4(e0, e1, e2);
-  const __m128 den = Mul(_mm_set1_ps(2.0f), Dot(n, d));
-  const __m128 t = _mm_div_ps(Mul(_mm_set1_ps(2.0f), Dot(v0, n)), den);
-  hit = _mm_and_ps(hit, _mm_cmpneq_ps(den, _mm_setzero_ps()));
-  hit = _mm_and_ps(hit, _mm_cmpge_ps(t, _mm_setzero_ps()));
-  hit = _mm_and_ps(hit, _mm_cmplt_ps(t, *t_max));
-  if (_mm_movemask_ps(hit) == 0) return;
-  hit = _mm_and_ps(hit, MeetsCornerBox4(corner, o, d, t));
-  const int mask = _mm_movemask_ps(hit);
-  if (mask == 0) return;
-  *t_max = Select(hit, t, *t_max);
-  alignas(16) float nx[4], ny[4], nz[4];
-  _mm_store_ps(nx, n.x), _mm_store_ps(ny, n.y), _mm_store_ps(nz, n.z);
-  for (int lane = 0; lane < 4; ++lane) {
-    if (mask & (1 << lane)) {
-      packet->body[lane] = target.body;
-      packet->normal[lane] = Eigen::Vector3f(nx[lane], ny[lane], nz[lane]);
-    }
-  }
+// The packet's BVH walk and triangle test (sensors/packet_walk.inc), compiled twice:
+// for any SSE2 CPU, in plain arithmetic redone fused (emulated) where
+// rounding could turn a decision; and for CPUs with an FMA unit, fused
+// throughout. Fused multiply-adds are what Embree's kernels use on such CPUs,
+// the reference the grazing rules are matched to; both give the same results
+// but for the emulation's rare double rounding (see FusedMulAdd).
+namespace sse2_kernel {
+// a b + c (or a b - c) rounded once: the product of two floats is exact in
+// double, so only the sum rounds, to double and then to float (a double
+// rounding that differs from a single one needs a tie at float precision
+// after rounding to double: about once in 2^29 operations).
+inline __m128 FusedMulAdd(__m128 a, __m128 b, __m128 c, bool subtract) {
+  const __m128d a_lo = _mm_cvtps_pd(a), b_lo = _mm_cvtps_pd(b), c_lo = _mm_cvtps_pd(c);
+  const __m128d a_hi = _mm_cvtps_pd(_mm_movehl_ps(a, a)), b_hi = _mm_cvtps_pd(_mm_movehl_ps(b, b));
+  const __m128d c_hi = _mm_cvtps_pd(_mm_movehl_ps(c, c));
+  const __m128d lo = subtract ? _mm_sub_pd(_mm_mul_pd(a_lo, b_lo), c_lo)
+                              : _mm_add_pd(_mm_mul_pd(a_lo, b_lo), c_lo);
+  const __m128d hi = subtract ? _mm_sub_pd(_mm_mul_pd(a_hi, b_hi), c_hi)
+                              : _mm_add_pd(_mm_mul_pd(a_hi, b_hi), c_hi);
+  return _mm_movelh_ps(_mm_cvtpd_ps(lo), _mm_cvtpd_ps(hi));
 }
+constexpr bool kPlainFirst = true;
+#define SANDBOX_KERNEL_TARGET
+#include "sensors/packet_walk.inc"
+#undef SANDBOX_KERNEL_TARGET
+}  // namespace sse2_kernel
 
-// The packet's walk of one object's quantized BVH, nearest child first (by
-// the first lane's direction), shortening the lanes' rays at every hit.
-void WalkTarget4(const Target& target, Packet* packet) {
-  const Eigen::Matrix3f& R = target.R_LB;
-  auto transform = [&](int row, __m128 x, __m128 y, __m128 z, float offset) {
-    return Add(Add(Mul(_mm_set1_ps(R(row, 0)), x), Mul(_mm_set1_ps(R(row, 1)), y)),
-               Add(Mul(_mm_set1_ps(R(row, 2)), z), _mm_set1_ps(offset)));
-  };
-  const __m128 o[3] = {transform(0, packet->ox, packet->oy, packet->oz, target.p_LB[0]),
-                       transform(1, packet->ox, packet->oy, packet->oz, target.p_LB[1]),
-                       transform(2, packet->ox, packet->oy, packet->oz, target.p_LB[2])};
-  const __m128 d[3] = {transform(0, packet->dx, packet->dy, packet->dz, 0.0f),
-                       transform(1, packet->dx, packet->dy, packet->dz, 0.0f),
-                       transform(2, packet->dx, packet->dy, packet->dz, 0.0f)};
-  __m128 qo[3], inverse[3];
-  float lane0_qd[3];
-  int axis = 0;  // the first lane's dominant axis orders the children
-  for (int k = 0; k < 3; ++k) {
-    const __m128 quantization = _mm_set1_ps(target.quantization[k]);
-    qo[k] = Mul(Sub(o[k], _mm_set1_ps(target.bvh_min[k])), quantization);
-    const __m128 qd = AwayFromZero(Mul(d[k], quantization));
-    inverse[k] = _mm_div_ps(_mm_set1_ps(1.0f), qd);
-    lane0_qd[k] = _mm_cvtss_f32(qd);
+namespace fma_kernel {
+__attribute__((target("fma"))) inline __m128 FusedMulAdd(__m128 a, __m128 b, __m128 c,
+                                                         bool subtract) {
+  return subtract ? _mm_fmsub_ps(a, b, c) : _mm_fmadd_ps(a, b, c);
+}
+constexpr bool kPlainFirst = false;
+#define SANDBOX_KERNEL_TARGET __attribute__((target("fma")))
+#include "sensors/packet_walk.inc"
+#undef SANDBOX_KERNEL_TARGET
+}  // namespace fma_kernel
+
+// The FMA kernel where the CPU has the unit, unless SANDBOX_RAY_KERNEL=sse2
+// asks for the portable one (tests run both; the results are the same).
+const bool kHasFma = [] {
+  const char* kernel = std::getenv("SANDBOX_RAY_KERNEL");
+  return __builtin_cpu_supports("fma") && !(kernel != nullptr && std::string(kernel) == "sse2");
+}();
+
+inline void WalkTarget4(const Target& target, Packet* packet) {
+  if (kHasFma) {  // the same branch every time: predicted
+    fma_kernel::WalkTarget4(target, packet);
+  } else {
+    sse2_kernel::WalkTarget4(target, packet);
   }
-  for (int k = 1; k < 3; ++k) {
-    if (std::abs(lane0_qd[k]) > std::abs(lane0_qd[axis])) axis = k;
-  }
-  const bool positive = lane0_qd[axis] > 0.0f;
-  __m128 t_max = packet->t_max;
-  const Vec4 o_B{packet->ox, packet->oy, packet->oz}, d_B{packet->dx, packet->dy, packet->dz};
-  const btQuantizedBvhNode* nodes = target.nodes;
-  WalkStack<int, kStackInPlace> stack;
-  stack.Push(0);
-  while (!stack.empty()) {
-    const int index = stack.Pop();
-    const btQuantizedBvhNode& node = nodes[index];
-    const __m128 lanes = _mm_and_ps(packet->active, EnterBox4(node, qo, inverse, t_max));
-    if (_mm_movemask_ps(lanes) == 0) continue;
-    if (node.isLeafNode()) {
-      const int packed = node.m_escapeIndexOrTriangleIndex;
-      HitTriangle4(target, packed >> 21, packed & ((1 << 21) - 1), o_B, d_B, lanes, packet,
-                   &t_max);
-      continue;
-    }
-    const int left = index + 1;
-    const int right = left + (nodes[left].isLeafNode() ? 1 : nodes[left].getEscapeIndex());
-    // The child whose box starts further along the dominant axis is walked second.
-    const bool right_is_further =
-        (nodes[right].m_quantizedAabbMin[axis] >= nodes[left].m_quantizedAabbMin[axis]) == positive;
-    stack.Push(right_is_further ? right : left);
-    stack.Push(right_is_further ? left : right);
-  }
-  packet->t_max = t_max;
 }
 
 // Lanes whose rays enter an axis-aligned box (Bullet frame) before their t_max.
@@ -429,6 +370,14 @@ inline int PacketMeetsBox(const Packet& packet, const __m128 inverse[3], const T
 #endif
 
 }  // namespace
+
+const char* RayCaster::kernel() {
+#if defined(__SSE2__)
+  return kHasFma ? "fma" : "sse2";
+#else
+  return "scalar";
+#endif
+}
 
 void RayBatch::Resize(std::size_t n) {
   start.resize(n);

@@ -72,6 +72,10 @@ class RayCaster {
   // Entries a BVH walk keeps on its own stack before it grows on the heap
   // (a deeper tree costs an allocation per walk, never a dropped node).
   static constexpr int kStackInPlace = 32;
+  // The packet kernel in use: "fma" (the CPU's fused multiply-add unit),
+  // "sse2" (fused operations emulated where they decide; SANDBOX_RAY_KERNEL=sse2
+  // forces it) or "scalar" (no SSE2). All give the same hits.
+  static const char* kernel();
   // Rays cast since construction (frame statistics).
   std::int64_t rays_cast() const { return rays_cast_; }
 

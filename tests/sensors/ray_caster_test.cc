@@ -167,7 +167,9 @@ scene::Level Room(const testing::TempDir& dir) {
 // The first hit of a ray on the room's box faces, computed here in double
 // from the rules (docs/sensors.md): faces are closed rectangles; a ray lying
 // in a face's plane does not hit it; one whose origin lies on a face hits it
-// at 0; nothing at or beyond the ray's length. Returns the length for none.
+// at 0; a ray running along a face's upper bound on an axis it does not move
+// along misses it (past its origin); nothing at or beyond the ray's length.
+// Returns the length for none.
 double ExpectedHit(const Vector3d& o, const Vector3d& d, double length) {
   struct Box {
     Vector3d lo, hi;
@@ -183,7 +185,11 @@ double ExpectedHit(const Vector3d& o, const Vector3d& d, double length) {
         const Vector3d p = o + t * d;
         bool inside = true;
         for (int k = 0; k < 3; ++k) {
-          if (k != axis) inside = inside && p[k] >= box.lo[k] && p[k] <= box.hi[k];
+          if (k == axis) continue;
+          inside = inside && p[k] >= box.lo[k] && p[k] <= box.hi[k];
+          // Along an upper bound (a zero component counts as a tiny positive
+          // one): the ray leaves the face at once, so only its origin is on it.
+          if (d[k] == 0.0 && p[k] == box.hi[k] && t > 0.0) inside = false;
         }
         if (inside) best = t;
       }
@@ -242,7 +248,9 @@ TEST(RayRulesTest, GrazingAndOriginRulesHoldInAnAxisAlignedRoom) {
     EXPECT_EQ(mismatches, 0);
     // The cases do exercise the rules.
     EXPECT_GT(in_plane, 20);
-    if (c.at.x() == 6 || c.at == Vector3d(3, 3, 4)) EXPECT_GT(on_surface, 20);
+    if (c.at.x() == 6 || c.at == Vector3d(3, 3, 4)) {
+      EXPECT_GT(on_surface, 20);
+    }
   }
 }
 
