@@ -1,13 +1,33 @@
 #pragma once
-// Helpers for tests: a private temporary folder and file writing.
+// Helpers for tests: a private temporary folder and file writing, a free UDP port.
 
+#include <netinet/in.h>
 #include <stdlib.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <string>
 
 namespace sandbox::testing {
+
+// A UDP port on 127.0.0.1 that no one holds now (the kernel's pick for port
+// 0), for a test to bind next: tests run in parallel, so fixed ports collide.
+inline int FreeUdpPort() {
+  const int s = ::socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t size = sizeof(address);
+  int port = -1;
+  if (::bind(s, reinterpret_cast<sockaddr*>(&address), sizeof(address)) == 0 &&
+      ::getsockname(s, reinterpret_cast<sockaddr*>(&address), &size) == 0) {
+    port = ntohs(address.sin_port);
+  }
+  ::close(s);
+  return port;
+}
 
 // A fresh folder under the system temp folder, removed with its contents.
 class TempDir {

@@ -352,7 +352,7 @@ TEST(OutputContractTest, ScansTwoHundredKilometresOutAreAsPreciseAsAtTheOrigin) 
 // counter: the outputs are tagged with them, not with the receive count.
 TEST(OutputContractTest, OutputsFromUdpDoublesCarryThePacketsOwnSeqAndTime) {
   testing::TempDir dir;
-  const int port = 41000 + getpid() % 8000;
+  const int port = testing::FreeUdpPort();
   const fs::path level = dir.Write(
       "level.toml", "[[robot]]\nname = \"W\"\nfile = \"" + Wing() +
                         "\"\nbones = [\"root\"]\n\n[robot.bridge]\nbind_address = \"127.0.0.1\"\n"

@@ -19,8 +19,6 @@ namespace {
 
 using Eigen::Vector3d;
 
-// A port unlikely to be taken: one per test process.
-int TestPort(int offset) { return 40000 + (getpid() % 10000) * 2 + offset; }
 
 void Send(int port, const void* data, std::size_t size) {
   const int s = ::socket(AF_INET, SOCK_DGRAM, 0);
@@ -47,7 +45,7 @@ scene::Level WingLevel(const testing::TempDir& dir, const std::string& bridge) {
 
 TEST(UdpInputsTest, NetFdmDrivesPoseAndControlSurfaces) {
   testing::TempDir dir;
-  const int port = TestPort(0);
+  const int port = testing::FreeUdpPort();
   const scene::Level level = WingLevel(
       dir, "geodetic_origin = [47.0, 8.0, 500.0]\nnet_fdm_port = " + std::to_string(port) +
                "\nnet_fdm_elevator = [\"E1\"]\nnet_fdm_max_deflection_deg = 20\n");
@@ -104,7 +102,7 @@ TEST(UdpInputsTest, NetFdmDrivesPoseAndControlSurfaces) {
 
 TEST(UdpInputsTest, DoublesInTheConfiguredLayout) {
   testing::TempDir dir;
-  const int port = TestPort(1);
+  const int port = testing::FreeUdpPort();
   const scene::Level level = WingLevel(dir, "udp_doubles_port = " + std::to_string(port) +
                                                 "\nudp_doubles_layout = [\"position\", \"rpy\", "
                                                 "\"bones\"]\nudp_doubles_big_endian = true\n");
@@ -145,7 +143,7 @@ TEST(UdpInputsTest, DoublesInTheConfiguredLayout) {
 
 TEST(UdpInputsTest, DoublesCarryTheirOwnTimeAndSequenceNumber) {
   testing::TempDir dir;
-  const int port = TestPort(2);
+  const int port = testing::FreeUdpPort();
   const scene::Level level = WingLevel(dir, "udp_doubles_port = " + std::to_string(port) +
                                                 "\nudp_doubles_layout = [\"time\", \"seq\", "
                                                 "\"position\"]\n");
