@@ -123,6 +123,13 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
     }
     sensor_runs_.push_back(std::move(run));
   }
+  // Each robot's STATE carries its first face scanner's frames.
+  for (std::size_t s = 0; s < sensor_runs_.size(); ++s) {
+    RobotRun& robot = robots_[std::size_t(sensor_runs_[s].mounted->robot)];
+    if (robot.face_run < 0 && std::holds_alternative<sensors::FaceScanner>(sensor_runs_[s].sensor)) {
+      robot.face_run = int(s);
+    }
+  }
   // Each robot keeps its poses over its longest lidar sweep (and a tick more).
   for (const sensors::MountedSensor& m : mounted_) {
     if (const auto* lidar = std::get_if<sensors::LidarConfig>(&m.config)) {
@@ -370,21 +377,13 @@ void SandboxLoop::RunDueSensors(double t, std::int64_t now_utime) {
 }
 
 void SandboxLoop::PublishStates(std::int64_t now_utime) {
-  for (std::size_t r = 0; r < robots_.size(); ++r) {
-    RobotRun& robot = robots_[r];
-    // The face frames of the robot's first face scanner, as its faces were
-    // last scanned (faces not scanned yet: the box as it is now).
-    const SensorRun* face_run = nullptr;
-    for (const SensorRun& run : sensor_runs_) {
-      if (run.mounted->robot == int(r) && std::holds_alternative<sensors::FaceScanner>(run.sensor)) {
-        face_run = &run;
-        break;
-      }
-    }
-    if (face_run == nullptr) {
+  for (RobotRun& robot : robots_) {
+    if (robot.face_run < 0) {
       robot.outputs->PublishState(*robot.state, robot.input, now_utime);
       continue;
     }
+    // The face frames as the faces were last scanned (not scanned yet: the box as it is now).
+    const SensorRun* face_run = &sensor_runs_[std::size_t(robot.face_run)];
     const auto& scanner = std::get<sensors::FaceScanner>(face_run->sensor);
     bridge::RobotOutputs::FaceFrames X_WF;
     for (int f = 0; f < 6; ++f) {

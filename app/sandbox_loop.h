@@ -76,6 +76,7 @@ class SandboxLoop {
     std::unique_ptr<bridge::RobotOutputs> outputs;
     bridge::InputTag input;  // the input the outputs are tagged with
     PoseHistory history;     // its poses over the longest lidar sweep
+    int face_run{-1};        // its first face scanner in sensor_runs_, or -1
 
     // Every input's counters: the LCM channels, then the UDP sockets.
     std::vector<bridge::ChannelStatus> Channels(std::int64_t now_utime) const;

@@ -89,10 +89,8 @@ void RobotOutputs::PublishFaces(const sensors::FaceScan& scan, std::int64_t tick
     message.face = std::int8_t(f);
     message.n = scan.n;
     const Eigen::Vector3d p = face.X_WS.translation();
-    const Eigen::Quaterniond q(face.X_WS.linear());
-    for (int k = 0; k < 3; ++k) message.sensor_position[k] = p[k], message.origin[k] = p[k];
-    message.sensor_orientation[0] = q.w(), message.sensor_orientation[1] = q.x();
-    message.sensor_orientation[2] = q.y(), message.sensor_orientation[3] = q.z();
+    PoseFields(face.X_WS, message.sensor_position, message.sensor_orientation);
+    for (int k = 0; k < 3; ++k) message.origin[k] = p[k];
     const std::size_t n = face.occupancy.size();
     message.num_points = int(n);
     message.occupancy = face.occupancy;
@@ -169,9 +167,8 @@ void RobotOutputs::PublishState(const scene::RobotState& state, const InputTag& 
   // Face frames in the robot frame (the sandbox's own body axes); without a
   // face scanner, the robot frame itself.
   for (int f = 0; f < 6; ++f) {
-    const Eigen::Isometry3d X_RF = X_WF != nullptr
-                                       ? Eigen::Isometry3d(state.pose().inverse() * (*X_WF)[std::size_t(f)])
-                                       : Eigen::Isometry3d::Identity();
+    Eigen::Isometry3d X_RF = Eigen::Isometry3d::Identity();
+    if (X_WF != nullptr) X_RF = state.pose().inverse() * (*X_WF)[std::size_t(f)];
     PoseFields(X_RF, &message.face_positions[3 * f], &message.face_orientations[4 * f]);
   }
   Send("STATE", message);

@@ -26,7 +26,6 @@ struct Target {
   Eigen::Vector3f aabb_min, aabb_max;  // in the Bullet frame (world minus origin)
   Eigen::Matrix3f R_LB;                // local from Bullet frame
   Eigen::Vector3f p_LB;
-  Eigen::Matrix3f R_BL;
   btTransform X_BL;                    // Bullet frame from local: where triangles are tested
   bool identity{false};                // X_BL is exactly the identity
   const btQuantizedBvhNode* nodes{nullptr};
@@ -58,9 +57,8 @@ std::vector<Target> CollectTargets(const scene::CollisionWorld& world, const Ray
     t.aabb_max = ToEigen(o.getBroadphaseHandle()->m_aabbMax);
     const btTransform& X = o.getWorldTransform();
     for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) t.R_BL(r, c) = float(X.getBasis()[r][c]);
+      for (int c = 0; c < 3; ++c) t.R_LB(c, r) = float(X.getBasis()[r][c]);
     }
-    t.R_LB = t.R_BL.transpose();
     t.X_BL = X;
     t.identity = X.getBasis() == btMatrix3x3::getIdentity() && X.getOrigin() == btVector3(0, 0, 0);
     t.p_LB = -(t.R_LB * ToEigen(X.getOrigin()));
