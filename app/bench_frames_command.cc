@@ -17,10 +17,11 @@
 #include "bridge/outputs.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
-#include "sensors/cameras.h"
-#include "sensors/debug_overlay.h"
-#include "sensors/renderer.h"
-#include "sensors/robot_sensors.h"
+#include "sensors/render/cameras.h"
+#include "sensors/render/debug_overlay.h"
+#include "sensors/render/renderer.h"
+#include "sensors/render/mounted_camera.h"
+#include "sensors/sensor.h"
 
 namespace sandbox::app {
 namespace {
@@ -92,12 +93,12 @@ int RunBenchFrames(const std::vector<std::string>& args, std::ostream& out, std:
     }
     if (scanner_config == nullptr) throw CommandError("the sample level has no face scanner");
     const sensors::FaceScanner scanner(*scanner_config);
-    const std::vector<sensors::MountedCamera> cameras = sensors::MakeRobotCameras(sample);
-    sensors::MountedCamera chase_camera;
-    for (const sensors::MountedCamera& c : cameras) {
-      if (c.spec.type == "chase") chase_camera = c;
+    const std::vector<render::MountedCamera> cameras = render::MakeRobotCameras(sample);
+    render::MountedCamera chase_camera;
+    for (const render::MountedCamera& c : cameras) {
+      if (c.kind == render::CameraKind::kChase) chase_camera = c;
     }
-    std::unique_ptr<sensors::Renderer> renderer = sensors::MakeRenderer();
+    std::unique_ptr<render::Renderer> renderer = render::MakeRenderer();
     sensors::RayCaster caster;
     bridge::LcmLink link("memq://");
     bridge::RobotOutputs outputs(link, "ELAHA", {});
@@ -113,7 +114,7 @@ int RunBenchFrames(const std::vector<std::string>& args, std::ostream& out, std:
     const int colors[3][3] = {{200, 80, 30}, {40, 160, 40}, {30, 60, 220}};
     for (const std::string level_name : {"empty", "sample"}) {
       const scene::Level& level = level_name == "empty" ? empty : sample;
-      renderer = sensors::MakeRenderer();  // a fresh context per level
+      renderer = render::MakeRenderer();  // a fresh context per level
       renderer->SetLevel(level, OpenCvTextureDecoder(level.limits));
       scene::CollisionWorld world(level);
       for (const std::string work : {"robot", "scanner", "overlay"}) {
@@ -122,11 +123,12 @@ int RunBenchFrames(const std::vector<std::string>& args, std::ostream& out, std:
         std::vector<double> all, run_means;
         for (int run = 0; run < runs; ++run) {
           scene::RobotState robot(level.robots[0]);
-          sensors::ChaseCamera chase(chase_camera.chase);
-          sensors::FaceScan scan = scanner.EmptyScan();
+          render::ChaseCamera chase(chase_camera.chase);
+          sensors::SensorOutput output = scanner.EmptyScan();  // as the loop publishes it
+          sensors::FaceScan& scan = std::get<sensors::FaceScan>(output);
           sensors::RayFilter filter;
           filter.ignore_robot = 0;
-          sensors::Frame frame;
+          render::Frame frame;
           std::vector<double> durations;
           const int warm_up = 20;  // shaders, caches and buffers settle first; not counted
           for (int i = -warm_up; i < frames; ++i) {
@@ -136,16 +138,16 @@ int RunBenchFrames(const std::vector<std::string>& args, std::ostream& out, std:
             world.UpdateRobot(0, robot);
             if (work != "robot") {
               scanner.Scan(world, caster, filter, scanner_mount->Pose(robot), i + warm_up, &scan);
-              outputs.PublishFaces(scan, i + warm_up, {i + warm_up, 0}, 0);
+              outputs.Publish(output, {"scanner", "SCAN_FACE"}, i + warm_up, {i + warm_up, 0}, 0);
             }
             outputs.PublishState(robot, {i + warm_up, 0}, 0);
-            sensors::CameraView view = chase_camera.view;
+            render::CameraView view = chase_camera.view;
             view.X_WC = chase.Update(robot.pose(), 0.01);
-            sensors::Overlay overlay;
+            render::Overlay overlay;
             if (work == "overlay") {
-              sensors::AddFaceScan(scan, 0.0, &overlay);
-              sensors::AddBoneFrames(robot, 1.0, &overlay);
-              sensors::AddActorBounds(level, {}, false, &overlay);
+              render::AddFaceScan(scan, 0.0, &overlay);
+              render::AddBoneFrames(robot, 1.0, &overlay);
+              render::AddActorBounds(level, {}, false, &overlay);
             }
             renderer->Render(view, {}, {&robot}, {}, &frame, &overlay);
             link.Drain();

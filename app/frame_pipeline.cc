@@ -100,9 +100,9 @@ std::string FramePipeline::error() const {
 
 void FramePipeline::RenderLoop() {
   LowerThisThreadsPriority();  // before the context: llvmpipe's threads inherit it
-  std::unique_ptr<sensors::Renderer> renderer;
+  std::unique_ptr<render::Renderer> renderer;
   try {
-    renderer = sensors::MakeRenderer();
+    renderer = render::MakeRenderer();
     renderer->SetLevel(level_, OpenCvTextureDecoder(level_.limits));
     for (const std::string& warning : renderer->warnings())
       std::cerr << "sandbox: warning: " << warning << "\n";

@@ -31,7 +31,7 @@
 #include "app/row_file.h"
 #include "scene/level.h"
 #include "scene/robot_state.h"
-#include "sensors/renderer.h"
+#include "sensors/render/renderer.h"
 
 namespace sandbox::app {
 
@@ -46,7 +46,7 @@ struct FramePipelineConfig {
   // due frame is written and a run's frames depend on its inputs alone.
   bool lossless{false};
   // Called on the render thread with each frame of a job marked `show`.
-  std::function<void(const std::string& camera, const sensors::Frame& frame)> show;
+  std::function<void(const std::string& camera, const render::Frame& frame)> show;
 };
 
 // What the loop hands over: a camera view and copies of the robot states.
@@ -54,12 +54,12 @@ struct RenderJob {
   std::string camera;
   std::int64_t tick{0};
   double time_s{0.0};
-  sensors::CameraView view;
+  render::CameraView view;
   bool depth{false};
   std::vector<scene::RobotState> robots;
   std::vector<Eigen::Isometry3d> actor_poses;
   Eigen::Isometry3d robot_pose{Eigen::Isometry3d::Identity()};  // for the index
-  sensors::Overlay overlay;                                     // empty: none
+  render::Overlay overlay;                                     // empty: none
   bool write{true};                                             // to the output folder
   bool show{false};  // to FramePipelineConfig::show (the live view)
 };
@@ -91,9 +91,9 @@ class FramePipeline {
     std::int64_t tick;
     double time_s;
     bool depth;
-    sensors::Frame frame;
+    render::Frame frame;
     Eigen::Isometry3d robot_pose;
-    sensors::CameraView view;
+    render::CameraView view;
   };
   void RenderLoop();
   void WriteLoop();

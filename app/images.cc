@@ -45,9 +45,9 @@ bool ImageHeaderSize(const std::uint8_t* data, std::size_t size, std::uint32_t* 
   return false;
 }
 
-sensors::TextureDecoder OpenCvTextureDecoder(const scene::LoadLimits& limits) {
+render::TextureDecoder OpenCvTextureDecoder(const scene::LoadLimits& limits) {
   return [limits](const scene::EmbeddedTexture* embedded, const std::string& path,
-                  sensors::RgbaImage* image) -> std::string {
+                  render::RgbaImage* image) -> std::string {
     cv::Mat decoded;
     auto too_big = [&](std::uint64_t width, std::uint64_t height) {
       return width * height > limits.max_texture_pixels
@@ -123,14 +123,14 @@ void Write(const cv::Mat& image, const std::string& path, const std::vector<int>
 
 }  // namespace
 
-void WriteColor(const sensors::Frame& frame, const std::string& path) {
+void WriteColor(const render::Frame& frame, const std::string& path) {
   cv::Mat rgb(frame.height, frame.width, CV_8UC3, const_cast<std::uint8_t*>(frame.rgb.data()));
   cv::Mat bgr;
   cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
   Write(bgr, path);
 }
 
-void WriteDepthMillimetres(const sensors::Frame& frame, const std::string& path) {
+void WriteDepthMillimetres(const render::Frame& frame, const std::string& path) {
   cv::Mat depth(frame.height, frame.width, CV_16U);
   for (int i = 0; i < frame.width * frame.height; ++i) {
     const float d = frame.depth_m[std::size_t(i)];
@@ -140,7 +140,7 @@ void WriteDepthMillimetres(const sensors::Frame& frame, const std::string& path)
   Write(depth, path);
 }
 
-void WriteDepthNpy(const sensors::Frame& frame, const std::string& path) {
+void WriteDepthNpy(const render::Frame& frame, const std::string& path) {
   // Format 1.0: magic, version, a little-endian header length, then a Python
   // dict literal padded with spaces and a newline to a multiple of 64 bytes.
   std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" +
@@ -159,7 +159,7 @@ void WriteDepthNpy(const sensors::Frame& frame, const std::string& path) {
   if (!out.good()) throw std::runtime_error("cannot write " + path);
 }
 
-void WriteDepthExr(const sensors::Frame& frame, const std::string& path) {
+void WriteDepthExr(const render::Frame& frame, const std::string& path) {
   // OpenCV reads this once, at its first EXR file.
   static std::once_flag enabled;
   std::call_once(enabled, [] { setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0); });

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "scene/load_limits.h"
-#include "sensors/renderer.h"
+#include "sensors/render/renderer.h"
 
 namespace sandbox::app {
 
@@ -13,7 +13,7 @@ namespace sandbox::app {
 // Texture files must be regular files within limits.max_file_mb, and a PNG or
 // JPEG whose header states more than limits.max_texture_pixels is refused
 // before it is decoded (other formats: OpenCV's own limit of 2^30 pixels).
-sensors::TextureDecoder OpenCvTextureDecoder(const scene::LoadLimits& limits = {});
+render::TextureDecoder OpenCvTextureDecoder(const scene::LoadLimits& limits = {});
 
 // The width and height a PNG or JPEG states in its header; false for other
 // formats or a header cut short.
@@ -22,14 +22,14 @@ bool ImageHeaderSize(const std::uint8_t* data, std::size_t size, std::uint32_t* 
 
 // Writes a frame's colour; the format follows the file's extension (.jpg,
 // .png, ...). Throws std::runtime_error naming the file when it cannot.
-void WriteColor(const sensors::Frame& frame, const std::string& path);
+void WriteColor(const render::Frame& frame, const std::string& path);
 // Writes depth as a 16-bit PNG in millimetres (0: nothing within range).
-void WriteDepthMillimetres(const sensors::Frame& frame, const std::string& path);
+void WriteDepthMillimetres(const render::Frame& frame, const std::string& path);
 // Writes depth as a NumPy .npy file: float32 metres, shape (height, width),
 // row 0 at the top, +inf where nothing is (numpy.load, or readNPY in MATLAB).
-void WriteDepthNpy(const sensors::Frame& frame, const std::string& path);
+void WriteDepthNpy(const render::Frame& frame, const std::string& path);
 // Writes depth as OpenEXR: one float32 channel (Y) in metres, ZIP compressed,
 // +inf where nothing is. Turns on OpenCV's EXR codec (off by default).
-void WriteDepthExr(const sensors::Frame& frame, const std::string& path);
+void WriteDepthExr(const render::Frame& frame, const std::string& path);
 
 }  // namespace sandbox::app

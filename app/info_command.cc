@@ -17,7 +17,7 @@
 #include "app/process_stats.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
-#include "sensors/robot_sensors.h"
+#include "sensors/sensor.h"
 
 namespace sandbox::app {
 namespace {
@@ -59,26 +59,6 @@ Eigen::Vector3d Lo(const Eigen::AlignedBox3d& b) {
 }
 Eigen::Vector3d Hi(const Eigen::AlignedBox3d& b) {
   return b.isEmpty() ? Eigen::Vector3d::Zero() : b.max();
-}
-
-// "face 51x51x6 six_stage" and the like.
-std::string Describe(const sensors::MountedSensor& sensor) {
-  std::ostringstream out;
-  out << sensor.spec.type;
-  if (const auto* face = std::get_if<sensors::FaceScannerConfig>(&sensor.config)) {
-    const int n = face->points_per_side();
-    out << " " << n << "x" << n << "x6 at " << face->resolution_m << " m";
-  } else if (const auto* ground = std::get_if<sensors::GroundScannerConfig>(&sensor.config)) {
-    out << " +-" << ground->half_extent_m << " m at " << ground->resolution_m << " m";
-  } else if (const auto* lidar = std::get_if<sensors::LidarConfig>(&sensor.config)) {
-    out << " " << lidar->channels() << "x" << lidar->azimuth_steps << ", " << lidar->range_m
-        << " m";
-  } else if (const auto* ray = std::get_if<sensors::RangeSensorConfig>(&sensor.config)) {
-    out << " " << ray->range_m << " m";
-  }
-  out << " on " << (sensor.spec.mount.empty() ? "body" : sensor.spec.mount);
-  if (sensor.spec.rate_hz > 0.0) out << " at " << sensor.spec.rate_hz << " Hz";
-  return out.str();
 }
 
 void PrintJson(const Level& level, const std::vector<sensors::MountedSensor>& sensors,
@@ -163,7 +143,7 @@ void PrintText(const Level& level, const std::vector<sensors::MountedSensor>& se
         << ")\n";
     for (const sensors::MountedSensor& sensor : sensors) {
       if (level.robots[static_cast<std::size_t>(sensor.robot)].name != r.name) continue;
-      out << "  sensor " << sensor.spec.name << ": " << Describe(sensor) << "\n";
+      out << "  sensor " << sensor.spec.name << ": " << sensor.Describe() << "\n";
     }
   }
   const Eigen::AlignedBox3d bounds = level.bounds_W();

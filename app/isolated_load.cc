@@ -177,9 +177,9 @@ int RunLoadLevelChild(const std::vector<std::string>& args, std::ostream& out) {
     const LoadedLevel loaded = LoadCheckedLevel(args[0], options);
     // The textures too, as the renderer will decode them (OpenCV, libpng, ...).
     const scene::Level& level = loaded.level;
-    const sensors::TextureDecoder decode = OpenCvTextureDecoder(level.limits);
+    const render::TextureDecoder decode = OpenCvTextureDecoder(level.limits);
     for (const scene::Material& material : level.materials) {
-      sensors::RgbaImage image;
+      render::RgbaImage image;
       if (!material.base_color_texture_path.empty()) {
         options.on_file(material.base_color_texture_path);
         decode(nullptr, material.base_color_texture_path, &image);

@@ -100,7 +100,7 @@ LiveView::LiveView(const std::string& title) : title_(title) {
   }
 }
 
-void LiveView::Show(const sensors::Frame& frame, const std::string& caption) {
+void LiveView::Show(const render::Frame& frame, const std::string& caption) {
   std::lock_guard<std::mutex> lock(mutex_);
   pending_ = frame;
   pending_caption_ = caption;
@@ -122,7 +122,7 @@ void LiveView::RunWindow(const std::atomic<bool>& stop) {
   }
   cv::Mat bgr;
   while (!stop) {
-    sensors::Frame frame;
+    render::Frame frame;
     std::string caption;
     {
       std::lock_guard<std::mutex> lock(mutex_);

@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "sensors/cameras.h"
-#include "sensors/renderer.h"
+#include "sensors/render/cameras.h"
+#include "sensors/render/renderer.h"
 
 namespace sandbox::app {
 
@@ -39,7 +39,7 @@ std::optional<ViewKey> KeyFromCode(int code);
 // What the keys have set.
 struct ViewControls {
   int camera{0};                   // index of the active camera
-  sensors::TrailingCommand steer;  // added to the bridge's <ROBOT>/CAMERA command
+  render::TrailingCommand steer;  // added to the bridge's <ROBOT>/CAMERA command
   bool overlay{false};
   bool paused{false};
   bool quit{false};
@@ -63,7 +63,7 @@ class LiveView {
   void RunWindow(const std::atomic<bool>& stop);
 
   // Any thread: the newest frame replaces one not yet shown.
-  void Show(const sensors::Frame& frame, const std::string& caption);
+  void Show(const render::Frame& frame, const std::string& caption);
   // Any thread: the keys pressed since the last call, in order.
   std::vector<ViewKey> TakeKeys();
   std::int64_t shown() const { return shown_; }
@@ -71,7 +71,7 @@ class LiveView {
  private:
   std::string title_;
   std::mutex mutex_;
-  sensors::Frame pending_;
+  render::Frame pending_;
   std::string pending_caption_;
   bool has_pending_{false};
   std::vector<ViewKey> keys_;

@@ -27,7 +27,7 @@ LoadedLevel LoadCheckedLevel(const std::string& file, const scene::LoadOptions& 
   LoadedLevel loaded;
   loaded.level = scene::LoadLevel(file, options);
   loaded.sensors = sensors::MakeRobotSensors(loaded.level);
-  loaded.cameras = sensors::MakeRobotCameras(loaded.level);
+  loaded.cameras = render::MakeRobotCameras(loaded.level);
   loaded.bridges = bridge::RobotBridgeConfigs(loaded.level);
   return loaded;
 }

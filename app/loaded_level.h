@@ -8,14 +8,15 @@
 
 #include "bridge/robot_bridge_config.h"
 #include "scene/level.h"
-#include "sensors/robot_sensors.h"
+#include "sensors/render/mounted_camera.h"
+#include "sensors/sensor.h"
 
 namespace sandbox::app {
 
 struct LoadedLevel {
   scene::Level level;
   std::vector<sensors::MountedSensor> sensors;
-  std::vector<sensors::MountedCamera> cameras;
+  std::vector<render::MountedCamera> cameras;
   std::vector<bridge::RobotBridgeConfig> bridges;  // one per robot, in Level::robots order
 };
 

@@ -12,9 +12,9 @@
 #include "app/loaded_level.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
-#include "sensors/cameras.h"
-#include "sensors/debug_overlay.h"
-#include "sensors/robot_sensors.h"
+#include "sensors/render/cameras.h"
+#include "sensors/render/debug_overlay.h"
+#include "sensors/sensor.h"
 
 namespace sandbox::app {
 namespace {
@@ -40,7 +40,7 @@ const char* kUsage =
 
 // The overlay at one robot state: its face scanners scanned in full.
 void BuildOverlay(const scene::Level& level, int robot_index, const scene::RobotState* robot,
-                  double stub_m, sensors::Overlay* overlay) {
+                  double stub_m, render::Overlay* overlay) {
   if (robot != nullptr) {
     scene::CollisionWorld world(level);
     world.UpdateRobot(robot_index, *robot);
@@ -60,11 +60,11 @@ void BuildOverlay(const scene::Level& level, int robot_index, const scene::Robot
       const sensors::FaceScanner scanner(config);
       sensors::FaceScan scan = scanner.EmptyScan();
       scanner.Scan(world, caster, filter, X_WS, 0, &scan);
-      sensors::AddFaceScan(scan, stub_m, overlay);
+      render::AddFaceScan(scan, stub_m, overlay);
     }
-    sensors::AddBoneFrames(*robot, 1.0, overlay);
+    render::AddBoneFrames(*robot, 1.0, overlay);
   }
-  sensors::AddActorBounds(level, {}, false, overlay);
+  render::AddActorBounds(level, {}, false, overlay);
 }
 
 }  // namespace
@@ -91,7 +91,7 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
   }
   try {
     const Eigen::Isometry3d X_at = ParsePose(parsed->Value("--at"), "--at");
-    sensors::CameraView view;
+    render::CameraView view;
     auto whole = [&](const std::string& option, int fallback) {
       return parsed->values.count(option) ? int(ParseWhole(parsed->Value(option), option, 1, 16384))
                                           : fallback;
@@ -123,9 +123,9 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
       throw CommandError("a " + camera + " camera needs a robot; the level declares none");
     }
     if (camera == "chase") {
-      view.X_WC = sensors::ChaseCamera({}).Update(robot->pose(), 0.0);
+      view.X_WC = render::ChaseCamera({}).Update(robot->pose(), 0.0);
     } else if (camera == "trailing") {
-      view.X_WC = sensors::TrailingPose(robot->pose(), 25.0, 8.0, {});
+      view.X_WC = render::TrailingPose(robot->pose(), 25.0, 8.0, {});
     } else if (camera == "payload") {
       view.X_WC = robot->pose();
     } else {
@@ -133,14 +133,14 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
     }
     view.ValidateOrThrow();
     const auto start = std::chrono::steady_clock::now();
-    std::unique_ptr<sensors::Renderer> renderer = sensors::MakeRenderer();
+    std::unique_ptr<render::Renderer> renderer = render::MakeRenderer();
     renderer->SetLevel(level, OpenCvTextureDecoder(level.limits));
     for (const std::string& warning : renderer->warnings())
       err << "sandbox render: warning: " << warning << "\n";
-    sensors::Frame frame;
+    render::Frame frame;
     std::vector<const scene::RobotState*> robots;
     if (robot) robots.push_back(robot.get());
-    sensors::Overlay overlay;
+    render::Overlay overlay;
     if (parsed->flags.count("--overlay")) {
       const double stub_m =
           parsed->values.count("--stub") ? ParseNumber(parsed->Value("--stub"), "--stub") : 0.0;

@@ -15,7 +15,6 @@ const char* kUsage =
     "usage: sandbox run [LEVEL] [--rate HZ|max] [--duration S] [--lcm-url URL] [--lockstep]\n"
     "                   [--replay LOG] [--record LOG] [--out DIR] [--frames LIST] [--depth D]\n"
     "                   [--scans-every S] [--view] [--realtime auto|off] [--isolate]\n"
-    "                   [--stall TICK:MS,...]\n"
     "  LEVEL          a level (default: the bundled sample level)\n"
     "  --isolate      read a manifest's files in a separate process first: a file that crashes\n"
     "                 assimp is then an error naming it (a scene file as LEVEL always is read so)\n"
@@ -39,7 +38,6 @@ const char* kUsage =
     "                 a/d pan, w/s tilt, +/- zoom (trailing), o overlay, space pause, q quit\n"
     "  --realtime     auto (default): the loop thread at real-time priority (SCHED_FIFO) when\n"
     "                 the user may (root, CAP_SYS_NICE or ulimit -r); off: normal priority\n"
-    "  --stall        test aid: sleep MS milliseconds inside tick TICK (the loop's timing)\n"
     "Inputs per robot: <ROBOT>/POSE, /BONES, /ACTORS, /CAMERA (trailing pan, tilt, zoom).\n"
     "Outputs: <ROBOT>/SCAN_FACE, /GROUND, /LIDAR, /RANGE, /STATE, /STATUS (docs/bridge.md).\n";
 
@@ -79,7 +77,7 @@ int RunLoop(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     try {
       view->RunWindow(done);
     } catch (...) {
-      SandboxLoop::RequestStop();
+      loop.RequestStop();
       loop_thread.join();
       throw;
     }

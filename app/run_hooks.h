@@ -1,7 +1,8 @@
 #pragma once
-// In-process additions to `sandbox run`'s loop (the demo's fallback pilot and
-// its heartbeat listener). Both run on the loop thread.
+// In-process additions to `sandbox run`'s loop: the demo's fallback pilot and
+// its heartbeat listener, and test aids (a slow tick). All run on the loop thread.
 
+#include <cstdint>
 #include <functional>
 
 #include "bridge/lcm_link.h"
@@ -12,6 +13,9 @@ struct RunHooks {
   // Called at the start of each tick, before the inputs are drained, with the
   // seconds since the loop started.
   std::function<void(bridge::LcmLink& link, double wall_s)> before_tick;
+  // Called at the end of each tick's work, inside its measured duration (a
+  // test slows given ticks here).
+  std::function<void(std::int64_t tick)> end_of_tick;
   // Called before the link closes: let go of what before_tick subscribed.
   std::function<void(bridge::LcmLink& link)> before_close;
 };

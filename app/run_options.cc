@@ -32,31 +32,11 @@ void ParseFrames(const std::string& text, FramePipelineConfig* config) {
   }
 }
 
-// --stall "TICK:MS,...": milliseconds to sleep inside given ticks.
-std::map<std::int64_t, double> ParseStalls(const std::string& text) {
-  std::map<std::int64_t, double> stalls;
-  std::stringstream list(text);
-  std::string item;
-  while (std::getline(list, item, ',')) {
-    const std::size_t colon = item.find(':');
-    std::vector<double> values;
-    if (colon != std::string::npos) {
-      values = ParseNumbers(item.substr(0, colon) + "," + item.substr(colon + 1), "--stall");
-    }
-    if (values.size() != 2 || !(values[0] >= 0 && values[0] <= 1e12) ||
-        !(values[1] >= 0 && values[1] <= 60000)) {
-      throw UsageError("--stall wants TICK:MS items (MS up to 60000), got '" + item + "'");
-    }
-    stalls[std::int64_t(values[0])] = values[1];
-  }
-  return stalls;
-}
-
 }  // namespace
 
 const std::set<std::string> kRunValueOptions = {
     "--rate",   "--duration", "--lcm-url",     "--replay", "--record",  "--out",
-    "--frames", "--depth",    "--scans-every", "--stall",  "--realtime"};
+    "--frames", "--depth",    "--scans-every",  "--realtime"};
 const std::set<std::string> kRunFlags = {"--lockstep", "--view", "--isolate"};
 
 RunOptions ParseRunOptions(const ParsedArgs& args) {
@@ -104,7 +84,6 @@ RunOptions ParseRunOptions(const ParsedArgs& args) {
     throw UsageError("--realtime must be auto or off, got '" + realtime + "'");
   }
   options.realtime = realtime == "auto";
-  options.stalls_ms = ParseStalls(args.Value("--stall"));
   return options;
 }
 

@@ -2,8 +2,6 @@
 // What `sandbox run` is asked to do, as values: its command line parsed and
 // checked. ParseRunOptions throws CommandError naming the option.
 
-#include <cstdint>
-#include <map>
 #include <set>
 #include <string>
 
@@ -30,7 +28,6 @@ struct RunOptions {
   bool view{false};            // the live view
   bool isolate{false};         // load the level in a child process first
   bool realtime{true};         // ask for SCHED_FIFO
-  std::map<std::int64_t, double> stalls_ms;  // test aid: tick -> extra milliseconds
 
   bool free_running() const { return rate_hz == 0.0; }
   bool replay() const { return !replay_file.empty(); }

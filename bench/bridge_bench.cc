@@ -58,7 +58,7 @@ struct Counter {
 };
 
 // Publishes `scans` full scans at 100 Hz while a subscriber on `url` counts.
-std::int64_t Received(const std::string& url, const sensors::FaceScan& scan, int scans) {
+std::int64_t Received(const std::string& url, const sensors::SensorOutput& scan, int scans) {
   lcm::LCM subscriber(url);
   Counter counter;
   subscriber.subscribe("BENCH/SCAN_FACE", &Counter::On, &counter);
@@ -70,7 +70,7 @@ std::int64_t Received(const std::string& url, const sensors::FaceScan& scan, int
   bridge::RobotOutputs outputs(link, "BENCH");
   auto next = Clock::now();
   for (int i = 0; i < scans; ++i) {
-    outputs.PublishFaces(scan, 0, {i, NowUtime()}, NowUtime());
+    outputs.Publish(scan, {"bench", "SCAN_FACE"}, 0, {i, NowUtime()}, NowUtime());
     next += std::chrono::milliseconds(10);
     std::this_thread::sleep_until(next);
   }
@@ -102,7 +102,10 @@ int main(int argc, char** argv) {
     bridge::RobotOutputs outputs(link, "BENCH");
     const int rounds = 200;
     const auto start = Clock::now();
-    for (int i = 0; i < rounds; ++i) outputs.PublishFaces(scan, 0, {i, 0}, NowUtime());
+    const sensors::SensorOutput output = scan;
+    for (int i = 0; i < rounds; ++i) {
+      outputs.Publish(output, {"bench", "SCAN_FACE"}, 0, {i, 0}, NowUtime());
+    }
     const double publish_ms =
         std::chrono::duration<double, std::milli>(Clock::now() - start).count() / rounds;
     // One face encoded, decoded many times.

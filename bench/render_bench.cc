@@ -25,10 +25,10 @@
 #include "bench/bench_levels.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
-#include "sensors/cameras.h"
-#include "sensors/debug_overlay.h"
+#include "sensors/render/cameras.h"
+#include "sensors/render/debug_overlay.h"
 #include "sensors/face_scanner.h"
-#include "sensors/renderer.h"
+#include "sensors/render/renderer.h"
 
 namespace {
 
@@ -49,14 +49,14 @@ int main(int argc, char** argv) {
         scene::LoadLevel(std::string(SANDBOX_SOURCE_DIR) + "/assets/sample/level.toml");
     std::mutex mutex;
     std::condition_variable wake;
-    std::deque<sensors::Frame> queue;
+    std::deque<render::Frame> queue;
     std::atomic<bool> done{false};
     std::atomic<long> rendered{0}, encoded{0};
     std::size_t bytes = 0;
     std::thread encoder([&] {
       std::vector<std::uint8_t> jpeg;
       for (;;) {
-        sensors::Frame frame;
+        render::Frame frame;
         {
           std::unique_lock<std::mutex> lock(mutex);
           wake.wait(lock, [&] { return done || !queue.empty(); });
@@ -71,11 +71,11 @@ int main(int argc, char** argv) {
         ++encoded;
       }
     });
-    auto renderer = sensors::MakeRenderer();
+    auto renderer = render::MakeRenderer();
     renderer->SetLevel(level, {});
     scene::RobotState wing(level.robots[0]);
-    sensors::ChaseCamera chase({});
-    sensors::CameraView view;
+    render::ChaseCamera chase({});
+    render::CameraView view;
     const auto start = Clock::now();
     double render_only_s = 0.0;
     for (int i = 0;; ++i) {
@@ -92,7 +92,7 @@ int main(int argc, char** argv) {
       }
       wing.Update();
       view.X_WC = chase.Update(X, 0.033);
-      sensors::Frame frame;
+      render::Frame frame;
       const auto render_start = Clock::now();
       renderer->Render(view, {}, {&wing}, {}, &frame);
       render_only_s += std::chrono::duration<double>(Clock::now() - render_start).count();
@@ -121,7 +121,7 @@ int main(int argc, char** argv) {
     std::printf("\n%-12s %12s %14s %8s\n", "triangles", "render ms", "empty-level ms", "ratio");
     double empty_ms = 0.0;
     for (const int triangles : {0, 10000, 100000, 1000000}) {
-      std::unique_ptr<sensors::Renderer> renderer = sensors::MakeRenderer();
+      std::unique_ptr<render::Renderer> renderer = render::MakeRenderer();
       scene::Level level;
       if (triangles > 0) {
         const int side = int(std::sqrt(triangles / 2.0));  // a square about the origin
@@ -132,10 +132,10 @@ int main(int argc, char** argv) {
         renderer->SetLevel(level, {});
       }
       auto median_ms = [&](const Eigen::Isometry3d& X_WC) {
-        sensors::CameraView view;
+        render::CameraView view;
         view.X_WC = X_WC;
         std::vector<double> ms;
-        sensors::Frame frame;
+        render::Frame frame;
         for (int i = 0; i < 21; ++i) {
           const auto start = Clock::now();
           renderer->Render(view, {}, {}, {}, &frame);
@@ -146,7 +146,7 @@ int main(int argc, char** argv) {
       };
       // All of the terrain in view.
       const double median =
-          median_ms(sensors::LookAt(Eigen::Vector3d(-200, -200, 150), Eigen::Vector3d(0, 0, 0)));
+          median_ms(render::LookAt(Eigen::Vector3d(-200, -200, 150), Eigen::Vector3d(0, 0, 0)));
       if (triangles == 0) empty_ms = median;
       std::printf("%-12d %12.2f %14.2f %7.1fx\n", int(level.num_triangles()), median, empty_ms,
                   median / empty_ms);
@@ -154,7 +154,7 @@ int main(int argc, char** argv) {
         // From the middle along the ground: about a sixth of the terrain in the
         // frustum, the rest culled by 128 m cells.
         const double ground =
-            median_ms(sensors::LookAt(Eigen::Vector3d(0, 0, 10), Eigen::Vector3d(100, 0, 0)));
+            median_ms(render::LookAt(Eigen::Vector3d(0, 0, 10), Eigen::Vector3d(100, 0, 0)));
         std::printf("%-12s %12.2f %14s %7.2fx of seeing it all (culling)\n", "1M, ground", ground,
                     "", ground / median);
       }
@@ -177,17 +177,17 @@ int main(int argc, char** argv) {
     sensors::RayFilter filter;
     filter.ignore_robot = 0;
     scanner.Scan(world, caster, filter, wing.pose(), 0, &scan);
-    sensors::Overlay points, stubs, rays;
-    sensors::AddFaceScan(scan, 0.0, &points);
-    sensors::AddFaceScan(scan, 0.5, &stubs);
-    sensors::AddFaceScan(scan, 100.0, &rays);
-    auto renderer = sensors::MakeRenderer();
+    render::Overlay points, stubs, rays;
+    render::AddFaceScan(scan, 0.0, &points);
+    render::AddFaceScan(scan, 0.5, &stubs);
+    render::AddFaceScan(scan, 100.0, &rays);
+    auto renderer = render::MakeRenderer();
     renderer->SetLevel(level, {});
-    sensors::CameraView view;
-    view.X_WC = sensors::TrailingPose(wing.pose(), 25.0, 8.0, {});
-    auto median_ms = [&](const sensors::Overlay* overlay) {
+    render::CameraView view;
+    view.X_WC = render::TrailingPose(wing.pose(), 25.0, 8.0, {});
+    auto median_ms = [&](const render::Overlay* overlay) {
       std::vector<double> ms;
-      sensors::Frame frame;
+      render::Frame frame;
       for (int i = 0; i < 21; ++i) {
         const auto start = Clock::now();
         renderer->Render(view, {}, {&wing}, {}, &frame, overlay);
@@ -200,7 +200,7 @@ int main(int argc, char** argv) {
     std::printf("\noverlay, trailing 640x480, %zu samples: plain %.2f ms", points.points_W.size(),
                 plain);
     for (const auto& [name, overlay] :
-         {std::pair<const char*, const sensors::Overlay*>{"points", &points},
+         {std::pair<const char*, const render::Overlay*>{"points", &points},
           {"0.5 m stubs", &stubs},
           {"whole rays", &rays}}) {
       const double ms = median_ms(overlay);

@@ -1,6 +1,7 @@
 #include "bridge/outputs.h"
 
 #include <map>
+#include <variant>
 
 #include "sandbox_msgs/ground_map_t.hpp"
 #include "sandbox_msgs/lidar_scan_t.hpp"
@@ -13,14 +14,21 @@ namespace sandbox::bridge {
 
 namespace {
 
-// The header every output carries: when, and the input it was computed from
+// What every output's header says: when, and the input it was computed from
 // (Send numbers it on its channel).
-template <typename Message>
-void Stamp(std::int64_t now_utime, const InputTag& input, Message* message) {
-  message->utime = now_utime;
-  message->input_seq = input.seq;
-  message->input_utime = input.utime;
-}
+struct Header {
+  const std::string& sensor;
+  std::int64_t tick;
+  InputTag input;
+  std::int64_t now_utime;
+
+  template <typename Message>
+  void Stamp(Message* message) const {
+    message->utime = now_utime;
+    message->input_seq = input.seq;
+    message->input_utime = input.utime;
+  }
+};
 
 // World points as float offsets from a double origin, flat.
 void Offsets(const std::vector<Eigen::Vector3d>& points_W, const Eigen::Vector3d& origin,
@@ -55,21 +63,15 @@ void RobotOutputs::Send(const std::string& topic, Message& message) {
   if (link_.Publish(prefix_ + topic, buffer_.data(), unsigned(buffer_.size()))) ++published_;
 }
 
-std::string OutputChannel(const scene::SensorSpec& spec) {
-  if (!spec.channel.empty()) return spec.channel;
-  if (spec.type == "face") return "SCAN_FACE";
-  if (spec.type == "ground") return "GROUND";
-  if (spec.type == "lidar") return "LIDAR";
-  return "RANGE";
-}
-
 void CheckOutputChannels(const scene::Level& level) {
   for (const scene::RobotModel& robot : level.robots) {
     std::map<std::string, const scene::SensorSpec*> used;
     for (const scene::SensorSpec& spec : robot.sensors) {
-      const std::string channel = OutputChannel(spec);
+      const std::string channel = sensors::OutputChannel(spec);
       const auto [it, fresh] = used.emplace(channel, &spec);
-      if (!fresh && !(spec.type == "ray" && it->second->type == "ray")) {
+      const sensors::SensorKind kind = sensors::ParseSensorKind(spec);
+      if (!fresh && !(sensors::Info(kind).shares_channel &&
+                      kind == sensors::ParseSensorKind(*it->second))) {
         throw scene::LevelError(spec.Where() + "publishes on " + channel + " like sensor '" +
                                 it->second->name + "'; give one of them its own 'channel'");
       }
@@ -77,15 +79,19 @@ void CheckOutputChannels(const scene::Level& level) {
   }
 }
 
-void RobotOutputs::PublishFaces(const sensors::FaceScan& scan, std::int64_t tick,
-                                const InputTag& input, std::int64_t now_utime,
-                                const std::string& channel) {
+namespace {
+
+// Each kind's publish function: its output as messages, handed to `send`.
+// (Adding a sensor kind adds one here.)
+
+template <typename Send>
+void PublishOutput(const sensors::FaceScan& scan, const Header& header, Send&& send) {
   for (int f = 0; f < 6; ++f) {
     const sensors::ScanFace& face = scan.faces[std::size_t(f)];
-    if (face.tick != tick) continue;
+    if (face.tick != header.tick) continue;  // only the faces this tick refreshed
     sandbox_msgs::scan_face_t message{};
-    Stamp(now_utime, input, &message);
-    message.tick = tick;
+    header.Stamp(&message);
+    message.tick = header.tick;
     message.face = std::int8_t(f);
     message.n = scan.n;
     const Eigen::Vector3d p = face.X_WS.translation();
@@ -96,27 +102,27 @@ void RobotOutputs::PublishFaces(const sensors::FaceScan& scan, std::int64_t tick
     message.occupancy = face.occupancy;
     message.num_xyz = int(3 * n);
     Offsets(face.points_W, p, &message.xyz);
-    Send(channel.empty() ? "SCAN_FACE" : channel, message);
+    send(message);
   }
 }
 
-void RobotOutputs::PublishGround(const sensors::HeightMap& map, const InputTag& input,
-                                 std::int64_t now_utime, const std::string& channel) {
+template <typename Send>
+void PublishOutput(const sensors::HeightMap& map, const Header& header, Send&& send) {
   sandbox_msgs::ground_map_t message{};
-  Stamp(now_utime, input, &message);
+  header.Stamp(&message);
   message.n = map.n;
   message.resolution_m = map.resolution_m;
   message.corner[0] = map.corner_W.x(), message.corner[1] = map.corner_W.y();
   message.origin_z = 0.0;
   message.num_points = int(map.height_m.size());
   message.height.assign(map.height_m.begin(), map.height_m.end());
-  Send(channel.empty() ? "GROUND" : channel, message);
+  send(message);
 }
 
-void RobotOutputs::PublishLidar(const sensors::LidarScan& scan, const InputTag& input,
-                                std::int64_t now_utime, const std::string& channel) {
+template <typename Send>
+void PublishOutput(const sensors::LidarScan& scan, const Header& header, Send&& send) {
   sandbox_msgs::lidar_scan_t message{};
-  Stamp(now_utime, input, &message);
+  header.Stamp(&message);
   message.channels = scan.channels;
   message.steps = scan.azimuth_steps;
   const Eigen::Vector3d& origin = scan.origin_W;
@@ -131,15 +137,15 @@ void RobotOutputs::PublishLidar(const sensors::LidarScan& scan, const InputTag& 
   message.num_xyz = int(3 * n);
   Offsets(scan.points_W, origin, &message.xyz);
   message.time_s.assign(scan.time_s.begin(), scan.time_s.end());
-  Send(channel.empty() ? "LIDAR" : channel, message);
+  send(message);
 }
 
-void RobotOutputs::PublishRange(const std::string& sensor, const sensors::RangeReading& reading,
-                                const InputTag& input, std::int64_t now_utime,
-                                const std::string& channel) {
+// Several range sensors may share a channel: the message names its sensor.
+template <typename Send>
+void PublishOutput(const sensors::RangeReading& reading, const Header& header, Send&& send) {
   sandbox_msgs::range_t message{};
-  Stamp(now_utime, input, &message);
-  message.sensor = sensor;
+  header.Stamp(&message);
+  message.sensor = header.sensor;
   for (int k = 0; k < 3; ++k) {
     message.origin[k] = reading.origin_W[k];
     message.direction[k] = reading.direction_W[k];
@@ -149,13 +155,25 @@ void RobotOutputs::PublishRange(const std::string& sensor, const sensors::RangeR
   message.hit = reading.hit ? 1 : 0;
   message.range_m = reading.range_m;
   message.body = reading.body;
-  Send(channel.empty() ? "RANGE" : channel, message);
+  send(message);
+}
+
+}  // namespace
+
+void RobotOutputs::Publish(const sensors::SensorOutput& output, const Address& to,
+                           std::int64_t tick, const InputTag& input, std::int64_t now_utime) {
+  const Header header{to.sensor, tick, input, now_utime};
+  std::visit(
+      [&](const auto& value) {
+        PublishOutput(value, header, [&](auto& message) { Send(to.channel, message); });
+      },
+      output);
 }
 
 void RobotOutputs::PublishState(const scene::RobotState& state, const InputTag& input,
                                 std::int64_t now_utime, const FaceFrames* X_WF) {
   sandbox_msgs::robot_state_t message{};
-  Stamp(now_utime, input, &message);
+  Header{"", 0, input, now_utime}.Stamp(&message);
   Eigen::Vector3d p;
   Eigen::Quaterniond q;
   state_translation_.FromWorld(state.pose(), &p, &q);

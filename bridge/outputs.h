@@ -14,9 +14,7 @@
 #include "bridge/translation.h"
 #include "scene/robot_state.h"
 #include "sensors/face_scanner.h"
-#include "sensors/ground_scanner.h"
-#include "sensors/lidar.h"
-#include "sensors/range_sensor.h"
+#include "sensors/sensor.h"
 
 namespace sandbox::bridge {
 
@@ -34,12 +32,9 @@ struct ChannelStatus {
   std::string last_reject_reason;
 };
 
-// The channel (after "<ROBOT>/") a sensor publishes on: its `channel`, or
-// SCAN_FACE, GROUND, LIDAR, RANGE by type.
-std::string OutputChannel(const scene::SensorSpec& spec);
-
 // Throws scene::LevelError when two sensors of one robot would publish on one
-// channel (range sensors may share: their messages carry the sensor's name).
+// channel (sensors::OutputChannel; range sensors may share: their messages
+// carry the sensor's name).
 void CheckOutputChannels(const scene::Level& level);
 
 class RobotOutputs {
@@ -49,20 +44,17 @@ class RobotOutputs {
   RobotOutputs(LcmLink& link, std::string channel_prefix,
                const Translation& state_translation = {});
 
-  // Publishes the faces of `scan` scanned at `tick` (the ones this tick
-  // refreshed). `channel`: after the prefix; empty: SCAN_FACE (GROUND, LIDAR).
-  void PublishFaces(const sensors::FaceScan& scan, std::int64_t tick, const InputTag& input,
-                    std::int64_t now_utime, const std::string& channel = "");
-  void PublishGround(const sensors::HeightMap& map, const InputTag& input, std::int64_t now_utime,
-                     const std::string& channel = "");
-  void PublishLidar(const sensors::LidarScan& scan, const InputTag& input, std::int64_t now_utime,
-                    const std::string& channel = "");
-  // One single-ray sensor's reading; `sensor` tells several on one robot apart.
-  void PublishRange(const std::string& sensor, const sensors::RangeReading& reading,
-                    const InputTag& input, std::int64_t now_utime, const std::string& channel = "");
-  // Face f's frame in the world: the scanner box it was last scanned in
-  // (sensors::ScanFace::X_WB).
-  using FaceFrames = std::array<Eigen::Isometry3d, 6>;
+  // Where and when an output goes: on <prefix>/<channel>, from sensor
+  // `sensor` (range readings carry it), at loop tick `tick`.
+  struct Address {
+    std::string sensor;
+    std::string channel;  // sensors::MountedSensor::channel
+  };
+  // Any sensor's output, each kind by its publish function in outputs.cc
+  // (a face scan: the faces scanned at `tick`, one message each).
+  void Publish(const sensors::SensorOutput& output, const Address& to, std::int64_t tick,
+               const InputTag& input, std::int64_t now_utime);
+  using FaceFrames = sensors::FaceFrames;
   // The robot pose and bones in use, and the face frames `X_WF` in the robot
   // frame at that pose (null: no face scanner; the robot frame itself).
   void PublishState(const scene::RobotState& state, const InputTag& input, std::int64_t now_utime,

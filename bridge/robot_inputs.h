@@ -16,9 +16,16 @@
 #include "scene/collision_world.h"
 #include "scene/level.h"
 #include "scene/robot_state.h"
-#include "sensors/cameras.h"
 
 namespace sandbox::bridge {
+
+// The trailing cameras' steering from <ROBOT>/CAMERA (render::TrailingCommand
+// takes these values).
+struct TrailingCommand {
+  double pan_rad{0.0};   // about the robot's up axis, positive to the left
+  double tilt_rad{0.0};  // positive: the camera rises and looks down more
+  double zoom{1.0};      // > 0; 2 halves the field of view
+};
 
 class RobotInputs {
  public:
@@ -57,7 +64,7 @@ class RobotInputs {
   const LatestInput& camera() const { return camera_; }
   // The last good camera command: the trailing cameras' pan, tilt and zoom,
   // and the active camera (one of the robot's, by name; empty until chosen).
-  const sensors::TrailingCommand& trailing() const { return trailing_; }
+  const TrailingCommand& trailing() const { return trailing_; }
   const std::string& active_camera() const { return active_camera_; }
   // Logs rejections of every input to `log`.
   void set_log(RejectLog* log) {
@@ -74,7 +81,7 @@ class RobotInputs {
     std::vector<std::pair<int, Eigen::Isometry3d>> X_WA;  // actor index, pose
   };
   struct Camera {
-    sensors::TrailingCommand trailing;
+    TrailingCommand trailing;
     std::string active;  // empty: keep the active camera
   };
   // Each returns "" with the value, or why the message is rejected.
@@ -97,7 +104,7 @@ class RobotInputs {
   int robot_;
   Translation translation_;
   LatestInput pose_, bones_, actors_, camera_;
-  sensors::TrailingCommand trailing_;
+  TrailingCommand trailing_;
   std::string active_camera_;
 };
 

@@ -31,7 +31,7 @@ enum class BoneRotation {
 // settings as given; sensors/ reads and checks them (it knows each type's keys).
 struct SensorSpec {
   std::string name;
-  std::string type;    // "face", "ground", "lidar", "ray"
+  std::string type;    // as given; sensors/ (cameras: sensors/render/) parse it into a kind
   std::string mount;   // a node of the robot (a bone), empty: the robot body frame
   int mount_node{-1};  // resolved by LoadRobotModel; -1: the body frame
   Eigen::Isometry3d X_MS{Eigen::Isometry3d::Identity()};  // sensor in its mount's frame

@@ -246,6 +246,13 @@ void RobotState::SkinRunOfVertices(const SkinnedMesh& mesh, const SkinRun& run, 
   for (; v < end; ++v) SkinVertex(mesh, v, m);
 }
 
+Eigen::Isometry3d RobotState::MountPose(const SensorSpec& spec) const {
+  const Eigen::Isometry3d X_BM = spec.mount_node < 0
+                                     ? Eigen::Isometry3d::Identity()
+                                     : RigidPart(X_BN_[static_cast<std::size_t>(spec.mount_node)]);
+  return X_WB_ * X_BM * spec.X_MS;
+}
+
 Eigen::Affine3d RobotState::node_pose_W(int node) const {
   SANDBOX_CHECK(node >= 0 && node < static_cast<int>(X_BN_.size()));
   return X_WB_ * X_BN_[static_cast<std::size_t>(node)];

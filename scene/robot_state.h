@@ -43,6 +43,9 @@ class RobotState {
   // Node poses in the robot body frame B (after Update()).
   const std::vector<Eigen::Affine3d>& node_poses_B() const { return X_BN_; }
   Eigen::Affine3d node_pose_W(int node) const;
+  // Where a sensor or camera mounted as `spec` says is: the robot pose, its
+  // mount node's rigid part (none: the body frame) and the offset X_MS.
+  Eigen::Isometry3d MountPose(const SensorSpec& spec) const;
   // The posed mesh in frame B, one array per RobotModel::meshes entry.
   const std::vector<Eigen::Vector3f>& positions_B(int mesh) const;
   const std::vector<Eigen::Vector3f>& normals_B(int mesh) const;

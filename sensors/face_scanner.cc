@@ -145,4 +145,47 @@ void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
   }
 }
 
+FaceScannerConfig FaceScannerConfig::Read(scene::SettingsReader& read) {
+  FaceScannerConfig face;
+  face.resolution_m = read.Number("resolution_m", face.resolution_m);
+  face.half_extent_m = read.Number("half_extent_m", face.half_extent_m);
+  const std::string refresh = read.Text("refresh", "six_stage");
+  if (refresh == "full") {
+    face.refresh = Refresh::kFull;
+  } else if (refresh == "six_stage") {
+    face.refresh = Refresh::kSixStage;
+  } else if (refresh == "twelve_stage") {
+    face.refresh = Refresh::kTwelveStage;
+  } else {
+    read.Fail("refresh", "'refresh' must be full, six_stage or twelve_stage, got '" + refresh + "'");
+  }
+  const std::string aligned = read.Text("aligned", "body");
+  if (aligned != "body" && aligned != "world") {
+    read.Fail("aligned", "'aligned' must be body or world, got '" + aligned + "'");
+  }
+  face.alignment = aligned == "body" ? Alignment::kBody : Alignment::kWorld;
+  return face;
+}
+
+std::string FaceScannerConfig::Summary() const {
+  std::ostringstream out;
+  const int n = points_per_side();
+  out << n << "x" << n << "x6 at " << resolution_m << " m";
+  return out.str();
+}
+
+void FaceScanner::Run(const SensorContext& at, FaceScan* scan) const {
+  if (scan->n != n_) *scan = EmptyScan();
+  Scan(at.world, at.caster, at.filter, at.X_WS, at.tick, scan);
+}
+
+FaceFrames FaceScanner::LatestFrames(const FaceScan& scan, const Eigen::Isometry3d& X_WS) const {
+  FaceFrames X_WF;
+  for (std::size_t f = 0; f < 6; ++f) {
+    const ScanFace& face = scan.faces[f];
+    X_WF[f] = face.tick >= 0 ? face.X_WB : BoxFrame(X_WS);
+  }
+  return X_WF;
+}
+
 }  // namespace sandbox::sensors

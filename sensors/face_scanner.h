@@ -16,7 +16,9 @@
 #include <string>
 #include <vector>
 
+#include "scene/settings.h"
 #include "sensors/ray_caster.h"
+#include "sensors/sensor_context.h"
 
 namespace sandbox::sensors {
 
@@ -42,6 +44,11 @@ struct FaceScannerConfig {
   // a whole number of resolutions, or more than 10 million rays a scan.
   void ValidateOrThrow() const;
   int points_per_side() const;  // n
+
+  // The [[robot.sensor]] table's own keys (docs/levels.md); throws scene::LevelError
+  // naming the key.
+  static FaceScannerConfig Read(scene::SettingsReader& read);
+  std::string Summary() const;  // "51x51x6 at 1 m"
 };
 
 // Occupancy of a scanned point.
@@ -60,8 +67,14 @@ struct FaceScan {
   std::array<ScanFace, 6> faces;
 };
 
+// Face f's frame in the world: the box it was last scanned in.
+using FaceFrames = std::array<Eigen::Isometry3d, 6>;
+
 class FaceScanner {
  public:
+  using Config = FaceScannerConfig;
+  using Output = FaceScan;
+
   // Throws std::invalid_argument for a bad config (see ValidateOrThrow).
   explicit FaceScanner(const FaceScannerConfig& config);
 
@@ -79,6 +92,13 @@ class FaceScanner {
   // writes it into `scan`; the rest of `scan` keeps its earlier values.
   void Scan(const scene::CollisionWorld& world, RayCaster& caster, const RayFilter& filter,
             const Eigen::Isometry3d& X_WS, std::int64_t tick, FaceScan* scan) const;
+
+  // The loop's call (sensors/sensor.h): what is due at the context's tick,
+  // into `scan` (sized on the first run).
+  void Run(const SensorContext& at, FaceScan* scan) const;
+
+  // Each face's box as last scanned; a face not scanned yet: the box at X_WS.
+  FaceFrames LatestFrames(const FaceScan& scan, const Eigen::Isometry3d& X_WS) const;
 
   // The faces and row ranges due at `tick`.
   struct Part {

@@ -52,4 +52,22 @@ void GroundScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
   }
 }
 
+GroundScannerConfig GroundScannerConfig::Read(scene::SettingsReader& read) {
+  GroundScannerConfig ground;
+  ground.resolution_m = read.Number("resolution_m", ground.resolution_m);
+  ground.half_extent_m = read.Number("half_extent_m", ground.half_extent_m);
+  ground.depth_m = read.Number("depth_m", ground.depth_m);
+  return ground;
+}
+
+std::string GroundScannerConfig::Summary() const {
+  std::ostringstream out;
+  out << "+-" << half_extent_m << " m at " << resolution_m << " m";
+  return out.str();
+}
+
+void GroundScanner::Run(const SensorContext& at, HeightMap* map) const {
+  Scan(at.world, at.caster, at.filter, at.X_WS.translation(), map);
+}
+
 }  // namespace sandbox::sensors

@@ -8,7 +8,11 @@
 #include <Eigen/Geometry>
 #include <vector>
 
+#include <string>
+
+#include "scene/settings.h"
 #include "sensors/ray_caster.h"
+#include "sensors/sensor_context.h"
 
 namespace sandbox::sensors {
 
@@ -17,6 +21,11 @@ struct GroundScannerConfig {
   double half_extent_m{25.0};
   double depth_m{100.0};         // how far below the sensor to look
   void ValidateOrThrow() const;  // throws std::invalid_argument naming the field
+
+  // The [[robot.sensor]] table's own keys (docs/levels.md); throws scene::LevelError
+  // naming the key.
+  static GroundScannerConfig Read(scene::SettingsReader& read);
+  std::string Summary() const;  // "+-25 m at 1 m"
 };
 
 struct HeightMap {
@@ -28,7 +37,12 @@ struct HeightMap {
 
 class GroundScanner {
  public:
+  using Config = GroundScannerConfig;
+  using Output = HeightMap;
+
   explicit GroundScanner(const GroundScannerConfig& config);
+  // The loop's call (sensors/sensor.h): a map around the sensor's position.
+  void Run(const SensorContext& at, HeightMap* map) const;
   void Scan(const scene::CollisionWorld& world, RayCaster& caster, const RayFilter& filter,
             const Eigen::Vector3d& p_WS, HeightMap* map) const;
 

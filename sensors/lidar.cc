@@ -97,4 +97,36 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
   }
 }
 
+LidarConfig LidarConfig::Read(scene::SettingsReader& read) {
+  LidarConfig lidar;
+  if (read.Has("elevations_deg")) {
+    for (const double deg : read.Numbers("elevations_deg")) {
+      lidar.elevations_rad.push_back(deg * M_PI / 180.0);
+    }
+  } else {
+    const int channels = read.Whole("channels", 16);
+    if (channels < 1) read.Fail("channels", "'channels' must be at least 1");
+    lidar = Uniform(channels, read.Number("min_elevation_deg", -15.0),
+                    read.Number("max_elevation_deg", 15.0), 1024);
+  }
+  lidar.azimuth_steps = read.Whole("azimuth_steps", 1024);
+  lidar.range_m = read.Number("range_m", 100.0);
+  lidar.rotation_hz = read.Number("rotation_hz", 10.0);
+  return lidar;
+}
+
+std::string LidarConfig::Summary() const {
+  std::ostringstream out;
+  out << channels() << "x" << azimuth_steps << ", " << range_m << " m";
+  return out.str();
+}
+
+void Lidar::Run(const SensorContext& at, LidarScan* scan) const {
+  const double sweep_s = 1.0 / config_.rotation_hz;
+  const Eigen::Isometry3d X_RS = at.X_WR.inverse() * at.X_WS;
+  const Eigen::Isometry3d X_WS_start =
+      at.history != nullptr ? at.history->At(at.t_s - sweep_s) * X_RS : at.X_WS;
+  Sweep(at.world, at.caster, at.filter, X_WS_start, at.X_WS, scan);
+}
+
 }  // namespace sandbox::sensors

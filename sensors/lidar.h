@@ -12,7 +12,11 @@
 #include <cstdint>
 #include <vector>
 
+#include <string>
+
+#include "scene/settings.h"
 #include "sensors/ray_caster.h"
+#include "sensors/sensor_context.h"
 
 namespace sandbox::sensors {
 
@@ -29,6 +33,11 @@ struct LidarConfig {
   // step count, range or rate, a non-finite elevation, or over 10 million rays.
   void ValidateOrThrow() const;
   int channels() const { return static_cast<int>(elevations_rad.size()); }
+
+  // The [[robot.sensor]] table's own keys (docs/levels.md); throws scene::LevelError
+  // naming the key.
+  static LidarConfig Read(scene::SettingsReader& read);
+  std::string Summary() const;  // "16x1024, 100 m"
 };
 
 struct LidarScan {
@@ -46,8 +55,18 @@ struct LidarScan {
 
 class Lidar {
  public:
+  using Config = LidarConfig;
+  using Output = LidarScan;
+
   explicit Lidar(const LidarConfig& config);  // throws std::invalid_argument
   const LidarConfig& config() const { return config_; }
+
+  // The loop's call (sensors/sensor.h): the sweep that ends now began
+  // 1 / rotation_hz ago, from the mount as it is now on the robot as it was
+  // then (the context's history; none: the sensor as it is now).
+  void Run(const SensorContext& at, LidarScan* scan) const;
+  // How long the robot's poses must be kept for Run.
+  double history_s() const { return 2.0 / config_.rotation_hz; }
 
   // One sweep from pose X_WS_start (at its start) to X_WS_end (at its end).
   void Sweep(const scene::CollisionWorld& world, RayCaster& caster, const RayFilter& filter,

@@ -38,4 +38,29 @@ RangeReading MeasureRange(const RangeSensorConfig& config, const scene::Collisio
   return reading;
 }
 
+RangeSensorConfig RangeSensorConfig::Read(scene::SettingsReader& read) {
+  RangeSensorConfig ray;
+  const std::vector<double> direction = read.Numbers("direction");
+  if (!direction.empty()) {
+    if (direction.size() != 3) read.Fail("direction", "'direction' must be [x, y, z]");
+    ray.direction_S = Eigen::Vector3d(direction[0], direction[1], direction[2]).normalized();
+  }
+  ray.range_m = read.Number("range_m", ray.range_m);
+  return ray;
+}
+
+std::string RangeSensorConfig::Summary() const {
+  std::ostringstream out;
+  out << range_m << " m";
+  return out.str();
+}
+
+RangeSensor::RangeSensor(const RangeSensorConfig& config) : config_(config) {
+  config_.ValidateOrThrow();
+}
+
+void RangeSensor::Run(const SensorContext& at, RangeReading* reading) const {
+  *reading = MeasureRange(config_, at.world, at.caster, at.filter, at.X_WS);
+}
+
 }  // namespace sandbox::sensors

@@ -3,7 +3,11 @@
 
 #include <Eigen/Geometry>
 
+#include <string>
+
+#include "scene/settings.h"
 #include "sensors/ray_caster.h"
+#include "sensors/sensor_context.h"
 
 namespace sandbox::sensors {
 
@@ -11,6 +15,11 @@ struct RangeSensorConfig {
   Eigen::Vector3d direction_S{0.0, 0.0, -1.0};  // unit, in the sensor frame (default: down)
   double range_m{100.0};
   void ValidateOrThrow() const;  // throws std::invalid_argument naming the field
+
+  // The [[robot.sensor]] table's own keys (docs/levels.md); throws scene::LevelError
+  // naming the key.
+  static RangeSensorConfig Read(scene::SettingsReader& read);
+  std::string Summary() const;  // "100 m"
 };
 
 struct RangeReading {
@@ -27,5 +36,19 @@ struct RangeReading {
 RangeReading MeasureRange(const RangeSensorConfig& config, const scene::CollisionWorld& world,
                           RayCaster& caster, const RayFilter& filter,
                           const Eigen::Isometry3d& X_WS);
+
+class RangeSensor {
+ public:
+  using Config = RangeSensorConfig;
+  using Output = RangeReading;
+
+  explicit RangeSensor(const RangeSensorConfig& config);  // throws std::invalid_argument
+  const RangeSensorConfig& config() const { return config_; }
+  // The loop's call (sensors/sensor.h): one ray from the sensor as it is now.
+  void Run(const SensorContext& at, RangeReading* reading) const;
+
+ private:
+  RangeSensorConfig config_;
+};
 
 }  // namespace sandbox::sensors

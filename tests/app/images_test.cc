@@ -18,8 +18,8 @@
 namespace sandbox::app {
 namespace {
 
-sensors::Frame DepthFrame() {
-  sensors::Frame frame;
+render::Frame DepthFrame() {
+  render::Frame frame;
   frame.width = 3;
   frame.height = 2;
   frame.rgb.assign(18, 0);
@@ -47,7 +47,7 @@ TEST(DepthFileTest, PngHoldsRoundedMillimetresAndZeroWhereNothingOrTooFar) {
 TEST(DepthFileTest, NpyIsFloat32MetresInRowsAsNumpyReadsIt) {
   testing::TempDir dir;
   const std::string path = (dir.path() / "d.npy").string();
-  const sensors::Frame frame = DepthFrame();
+  const render::Frame frame = DepthFrame();
   WriteDepthNpy(frame, path);
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   std::string bytes(std::size_t(in.tellg()), '\0');
@@ -80,7 +80,7 @@ TEST(DepthFileTest, NpyIsFloat32MetresInRowsAsNumpyReadsIt) {
 TEST(DepthFileTest, ExrIsOneFloat32ChannelOfMetres) {
   testing::TempDir dir;
   const std::string path = (dir.path() / "d.exr").string();
-  const sensors::Frame frame = DepthFrame();
+  const render::Frame frame = DepthFrame();
   WriteDepthExr(frame, path);
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   std::string bytes(std::size_t(in.tellg()), '\0');
@@ -132,12 +132,12 @@ TEST(TextureTest, TexturesOverTheLimitOrNotFilesAreRefusedBeforeDecoding) {
   ASSERT_TRUE(cv::imencode(".png", image, png));
   scene::LoadLimits limits;
   limits.max_texture_pixels = 100000;  // less than 400 x 300
-  const sensors::TextureDecoder decode = OpenCvTextureDecoder(limits);
+  const render::TextureDecoder decode = OpenCvTextureDecoder(limits);
   scene::EmbeddedTexture embedded;
   embedded.format_hint = "png";
   embedded.width = int(png.size());
   embedded.bytes = png;
-  sensors::RgbaImage rgba;
+  render::RgbaImage rgba;
   EXPECT_EQ(decode(&embedded, "", &rgba),
             "400 x 300 pixels, over the limit of 100000 ([level] max_texture_pixels)");
   EXPECT_EQ(OpenCvTextureDecoder()(&embedded, "", &rgba), "");

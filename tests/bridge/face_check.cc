@@ -14,7 +14,7 @@
 #include "sandbox_msgs/scan_face_t.hpp"
 #include "scene/collision_world.h"
 #include "scene/level.h"
-#include "sensors/robot_sensors.h"
+#include "sensors/sensor.h"
 
 namespace {
 

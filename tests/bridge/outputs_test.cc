@@ -33,7 +33,7 @@ TEST(RobotOutputsTest, RangeReadingArrivesOnItsChannelWithItsSensorAndInput) {
   const Eigen::Isometry3d X_WS(Eigen::Translation3d(3.0, -4.0, 500.0));
   const sensors::RangeReading reading = sensors::MeasureRange(altimeter, world, caster, {}, X_WS);
   ASSERT_TRUE(reading.hit);
-  outputs.PublishRange("altimeter", reading, InputTag{42, 4200}, 123456);
+  outputs.Publish(reading, {"altimeter", "RANGE"}, 0, InputTag{42, 4200}, 123456);
   link.Drain();
 
   const std::vector<std::uint8_t>* bytes = subscriber.TakeNewest();
@@ -101,9 +101,9 @@ TEST(RobotOutputsTest, EachChannelCountsItsOwnMessages) {
   sensors::RangeReading reading;
   std::vector<std::int64_t> range_seqs, state_seqs;
   for (int i = 0; i < 3; ++i) {
-    outputs.PublishRange("a", reading, InputTag{i, i}, 1000 + i);
+    outputs.Publish(reading, {"a", "RANGE"}, i, InputTag{i, i}, 1000 + i);
     outputs.PublishState(wing, InputTag{i, i}, 1000 + i);
-    outputs.PublishRange("b", reading, InputTag{i, i}, 1000 + i);  // a second sensor, same channel
+    outputs.Publish(reading, {"b", "RANGE"}, i, InputTag{i, i}, 1000 + i);  // a second sensor, same channel
     link.Drain();
     sandbox_msgs::range_t r;
     const std::vector<std::uint8_t>* bytes = range.TakeNewest();
@@ -141,7 +141,7 @@ TEST(RobotOutputsTest, TwoSensorsOfATypeNeedTheirOwnChannels) {
                                                "[[robot.sensor]]\nname = \"a1\"\ntype = \"ray\"\n"
                                                "[[robot.sensor]]\nname = \"a2\"\ntype = \"ray\"\n");
   EXPECT_NO_THROW(CheckOutputChannels(level));  // range sensors share RANGE: they say their names
-  EXPECT_EQ(OutputChannel(level.robots[0].sensors[1]), "SCAN_FACE_TAIL");
+  EXPECT_EQ(sensors::OutputChannel(level.robots[0].sensors[1]), "SCAN_FACE_TAIL");
   LcmLink link("memq://");
   LatestInput own(link, "W/SCAN_FACE_TAIL"), shared(link, "W/SCAN_FACE");
   RobotOutputs outputs(link, "W");
@@ -150,7 +150,7 @@ TEST(RobotOutputsTest, TwoSensorsOfATypeNeedTheirOwnChannels) {
   scan.faces[2].tick = 5;
   scan.faces[2].occupancy = {sensors::kFree};
   scan.faces[2].points_W = {Eigen::Vector3d(1, 2, 3)};
-  outputs.PublishFaces(scan, 5, {}, 0, OutputChannel(level.robots[0].sensors[1]));
+  outputs.Publish(scan, {"tail", sensors::OutputChannel(level.robots[0].sensors[1])}, 5, {}, 0);
   link.Drain();
   EXPECT_NE(own.TakeNewest(), nullptr);
   EXPECT_EQ(shared.TakeNewest(), nullptr);

@@ -1,7 +1,8 @@
 // Sensors declared in level manifests: their configs, their mounts, and one
 // clear message per mistake.
 
-#include "sensors/robot_sensors.h"
+#include "sensors/render/mounted_camera.h"
+#include "sensors/sensor.h"
 
 #include <gtest/gtest.h>
 
@@ -74,7 +75,7 @@ std::string ErrorOf(const std::string& kind, const std::string& table) {
   try {
     const scene::Level level = scene::LoadLevel(file);
     if (kind == "sensor") MakeRobotSensors(level);
-    if (kind == "camera") MakeRobotCameras(level);
+    if (kind == "camera") render::MakeRobotCameras(level);
   } catch (const scene::LevelError& error) {
     const std::string message = error.what();
     return message.substr(message.find("level.toml"));

@@ -2,7 +2,7 @@
 // textures (a generated quad, CesiumMan's embedded texture), the bent wing's silhouette, the chase
 // camera's aim and lag.
 
-#include "sensors/renderer.h"
+#include "sensors/render/renderer.h"
 
 #include <gtest/gtest.h>
 
@@ -14,13 +14,13 @@
 #include "app/images.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
-#include "sensors/cameras.h"
-#include "sensors/debug_overlay.h"
+#include "sensors/render/cameras.h"
+#include "sensors/render/debug_overlay.h"
 #include "sensors/face_scanner.h"
 #include "sensors/ray_caster.h"
 #include "tests/test_util.h"
 
-namespace sandbox::sensors {
+namespace sandbox::render {
 namespace {
 
 using Eigen::Isometry3d;
@@ -77,8 +77,8 @@ TEST_F(RendererTest, DepthAgreesWithTheRayCaster) {
   Frame frame;
   renderer_->Render(view, {}, {}, {}, &frame);
   const scene::CollisionWorld world(level_);
-  RayCaster caster(1);
-  RayBatch rays;
+  sensors::RayCaster caster(1);
+  sensors::RayBatch rays;
   rays.origin_W = view.X_WC.translation();
   std::vector<std::pair<int, int>> pixels;
   const double f = 0.5 * view.height / std::tan(0.5 * view.fov_y_rad);
@@ -93,14 +93,14 @@ TEST_F(RendererTest, DepthAgreesWithTheRayCaster) {
       pixels.emplace_back(column, row);
     }
   }
-  RayHits hits;
+  sensors::RayHits hits;
   caster.Cast(world, rays, {}, &hits);
   int compared = 0;
   for (std::size_t i = 0; i < pixels.size(); ++i) {
     const auto [column, row] = pixels[i];
     const float depth =
         frame.depth_m[std::size_t(row) * std::size_t(view.width) + std::size_t(column)];
-    if (hits.body[i] == RayHits::kNoHit) {
+    if (hits.body[i] == sensors::RayHits::kNoHit) {
       EXPECT_TRUE(std::isinf(depth)) << column << ", " << row;
       continue;
     }
@@ -117,12 +117,12 @@ TEST_F(RendererTest, OverlayMarksEachScannedSampleInItsColourWithoutTouchingDept
   // A full face scan 12 m above the valley floor: the lower face hits the
   // terrain (occupied), the upper faces reach into the sky (free).
   const scene::CollisionWorld world(level_);
-  RayCaster caster(1);
-  FaceScannerConfig config;
+  sensors::RayCaster caster(1);
+  sensors::FaceScannerConfig config;
   config.resolution_m = 2.0;
-  config.refresh = Refresh::kFull;
-  const FaceScanner scanner(config);
-  FaceScan scan = scanner.EmptyScan();
+  config.refresh = sensors::Refresh::kFull;
+  const sensors::FaceScanner scanner(config);
+  sensors::FaceScan scan = scanner.EmptyScan();
   const Isometry3d X_WS(Eigen::Translation3d(0, 0, 12));
   scanner.Scan(world, caster, {}, X_WS, 0, &scan);
   Overlay overlay;
@@ -188,11 +188,11 @@ TEST(DebugOverlayTest, ActorBoundsFollowTheActorAndStubsPointBackAlongTheRay) {
   EXPECT_EQ(all.line_rgb.size(), 12u);
 
   // Stubs: 0.5 m from the sample back towards the sensor.
-  FaceScan scan;
+  sensors::FaceScan scan;
   scan.n = 1;
   scan.faces[0].tick = 3;
   scan.faces[0].X_WS = Isometry3d(Eigen::Translation3d(1, 2, 3));
-  scan.faces[0].occupancy = {kOccupied};
+  scan.faces[0].occupancy = {sensors::kOccupied};
   scan.faces[0].points_W = {Vector3d(11, 2, 3)};
   Overlay stubs;
   AddFaceScan(scan, 0.5, &stubs);
@@ -459,4 +459,4 @@ TEST(CameraTest, BadViewsAreRefused) {
 }
 
 }  // namespace
-}  // namespace sandbox::sensors
+}  // namespace sandbox::render

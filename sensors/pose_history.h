@@ -7,7 +7,7 @@
 #include <deque>
 #include <utility>
 
-namespace sandbox::app {
+namespace sandbox::sensors {
 
 class PoseHistory {
  public:
@@ -49,4 +49,4 @@ class PoseHistory {
   std::deque<std::pair<double, Eigen::Isometry3d>> poses_;
 };
 
-}  // namespace sandbox::app
+}  // namespace sandbox::sensors

@@ -1,15 +1,15 @@
-#include "sensors/debug_overlay.h"
+#include "sensors/render/debug_overlay.h"
 
-namespace sandbox::sensors {
+namespace sandbox::render {
 
-void AddFaceScan(const FaceScan& scan, double stub_m, Overlay* overlay) {
+void AddFaceScan(const sensors::FaceScan& scan, double stub_m, Overlay* overlay) {
   const Eigen::Vector3f red(1.f, 0.1f, 0.1f), green(0.1f, 0.9f, 0.1f);
-  for (const ScanFace& face : scan.faces) {
+  for (const sensors::ScanFace& face : scan.faces) {
     if (face.tick < 0) continue;
     const Eigen::Vector3d origin_W = face.X_WS.translation();
     for (std::size_t i = 0; i < face.points_W.size() && i < face.occupancy.size(); ++i) {
-      if (face.occupancy[i] == kUnvisited) continue;
-      const Eigen::Vector3f& rgb = face.occupancy[i] == kOccupied ? red : green;
+      if (face.occupancy[i] == sensors::kUnvisited) continue;
+      const Eigen::Vector3f& rgb = face.occupancy[i] == sensors::kOccupied ? red : green;
       const Eigen::Vector3d& p_W = face.points_W[i];
       if (stub_m <= 0.0) {
         overlay->AddPoint(p_W, rgb);
@@ -61,4 +61,4 @@ void AddActorBounds(const scene::Level& level, const std::vector<Eigen::Isometry
   }
 }
 
-}  // namespace sandbox::sensors
+}  // namespace sandbox::render

@@ -10,14 +10,14 @@
 #include "scene/level.h"
 #include "scene/robot_state.h"
 #include "sensors/face_scanner.h"
-#include "sensors/renderer.h"
+#include "sensors/render/view.h"
 
-namespace sandbox::sensors {
+namespace sandbox::render {
 
 // Scanned samples of `scan` (unvisited ones skipped). stub_m = 0 draws
 // points; otherwise a stub of that length ending at each sample, pointing
 // back along its ray (long lines are slow on llvmpipe: keep stubs short).
-void AddFaceScan(const FaceScan& scan, double stub_m, Overlay* overlay);
+void AddFaceScan(const sensors::FaceScan& scan, double stub_m, Overlay* overlay);
 
 // Every bone of the bone map: its frame's axes, axis_m long.
 void AddBoneFrames(const scene::RobotState& state, double axis_m, Overlay* overlay);
@@ -28,4 +28,4 @@ void AddBoneFrames(const scene::RobotState& state, double axis_m, Overlay* overl
 void AddActorBounds(const scene::Level& level, const std::vector<Eigen::Isometry3d>& actor_poses,
                     bool static_too, Overlay* overlay);
 
-}  // namespace sandbox::sensors
+}  // namespace sandbox::render

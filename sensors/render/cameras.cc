@@ -1,8 +1,8 @@
-#include "sensors/cameras.h"
+#include "sensors/render/cameras.h"
 
 #include <cmath>
 
-namespace sandbox::sensors {
+namespace sandbox::render {
 
 Eigen::Isometry3d LookAt(const Eigen::Vector3d& p_W, const Eigen::Vector3d& target_W) {
   Eigen::Vector3d x = target_W - p_W;
@@ -59,4 +59,4 @@ double ZoomedFov(double fov_y_rad, double zoom) {
   return 2.0 * std::atan(std::tan(0.5 * fov_y_rad) / zoom);
 }
 
-}  // namespace sandbox::sensors
+}  // namespace sandbox::render

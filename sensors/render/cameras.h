@@ -4,14 +4,9 @@
 // (mounted on the robot or a bone) and fixed (a world pose). Pure pose math;
 // the Renderer draws what they see. Camera frames: x forward, y left, z up.
 
-#include <string>
-
 #include <Eigen/Geometry>
 
-#include "scene/robot_state.h"
-#include "sensors/renderer.h"
-
-namespace sandbox::sensors {
+namespace sandbox::render {
 
 // A pose at `p_W` looking at `target_W`, level (its y axis horizontal).
 Eigen::Isometry3d LookAt(const Eigen::Vector3d& p_W, const Eigen::Vector3d& target_W);
@@ -53,4 +48,4 @@ Eigen::Isometry3d TrailingPose(const Eigen::Isometry3d& X_WB, double distance_m,
 // The vertical field of view `zoom` times magnified: tan(fov / 2) / zoom.
 double ZoomedFov(double fov_y_rad, double zoom);
 
-}  // namespace sandbox::sensors
+}  // namespace sandbox::render

@@ -1,0 +1,49 @@
+#pragma once
+// The end of `sandbox run`: the summary it prints, the tick plot (ticks.png)
+// and the last of the statistics file, gathered from the parts that ran.
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "app/camera_director.h"
+#include "app/frame_pipeline.h"
+#include "app/live_view.h"
+#include "app/run_options.h"
+#include "app/scan_files.h"
+#include "app/tick_stats.h"
+#include "bridge/lcm_link.h"
+#include "bridge/robot_feed.h"
+
+namespace sandbox::app {
+
+// What ran, as the loop leaves it. Null pointers: that part did not run.
+struct RunRecord {
+  const RunOptions* options{nullptr};
+  std::string level_name;
+  std::int64_t ticks{0};
+  double elapsed_s{0.0};
+  TickStats* stats{nullptr};  // flushed here
+  const bridge::LogReader* replay{nullptr};
+  std::int64_t origin_moves{0};
+  double longest_origin_move_ms{0.0};
+  Eigen::Vector3d origin{Eigen::Vector3d::Zero()};
+  const ScanFileWriter* scan_files{nullptr};
+  const LiveView* live_view{nullptr};
+  const CameraDirector* cameras{nullptr};
+  const bridge::LcmLink* link{nullptr};
+  const FramePipeline* frames{nullptr};  // null unless frames were written
+  std::vector<const bridge::RobotFeed*> feeds;
+};
+
+// The name of the pace: "100 Hz", "free running" or "lock-step".
+std::string PaceName(const RunOptions& options);
+
+// Prints the summary to `out` (a replay's end and failures to `err`), plots
+// ticks.png and flushes ticks.csv. Returns false when some output could not
+// be written (each loss is reported).
+bool ReportRun(const RunRecord& run, std::ostream& out, std::ostream& err);
+
+}  // namespace sandbox::app

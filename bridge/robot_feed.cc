@@ -1,0 +1,82 @@
+#include "bridge/robot_feed.h"
+
+namespace sandbox::bridge {
+
+RobotFeed::RobotFeed(LcmLink& link, const scene::Level& level, int robot,
+                     const RobotBridgeConfig& config, bool lockstep, RejectLog* log)
+    : config_(config),
+      robot_(robot),
+      lockstep_(lockstep),
+      inputs_(link, level, robot, config) {
+  inputs_.set_log(log);
+  inputs_.set_lockstep(lockstep);
+  if (config.net_fdm_port > 0) {
+    net_fdm_ = std::make_unique<NetFdmInput>(config);
+    net_fdm_->set_log(log);
+  }
+  if (config.udp_doubles_port > 0) {
+    doubles_ = std::make_unique<DoublesInput>(config, level.robots[std::size_t(robot)]);
+    doubles_->set_log(log);
+  }
+}
+
+RobotFeed::Changes RobotFeed::Apply(std::int64_t now_utime, scene::RobotState* state,
+                                    scene::CollisionWorld* world) {
+  const RobotInputs::Applied applied =
+      lockstep_ ? inputs_.ApplyNext(state, world) : inputs_.Apply(state, world);
+  Changes changes;
+  changes.messages =
+      int(applied.pose) + int(applied.bones) + int(applied.actors) + int(applied.camera);
+  changes.pose = applied.pose;
+  changes.pose_utime = applied.pose_utime;
+  changes.moved = applied.pose || applied.bones;
+  if (applied.pose) input_ = {applied.pose_seq, applied.pose_utime};
+  // UDP inputs: the packet's own counter and time where its format has
+  // them, else the receive counter and the arrival time.
+  auto tag = [now_utime](const PacketTag& own, std::int64_t received) {
+    return InputTag{own.seq >= 0 ? own.seq : received, own.utime >= 0 ? own.utime : now_utime};
+  };
+  if (net_fdm_ && net_fdm_->Apply(state)) {
+    changes.moved = true;
+    ++changes.messages;
+    input_ = tag(net_fdm_->last_tag(), net_fdm_->socket().received());
+  }
+  if (doubles_ && doubles_->Apply(state)) {
+    changes.moved = true;
+    ++changes.messages;
+    input_ = tag(doubles_->last_tag(), doubles_->socket().received());
+  }
+  if (changes.moved) {
+    state->Update();
+    world->UpdateRobot(robot_, *state);
+  }
+  return changes;
+}
+
+std::vector<ChannelStatus> RobotFeed::Channels(std::int64_t now_utime) const {
+  std::vector<ChannelStatus> channels;
+  for (const LatestInput* in :
+       {&inputs_.pose(), &inputs_.bones(), &inputs_.actors(), &inputs_.camera()}) {
+    // Camera commands come when someone steers: never stale.
+    const bool stale = in != &inputs_.camera() && in->Stale(now_utime, config_.stale_after_s);
+    channels.push_back({in->channel(), in->received(), in->superseded(), in->rejected(), stale,
+                        in->last_reject_reason()});
+  }
+  for (const UdpLatest* socket :
+       {net_fdm_ ? &net_fdm_->socket() : nullptr, doubles_ ? &doubles_->socket() : nullptr}) {
+    if (socket == nullptr) continue;
+    channels.push_back({socket->name(), socket->received(), socket->superseded(),
+                        socket->rejected(), false, socket->last_reject_reason()});
+  }
+  return channels;
+}
+
+std::vector<bool> RobotFeed::Stale(std::int64_t now_utime) const {
+  std::vector<bool> stale;
+  for (const LatestInput* in : {&inputs_.pose(), &inputs_.bones(), &inputs_.actors()}) {
+    stale.push_back(in->Stale(now_utime, config_.stale_after_s));
+  }
+  return stale;
+}
+
+}  // namespace sandbox::bridge

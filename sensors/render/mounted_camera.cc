@@ -1,0 +1,93 @@
+#include "sensors/render/mounted_camera.h"
+
+#include <array>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+#include "scene/settings.h"
+
+namespace sandbox::render {
+namespace {
+
+constexpr std::array<std::pair<CameraKind, std::string_view>, 4> kCameraTypes{{
+    {CameraKind::kChase, "chase"},
+    {CameraKind::kTrailing, "trailing"},
+    {CameraKind::kPayload, "payload"},
+    {CameraKind::kFixed, "fixed"},
+}};
+
+CameraKind ParseCameraKind(const scene::SensorSpec& spec) {
+  std::string names;
+  for (std::size_t i = 0; i < kCameraTypes.size(); ++i) {
+    if (kCameraTypes[i].second == spec.type) return kCameraTypes[i].first;
+    names += (i == 0 ? "" : i + 1 == kCameraTypes.size() ? " or " : ", ");
+    names += kCameraTypes[i].second;
+  }
+  throw scene::LevelError(spec.settings.Where("type") + "'type' must be " + names + ", got '" +
+                          spec.type + "'");
+}
+
+}  // namespace
+
+std::string_view CameraTypeName(CameraKind kind) {
+  for (const auto& [k, name] : kCameraTypes) {
+    if (k == kind) return name;
+  }
+  return "?";
+}
+
+Eigen::Isometry3d MountedCamera::Pose(const scene::RobotState& state, ChaseCamera* chase_state,
+                                      const TrailingCommand& command, double dt_s) const {
+  switch (kind) {
+    case CameraKind::kChase:
+      return chase_state->Update(state.pose(), dt_s);
+    case CameraKind::kTrailing:
+      return TrailingPose(state.pose(), trailing_distance_m, trailing_height_m, command);
+    case CameraKind::kFixed:
+      return spec.X_MS;
+    case CameraKind::kPayload:
+      break;
+  }
+  return state.MountPose(spec);
+}
+
+std::vector<MountedCamera> MakeRobotCameras(const scene::Level& level) {
+  std::vector<MountedCamera> cameras;
+  for (std::size_t r = 0; r < level.robots.size(); ++r) {
+    for (const scene::SensorSpec& spec : level.robots[r].cameras) {
+      scene::SettingsReader read(spec.settings);
+      MountedCamera camera;
+      camera.spec = spec;
+      camera.kind = ParseCameraKind(spec);
+      camera.robot = static_cast<int>(r);
+      camera.view.width = read.Whole("width", 640);
+      camera.view.height = read.Whole("height", 480);
+      camera.view.fov_y_rad = read.Number("fov_deg", 60.0) * M_PI / 180.0;
+      camera.view.near_m = read.Number("near_m", 0.1);
+      camera.view.far_m = read.Number("far_m", 2000.0);
+      camera.chase.arm_length_m = read.Number("arm_length_m", camera.chase.arm_length_m);
+      camera.chase.arm_height_m = read.Number("arm_height_m", camera.chase.arm_height_m);
+      camera.chase.position_lag_s = read.Number("position_lag_s", camera.chase.position_lag_s);
+      camera.chase.rotation_lag_s = read.Number("rotation_lag_s", camera.chase.rotation_lag_s);
+      camera.trailing_distance_m = read.Number("distance_m", camera.trailing_distance_m);
+      camera.trailing_height_m = read.Number("height_m", camera.trailing_height_m);
+      camera.depth = read.Flag("depth", camera.kind == CameraKind::kPayload);
+      camera.overlay = read.Flag("overlay", false);
+      camera.overlay_stub_m = read.Number("overlay_stub_m", 0.0);
+      if (!(camera.overlay_stub_m >= 0.0 && camera.overlay_stub_m <= 100.0)) {
+        throw scene::LevelError(spec.Where() + "overlay_stub_m must be 0 (points) to 100 m");
+      }
+      read.RejectUnknownKeys(spec.type + " camera");
+      try {
+        camera.view.ValidateOrThrow();
+      } catch (const std::invalid_argument& error) {
+        throw scene::LevelError(spec.Where() + error.what());
+      }
+      cameras.push_back(std::move(camera));
+    }
+  }
+  return cameras;
+}
+
+}  // namespace sandbox::render

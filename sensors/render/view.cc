@@ -1,0 +1,33 @@
+#include "sensors/render/view.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace sandbox::render {
+
+void Overlay::AddPoint(const Eigen::Vector3d& p_W, const Eigen::Vector3f& rgb) {
+  points_W.push_back(p_W);
+  point_rgb.push_back(rgb);
+}
+
+void Overlay::AddLine(const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W,
+                      const Eigen::Vector3f& rgb) {
+  lines_W.push_back(a_W);
+  lines_W.push_back(b_W);
+  line_rgb.push_back(rgb);
+}
+
+void CameraView::ValidateOrThrow() const {
+  if (width < 1 || width > 8192 || height < 1 || height > 8192) {
+    throw std::invalid_argument("resolution must be 1 to 8192 pixels a side, got " +
+                                std::to_string(width) + " x " + std::to_string(height));
+  }
+  if (!(fov_y_rad > 0.0 && fov_y_rad < M_PI)) {
+    throw std::invalid_argument("field of view must be between 0 and 180 degrees");
+  }
+  if (!(near_m > 0.0 && far_m > near_m)) throw std::invalid_argument("need 0 < near_m < far_m");
+  if (!X_WC.matrix().allFinite()) throw std::invalid_argument("non-finite camera pose");
+}
+
+}  // namespace sandbox::render

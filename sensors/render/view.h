@@ -1,0 +1,46 @@
+#pragma once
+// What a camera sees and what the renderer gives back, without GL: the view
+// (pose and lens), the debug overlay's marks and the rendered frame.
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <vector>
+
+namespace sandbox::render {
+
+// A pinhole camera: pose X_WC with x forward, y left, z up (like a robot body).
+struct CameraView {
+  Eigen::Isometry3d X_WC{Eigen::Isometry3d::Identity()};
+  int width{640};
+  int height{480};
+  double fov_y_rad{0.9};  // vertical field of view
+  double near_m{0.1};
+  double far_m{2000.0};
+  // Throws std::invalid_argument naming the field: sizes from 1 to 8192,
+  // a field of view in (0, pi), 0 < near < far.
+  void ValidateOrThrow() const;
+};
+
+struct Frame {
+  int width{0};
+  int height{0};
+  std::vector<std::uint8_t> rgb;  // row 0 at the top
+  std::vector<float> depth_m;     // distance along the optical axis; +inf where sky
+};
+
+// Debug marks drawn over the scene, hidden behind nearer surfaces: points and
+// short line segments in world coordinates, each with its own colour. They
+// change the colour image only, never the depth image.
+struct Overlay {
+  std::vector<Eigen::Vector3d> points_W;
+  std::vector<Eigen::Vector3f> point_rgb;  // one per point, 0..1
+  std::vector<Eigen::Vector3d> lines_W;    // two ends per segment
+  std::vector<Eigen::Vector3f> line_rgb;   // one per segment
+  float point_size_px{3.0f};
+
+  void AddPoint(const Eigen::Vector3d& p_W, const Eigen::Vector3f& rgb);
+  void AddLine(const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W, const Eigen::Vector3f& rgb);
+  bool empty() const { return points_W.empty() && lines_W.empty(); }
+};
+
+}  // namespace sandbox::render

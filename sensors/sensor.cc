@@ -1,0 +1,128 @@
+#include "sensors/sensor.h"
+
+#include <sstream>
+#include <stdexcept>
+#include <type_traits>
+#include <utility>
+
+namespace sandbox::sensors {
+namespace {
+
+// The lists agree: kind i is alternative i and row i.
+constexpr bool KindsInOrder() {
+  for (std::size_t i = 0; i < kSensorKinds.size(); ++i) {
+    if (kSensorKinds[i].kind != SensorKind(i)) return false;
+  }
+  return kSensorKinds.size() == std::variant_size_v<SensorConfig>;
+}
+static_assert(KindsInOrder(), "kSensorKinds must list every SensorClasses entry, in order");
+
+// The config of alternative I, read from the table.
+template <std::size_t I>
+SensorConfig ReadAlternative(scene::SettingsReader& read) {
+  return SensorConfig(std::in_place_index<I>,
+                      std::variant_alternative_t<I, SensorConfig>::Read(read));
+}
+template <std::size_t... I>
+SensorConfig ReadConfig(SensorKind kind, scene::SettingsReader& read, std::index_sequence<I...>) {
+  static constexpr SensorConfig (*kRead[])(scene::SettingsReader&) = {&ReadAlternative<I>...};
+  return kRead[std::size_t(kind)](read);
+}
+
+// The class of alternative I, made from its config.
+template <std::size_t I>
+SensorClasses::Any MakeAlternative(const SensorConfig& config) {
+  return SensorClasses::Any(std::in_place_index<I>, std::get<I>(config));
+}
+template <std::size_t... I>
+SensorClasses::Any MakeClass(const SensorConfig& config, std::index_sequence<I...>) {
+  static constexpr SensorClasses::Any (*kMake[])(const SensorConfig&) = {&MakeAlternative<I>...};
+  return kMake[config.index()](config);
+}
+
+constexpr auto kAlternatives = std::make_index_sequence<kSensorKinds.size()>();
+
+// A class's history_s(), or 0 when it has none.
+template <typename Class, typename = void>
+struct HistoryOf {
+  static double Of(const Class&) { return 0.0; }
+};
+template <typename Class>
+struct HistoryOf<Class, std::void_t<decltype(std::declval<const Class&>().history_s())>> {
+  static double Of(const Class& sensor) { return sensor.history_s(); }
+};
+
+}  // namespace
+
+const SensorKindInfo& Info(SensorKind kind) { return kSensorKinds[std::size_t(kind)]; }
+
+SensorKind ParseSensorKind(const scene::SensorSpec& spec) {
+  std::string names;
+  for (std::size_t i = 0; i < kSensorKinds.size(); ++i) {
+    if (kSensorKinds[i].type == spec.type) return kSensorKinds[i].kind;
+    names += (i == 0 ? "" : i + 1 == kSensorKinds.size() ? " or " : ", ");
+    names += kSensorKinds[i].type;
+  }
+  throw scene::LevelError(spec.settings.Where("type") + "'type' must be " + names + ", got '" +
+                          spec.type + "'");
+}
+
+std::string OutputChannel(const scene::SensorSpec& spec) {
+  if (!spec.channel.empty()) return spec.channel;
+  return std::string(Info(ParseSensorKind(spec)).channel);
+}
+
+std::string MountedSensor::Describe() const {
+  std::ostringstream out;
+  out << spec.type << " " << std::visit([](const auto& c) { return c.Summary(); }, config)
+      << " on " << (spec.mount.empty() ? "body" : spec.mount);
+  if (spec.rate_hz > 0.0) out << " at " << spec.rate_hz << " Hz";
+  return out.str();
+}
+
+std::vector<MountedSensor> MakeRobotSensors(const scene::Level& level) {
+  std::vector<MountedSensor> sensors;
+  for (std::size_t r = 0; r < level.robots.size(); ++r) {
+    for (const scene::SensorSpec& spec : level.robots[r].sensors) {
+      MountedSensor sensor;
+      sensor.spec = spec;
+      sensor.kind = ParseSensorKind(spec);
+      sensor.robot = static_cast<int>(r);
+      sensor.channel = OutputChannel(spec);
+      scene::SettingsReader read(spec.settings);
+      sensor.config = ReadConfig(sensor.kind, read, kAlternatives);
+      read.RejectUnknownKeys(spec.type + " sensor");
+      // The config's own checks, named with the sensor.
+      try {
+        std::visit([](const auto& c) { c.ValidateOrThrow(); }, sensor.config);
+      } catch (const std::invalid_argument& error) {
+        throw scene::LevelError(spec.Where() + error.what());
+      }
+      sensors.push_back(std::move(sensor));
+    }
+  }
+  return sensors;
+}
+
+Sensor::Sensor(const MountedSensor& mounted)
+    : mounted_(&mounted), sensor_(MakeClass(mounted.config, kAlternatives)) {
+  std::visit([this](const auto& s) { output_.emplace<typename std::decay_t<decltype(s)>::Output>(); },
+             sensor_);
+}
+
+const SensorOutput& Sensor::Run(const SensorContext& at) {
+  std::visit(
+      [&](const auto& sensor) {
+        using Output = typename std::decay_t<decltype(sensor)>::Output;
+        sensor.Run(at, &std::get<Output>(output_));
+      },
+      sensor_);
+  return output_;
+}
+
+double Sensor::history_s() const {
+  return std::visit(
+      [](const auto& s) { return HistoryOf<std::decay_t<decltype(s)>>::Of(s); }, sensor_);
+}
+
+}  // namespace sandbox::sensors
