@@ -376,13 +376,6 @@ void CheckGlbHeader(const fs::path& file) {
 
 }  // namespace
 
-std::string LowerExtension(const fs::path& file) {
-  std::string ext = file.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
-
 void TransformMesh(const Eigen::Affine3d& T, Mesh* mesh) {
   const Eigen::Matrix3f linear = T.linear().cast<float>();
   const Eigen::Vector3f translation = T.translation().cast<float>();

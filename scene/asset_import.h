@@ -7,27 +7,12 @@
 #include <string>
 #include <vector>
 
-#include "scene/level.h"
+#include "scene/imported_asset.h"
+#include "scene/load_limits.h"
+#include "scene/mesh.h"
+#include "scene/placement.h"
 
 namespace sandbox::scene {
-
-// A node of an asset that carries meshes. Its meshes are in the node's own
-// frame N, in file units; X_RN takes them to the asset root frame R, which has
-// world axes (Z up) and metres (the up-axis and unit conversion are in X_RN).
-struct ImportedNode {
-  std::string path;  // unique within the asset: "body/wing", unnamed nodes "node3"
-  Eigen::Affine3d X_RN{Eigen::Affine3d::Identity()};
-  std::vector<Mesh> meshes;  // Mesh::material indexes ImportedAsset::materials
-};
-
-struct ImportedAsset {
-  std::vector<ImportedNode> nodes;
-  std::vector<Material> materials;
-  std::vector<EmbeddedTexture> textures;
-  std::vector<std::string> warnings;
-  UpAxis up{UpAxis::kPosZ};
-  double unit_scale_m{1.0};
-};
 
 // Reads a scene file with assimp (or a Terragen .ter terrain natively).
 // Throws LevelError naming the file when it is missing, not a regular file,
@@ -37,13 +22,7 @@ struct ImportedAsset {
 ImportedAsset ImportAsset(const std::filesystem::path& file, const AssetConversion& conversion,
                           const LoadLimits& limits = {});
 
-// Appends materials and textures to the level, renumbering the materials'
-// texture references; returns the index the first material got.
-int AppendMaterials(std::vector<Material> materials, std::vector<EmbeddedTexture> textures,
-                    Level* level);
 
-// The file's extension in lower case, with its dot: ".glb".
-std::string LowerExtension(const std::filesystem::path& file);
 
 // Applies an affine map to a mesh: positions, normals (inverse transpose), and
 // the triangle winding when the map mirrors.

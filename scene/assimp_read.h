@@ -10,7 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "scene/level.h"
+#include "scene/load_limits.h"
+#include "scene/mesh.h"
+#include "scene/placement.h"
 
 namespace sandbox::scene {
 

@@ -3,6 +3,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 
@@ -38,6 +40,13 @@ void CheckReadable(const std::filesystem::path& file, const LoadLimits& limits) 
   }
   if (FileBytes(file) == 0) throw LevelError(file.string() + ": file is empty");
   limits.CheckFileSize(file);
+}
+
+std::string LowerExtension(const std::filesystem::path& file) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
 }
 
 }  // namespace sandbox::scene

@@ -18,6 +18,9 @@ std::string RegularFileProblem(const std::filesystem::path& file);
 // The size of a regular file in bytes (0 when it cannot be told).
 std::uint64_t FileBytes(const std::filesystem::path& file);
 
+// The file's extension in lower case, with its dot: ".glb".
+std::string LowerExtension(const std::filesystem::path& file);
+
 // Before a level's file is opened: throws LevelError naming it when it is
 // missing, not a regular file, empty, unreadable or over limits.max_file_mb.
 void CheckReadable(const std::filesystem::path& file, const LoadLimits& limits);

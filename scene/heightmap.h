@@ -6,7 +6,10 @@
 #include <filesystem>
 #include <vector>
 
-#include "scene/asset_import.h"
+#include "scene/imported_asset.h"
+#include "scene/load_limits.h"
+#include "scene/mesh.h"
+#include "scene/placement.h"
 
 namespace sandbox::scene {
 

@@ -58,6 +58,11 @@ struct LoadOptions {
   std::function<void(const std::filesystem::path& file)> on_file;
 };
 
+// Appends materials and textures to the level, renumbering the materials'
+// texture references; returns the index the first material got.
+int AppendMaterials(std::vector<Material> materials, std::vector<EmbeddedTexture> textures,
+                    Level* level);
+
 // Loads a level: a `.toml` file is a level manifest, anything else a scene file
 // that assimp reads (or a Terragen .ter terrain), in which every node with
 // meshes becomes an actor named after its node path. Only regular files are

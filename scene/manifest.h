@@ -9,7 +9,8 @@
 #include <string_view>
 #include <vector>
 
-#include "scene/level.h"
+#include "scene/load_limits.h"
+#include "scene/placement.h"
 #include "scene/robot_model.h"
 
 namespace sandbox::scene {
