@@ -14,6 +14,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "scene/settings.h"
@@ -74,6 +75,7 @@ class FaceScanner {
  public:
   using Config = FaceScannerConfig;
   using Output = FaceScan;
+  static constexpr std::string_view kType = "face";  // [[robot.sensor]] type
 
   // Throws std::invalid_argument for a bad config (see ValidateOrThrow).
   explicit FaceScanner(const FaceScannerConfig& config);

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <string>
+#include <string_view>
 
 #include "scene/settings.h"
 #include "sensors/ray_caster.h"
@@ -39,6 +40,7 @@ class GroundScanner {
  public:
   using Config = GroundScannerConfig;
   using Output = HeightMap;
+  static constexpr std::string_view kType = "ground";  // [[robot.sensor]] type
 
   explicit GroundScanner(const GroundScannerConfig& config);
   // The loop's call (sensors/sensor.h): a map around the sensor's position.

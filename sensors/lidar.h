@@ -13,6 +13,7 @@
 #include <vector>
 
 #include <string>
+#include <string_view>
 
 #include "scene/settings.h"
 #include "sensors/ray_caster.h"
@@ -57,6 +58,7 @@ class Lidar {
  public:
   using Config = LidarConfig;
   using Output = LidarScan;
+  static constexpr std::string_view kType = "lidar";  // [[robot.sensor]] type
 
   explicit Lidar(const LidarConfig& config);  // throws std::invalid_argument
   const LidarConfig& config() const { return config_; }

@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 
 #include <string>
+#include <string_view>
 
 #include "scene/settings.h"
 #include "sensors/ray_caster.h"
@@ -41,6 +42,7 @@ class RangeSensor {
  public:
   using Config = RangeSensorConfig;
   using Output = RangeReading;
+  static constexpr std::string_view kType = "ray";  // [[robot.sensor]] type
 
   explicit RangeSensor(const RangeSensorConfig& config);  // throws std::invalid_argument
   const RangeSensorConfig& config() const { return config_; }

@@ -8,14 +8,18 @@
 namespace sandbox::sensors {
 namespace {
 
-// The lists agree: kind i is alternative i and row i.
-constexpr bool KindsInOrder() {
-  for (std::size_t i = 0; i < kSensorKinds.size(); ++i) {
-    if (kSensorKinds[i].kind != SensorKind(i)) return false;
-  }
-  return kSensorKinds.size() == std::variant_size_v<SensorConfig>;
+constexpr auto kAlternatives = std::make_index_sequence<kSensorKinds.size()>();
+
+// The lists agree: kind i is row i and class i.
+template <std::size_t... I>
+constexpr bool KindsInOrder(std::index_sequence<I...>) {
+  return kSensorKinds.size() == std::variant_size_v<SensorClasses::Any> &&
+         ((kSensorKinds[I].kind == SensorKind(I) &&
+           kSensorKinds[I].type == std::variant_alternative_t<I, SensorClasses::Any>::kType) &&
+          ...);
 }
-static_assert(KindsInOrder(), "kSensorKinds must list every SensorClasses entry, in order");
+static_assert(KindsInOrder(kAlternatives),
+              "SensorKind, SensorClasses and kSensorKinds must list the kinds in one order");
 
 // The config of alternative I, read from the table.
 template <std::size_t I>
@@ -39,8 +43,6 @@ SensorClasses::Any MakeClass(const SensorConfig& config, std::index_sequence<I..
   static constexpr SensorClasses::Any (*kMake[])(const SensorConfig&) = {&MakeAlternative<I>...};
   return kMake[config.index()](config);
 }
-
-constexpr auto kAlternatives = std::make_index_sequence<kSensorKinds.size()>();
 
 // A class's history_s(), or 0 when it has none.
 template <typename Class, typename = void>

@@ -31,10 +31,10 @@ namespace sandbox::sensors {
 // The kinds, in the order of SensorClasses.
 enum class SensorKind { kFace, kGround, kLidar, kRange };
 
-// One class a kind. Each has `Config` (with static Read, Summary and
-// ValidateOrThrow), `Output` (its own type) and `void Run(const
-// SensorContext&, Output*) const`; `double history_s() const` when it needs
-// its robot's earlier poses.
+// One class a kind. Each has `kType` (its manifest name), `Config` (with
+// static Read, Summary and ValidateOrThrow), `Output` (a type of its own) and
+// `void Run(const SensorContext&, Output*) const`; `double history_s() const`
+// when it needs its robot's earlier poses.
 template <typename... Classes>
 struct SensorClassList {
   using Any = std::variant<Classes...>;
@@ -46,15 +46,15 @@ using SensorClasses = SensorClassList<FaceScanner, GroundScanner, Lidar, RangeSe
 // How the manifest names each kind and where it publishes.
 struct SensorKindInfo {
   SensorKind kind;
-  std::string_view type;     // [[robot.sensor]] type = "..."
+  std::string_view type;     // [[robot.sensor]] type = "...": the class's kType
   std::string_view channel;  // after "<ROBOT>/", unless the table sets `channel`
   bool shares_channel;       // several on one robot may share it (messages name the sensor)
 };
 inline constexpr std::array<SensorKindInfo, 4> kSensorKinds{{
-    {SensorKind::kFace, "face", "SCAN_FACE", false},
-    {SensorKind::kGround, "ground", "GROUND", false},
-    {SensorKind::kLidar, "lidar", "LIDAR", false},
-    {SensorKind::kRange, "ray", "RANGE", true},
+    {SensorKind::kFace, FaceScanner::kType, "SCAN_FACE", false},
+    {SensorKind::kGround, GroundScanner::kType, "GROUND", false},
+    {SensorKind::kLidar, Lidar::kType, "LIDAR", false},
+    {SensorKind::kRange, RangeSensor::kType, "RANGE", true},
 }};
 
 using SensorConfig = SensorClasses::Config;
