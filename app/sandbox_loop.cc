@@ -155,32 +155,21 @@ int SandboxLoop::Run() {
       if (!NextLockstepInput(wall_s, &wait)) break;
       if (wait) continue;
     }
-    const auto tick_start = Clock::now();
-    TickRecord record;
-    record.tick = tick_;
-    record.start_s = seconds_since_start(tick_start);
-    record.lateness_ms = 1e3 * pacer.Lateness(record.start_s);
-    const std::int64_t rays_before = caster_.rays_cast();
     if (!TakeViewKeys(drain_budget_s)) {
       if (cameras_.controls().quit) break;
       pacer.Restart(seconds_since_start(Clock::now()));  // paused
       continue;
     }
-    if (hooks_.before_tick) hooks_.before_tick(link_, wall_s);
-    std::int64_t now = bridge::NowUtime();
-    const double t = ApplyInputs(wall_s, drain_budget_s, &now, &record);  // 1-2
-    RunDueSensors(t, now);                                                  // 3-4
-    PublishStates(now);                                                     // 4
-    WriteDueScans(t);
-    DirectCameras(t, &record);                                              // 5
-    PublishStatusIfDue(t, now);                                             // 4
-    ReportRecordingFailure();
-    if (hooks_.end_of_tick) hooks_.end_of_tick(tick_);
+    const auto tick_start = Clock::now();
+    TickRecord record;
+    record.tick = tick_;
+    record.start_s = seconds_since_start(tick_start);
+    record.lateness_ms = 1e3 * pacer.Lateness(record.start_s);
+    Tick(wall_s, drain_budget_s, &record);
     ++tick_;
     // 6. Record the tick; wait for the next (or the end of the run, or a stop).
     const auto tick_end = Clock::now();
     record.duration_ms = std::chrono::duration<double, std::milli>(tick_end - tick_start).count();
-    record.rays = caster_.rays_cast() - rays_before;
     bool overrun = false;
     const double next_s = pacer.Next(seconds_since_start(tick_end), &overrun);
     stats_.Add(record, overrun);
@@ -193,6 +182,21 @@ int SandboxLoop::Run() {
   scan_files_.Finish();
   link_.FinishRecording();
   return Report(seconds_since_start(Clock::now())) ? 0 : kExitOutputLost;
+}
+
+void SandboxLoop::Tick(double wall_s, double drain_budget_s, TickRecord* record) {
+  const std::int64_t rays_before = caster_.rays_cast();
+  if (hooks_.before_tick) hooks_.before_tick(link_, wall_s);
+  std::int64_t now = bridge::NowUtime();
+  const double t = ApplyInputs(wall_s, drain_budget_s, &now, record);  // 1-2
+  RunDueSensors(t, now);                                                 // 3, and 4: their outputs
+  PublishStates(now);                                                    // 4
+  WriteDueScans(t);
+  DirectCameras(t, record);    // 5
+  PublishStatusIfDue(t, now);  // 4
+  ReportRecordingFailure();
+  if (hooks_.end_of_tick) hooks_.end_of_tick(tick_);
+  record->rays = caster_.rays_cast() - rays_before;
 }
 
 bool SandboxLoop::TakeViewKeys(double drain_budget_s) {

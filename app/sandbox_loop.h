@@ -86,7 +86,8 @@ class SandboxLoop {
   bool NextLockstepInput(double wall_s, bool* wait);
   // The live view's keys; false when the tick is skipped (paused or quit).
   bool TakeViewKeys(double drain_budget_s);
-  // The steps of a tick, in order.
+  // Steps 1-5 of a tick, each below in order; the caller records it (6).
+  void Tick(double wall_s, double drain_budget_s, TickRecord* record);
   double ApplyInputs(double wall_s, double drain_budget_s, std::int64_t* now_utime,
                      TickRecord* record);
   void RunDueSensors(double t, std::int64_t now_utime);

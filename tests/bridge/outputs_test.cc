@@ -8,12 +8,16 @@
 #include <cmath>
 
 #include "bridge/lcm_link.h"
+#include "sandbox_msgs/ground_map_t.hpp"
+#include "sandbox_msgs/lidar_scan_t.hpp"
 #include "sandbox_msgs/range_t.hpp"
+#include "sandbox_msgs/scan_face_t.hpp"
 #include "sandbox_msgs/robot_state_t.hpp"
 #include "scene/collision_world.h"
 #include "scene/level.h"
 #include "sensors/face_scanner.h"
 #include "sensors/range_sensor.h"
+#include "sensors/sensor.h"
 #include "tests/test_util.h"
 
 namespace sandbox::bridge {
@@ -56,6 +60,69 @@ TEST(RobotOutputsTest, RangeReadingArrivesOnItsChannelWithItsSensorAndInput) {
   EXPECT_NEAR(message.point[2], 500.0 - message.range_m, 1e-3);
   EXPECT_GT(message.normal[2], 0.0);  // the ground faces up
   EXPECT_EQ(outputs.published(), 1);
+}
+
+// Decodes the newest message of `input` as a Message; false when there is none.
+template <typename Message>
+bool Newest(LatestInput& input, Message* message) {
+  const std::vector<std::uint8_t>* bytes = input.TakeNewest();
+  return bytes != nullptr &&
+         message->decode(bytes->data(), 0, int(bytes->size())) == int(bytes->size());
+}
+
+// Every kind's output goes out through the one Publish call, on its kind's
+// channel, as its own message type.
+TEST(RobotOutputsTest, AnyKindOfOutputGoesOutThroughOneCall) {
+  LcmLink link("memq://");
+  LatestInput face(link, "W/SCAN_FACE"), ground(link, "W/GROUND"), lidar(link, "W/LIDAR"),
+      range(link, "W/RANGE");
+  RobotOutputs outputs(link, "W");
+  std::vector<sensors::SensorOutput> all(sensors::kSensorKinds.size());
+  sensors::FaceScan scan;
+  scan.n = 1;
+  scan.faces[4].tick = 3;  // the +Z face, scanned at tick 3
+  scan.faces[4].occupancy = {sensors::kOccupied};
+  scan.faces[4].points_W = {Eigen::Vector3d(1, 2, 3)};
+  all[std::size_t(sensors::SensorKind::kFace)] = scan;
+  sensors::HeightMap map;
+  map.n = 1;
+  map.height_m = {7.5};
+  all[std::size_t(sensors::SensorKind::kGround)] = map;
+  sensors::LidarScan sweep;
+  sweep.channels = 1, sweep.azimuth_steps = 2;
+  sweep.range_m = {4.0f, 5.0f};
+  sweep.hit = {1, 0};
+  sweep.points_W = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  sweep.time_s = {0.0, 0.05};
+  all[std::size_t(sensors::SensorKind::kLidar)] = sweep;
+  sensors::RangeReading reading;
+  reading.range_m = 12.0;
+  all[std::size_t(sensors::SensorKind::kRange)] = reading;
+  for (const sensors::SensorKindInfo& kind : sensors::kSensorKinds) {
+    outputs.Publish(all[std::size_t(kind.kind)],
+                    {std::string(kind.type) + "_sensor", std::string(kind.channel)}, 3,
+                    InputTag{9, 900}, 1000);
+  }
+  link.Drain();
+  EXPECT_EQ(outputs.published(), 4);
+  sandbox_msgs::scan_face_t f;
+  ASSERT_TRUE(Newest(face, &f));
+  EXPECT_EQ(f.face, 4);
+  EXPECT_EQ(f.tick, 3);
+  EXPECT_EQ(f.occupancy, std::vector<std::int8_t>{sensors::kOccupied});
+  sandbox_msgs::ground_map_t g;
+  ASSERT_TRUE(Newest(ground, &g));
+  EXPECT_EQ(g.height, std::vector<float>{7.5f});
+  sandbox_msgs::lidar_scan_t l;
+  ASSERT_TRUE(Newest(lidar, &l));
+  EXPECT_EQ(l.range_m, (std::vector<float>{4.0f, 5.0f}));
+  sandbox_msgs::range_t r;
+  ASSERT_TRUE(Newest(range, &r));
+  EXPECT_EQ(r.sensor, "ray_sensor");
+  EXPECT_EQ(r.range_m, 12.0);
+  for (const std::int64_t input_seq : {f.input_seq, g.input_seq, l.input_seq, r.input_seq}) {
+    EXPECT_EQ(input_seq, 9);
+  }
 }
 
 // The sample level's wing with extra [[robot.sensor]] tables appended.

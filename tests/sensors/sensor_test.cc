@@ -1,5 +1,5 @@
-// Sensors declared in level manifests: their configs, their mounts, and one
-// clear message per mistake.
+// The sensor family: sensors declared in level manifests, their configs and
+// mounts, one clear message per mistake, and every kind run through Sensor.
 
 #include "sensors/render/mounted_camera.h"
 #include "sensors/sensor.h"
@@ -8,6 +8,7 @@
 
 #include <cmath>
 
+#include "scene/collision_world.h"
 #include "tests/test_util.h"
 
 namespace sandbox::sensors {
@@ -19,7 +20,7 @@ std::filesystem::path Robots() {
   return std::filesystem::path(SANDBOX_SOURCE_DIR) / "assets/robots/robots.toml";
 }
 
-TEST(RobotSensorsTest, BundledLevelsDeclareTheirSensors) {
+TEST(SensorTest, BundledLevelsDeclareTheirSensors) {
   const scene::Level level = scene::LoadLevel(Robots());
   const std::vector<MountedSensor> sensors = MakeRobotSensors(level);
   ASSERT_EQ(sensors.size(), 2u);
@@ -39,7 +40,7 @@ TEST(RobotSensorsTest, BundledLevelsDeclareTheirSensors) {
   EXPECT_EQ(face.refresh, Refresh::kSixStage);
 }
 
-TEST(RobotSensorsTest, ASensorOnABoneMovesWithTheBone) {
+TEST(SensorTest, ASensorOnABoneMovesWithTheBone) {
   const scene::Level level = scene::LoadLevel(Robots());
   const std::vector<MountedSensor> sensors = MakeRobotSensors(level);
   const scene::RobotModel& wing = level.robots[static_cast<std::size_t>(level.FindRobot("ELAHA"))];
@@ -61,6 +62,114 @@ TEST(RobotSensorsTest, ASensorOnABoneMovesWithTheBone) {
   const Eigen::Isometry3d X_WS = sensors[0].Pose(state);
   EXPECT_LT((X_WS.translation() - X.translation()).norm(), 1e-4) << X_WS.translation().transpose();
   EXPECT_TRUE(X_WS.linear().isApprox(X.linear(), 1e-6));
+}
+
+// The sample terrain with the wing carrying one sensor of every kind.
+scene::Level EveryKindLevel(testing::TempDir& dir) {
+  const std::filesystem::path assets = std::filesystem::path(SANDBOX_SOURCE_DIR) / "assets";
+  return scene::LoadLevel(dir.Write(
+      "level.toml",
+      "[[actor]]\nname = \"terrain\"\nfile = \"" +
+          (assets / "sample/generated/terrain.gltf").string() +
+          "\"\n[[robot]]\nname = \"W\"\nfile = \"" +
+          (assets / "robots/generated/flying_wing.gltf").string() +
+          "\"\nbones = [\"root\"]\nposition = [10, -20, 40]\nrpy_deg = [0, 10, 30]\n"
+          "[[robot.sensor]]\nname = \"box\"\ntype = \"face\"\nrefresh = \"full\"\n"
+          "resolution_m = 2\nhalf_extent_m = 40\n"
+          "[[robot.sensor]]\nname = \"below\"\ntype = \"ground\"\nposition = [1, 0, 0]\n"
+          "[[robot.sensor]]\nname = \"spin\"\ntype = \"lidar\"\nchannels = 4\n"
+          "azimuth_steps = 64\nrpy_deg = [0, 20, 0]\n"
+          "[[robot.sensor]]\nname = \"alt\"\ntype = \"ray\"\nrange_m = 200\n"));
+}
+
+// Each kind made and run through the family gives its own output, equal to
+// what its class's own call computes from the same pose.
+TEST(SensorTest, EveryKindRunsThroughTheFamilyAsItsOwnClassWould) {
+  testing::TempDir dir;
+  const scene::Level level = EveryKindLevel(dir);
+  const std::vector<MountedSensor> mounted = MakeRobotSensors(level);
+  ASSERT_EQ(mounted.size(), 4u);
+  const scene::CollisionWorld world(level);
+  RayCaster caster(1);
+  scene::RobotState state(level.robots[0]);
+  RayFilter filter;
+  filter.ignore_robot = 0;
+  const SensorKind kinds[] = {SensorKind::kFace, SensorKind::kGround, SensorKind::kLidar,
+                              SensorKind::kRange};
+  const char* channels[] = {"SCAN_FACE", "GROUND", "LIDAR", "RANGE"};
+  int hits = 0;
+  for (std::size_t i = 0; i < mounted.size(); ++i) {
+    const MountedSensor& m = mounted[i];
+    EXPECT_EQ(m.kind, kinds[i]) << m.spec.name;
+    EXPECT_EQ(m.channel, channels[i]) << m.spec.name;
+    Sensor sensor(m);
+    EXPECT_EQ(sensor.output().index(), std::size_t(kinds[i])) << "made empty, of its kind";
+    const Eigen::Isometry3d X_WS = m.Pose(state);
+    const SensorContext at{world, caster, filter, X_WS, state.pose(), nullptr, 0.0, 0};
+    const SensorOutput& output = sensor.Run(at);
+    ASSERT_EQ(output.index(), std::size_t(kinds[i])) << m.spec.name;
+    if (const auto* scan = std::get_if<FaceScan>(&output)) {
+      const FaceScanner own(std::get<FaceScannerConfig>(m.config));
+      FaceScan expected = own.EmptyScan();
+      own.Scan(world, caster, filter, X_WS, 0, &expected);
+      for (std::size_t f = 0; f < 6; ++f) {
+        EXPECT_EQ(scan->faces[f].occupancy, expected.faces[f].occupancy) << f;
+        for (const std::int8_t o : scan->faces[f].occupancy) hits += o == kOccupied;
+      }
+    } else if (const auto* map = std::get_if<HeightMap>(&output)) {
+      HeightMap expected;
+      GroundScanner(std::get<GroundScannerConfig>(m.config))
+          .Scan(world, caster, filter, X_WS.translation(), &expected);
+      ASSERT_EQ(map->height_m.size(), expected.height_m.size());
+      for (std::size_t k = 0; k < expected.height_m.size(); ++k) {
+        EXPECT_TRUE(map->height_m[k] == expected.height_m[k] ||
+                    (std::isnan(map->height_m[k]) && std::isnan(expected.height_m[k])))
+            << k;
+        hits += !std::isnan(map->height_m[k]);
+      }
+    } else if (const auto* sweep = std::get_if<LidarScan>(&output)) {
+      LidarScan expected;  // no pose history: the sweep is cast from the pose now
+      Lidar(std::get<LidarConfig>(m.config)).Sweep(world, caster, filter, X_WS, X_WS, &expected);
+      EXPECT_EQ(sweep->range_m, expected.range_m);
+      for (const std::uint8_t h : sweep->hit) hits += h;
+    } else if (const auto* reading = std::get_if<RangeReading>(&output)) {
+      const RangeReading expected =
+          MeasureRange(std::get<RangeSensorConfig>(m.config), world, caster, filter, X_WS);
+      EXPECT_EQ(reading->range_m, expected.range_m);
+      EXPECT_TRUE(reading->hit);  // straight down from 40 m onto the terrain
+      hits += reading->hit;
+    }
+  }
+  EXPECT_GT(hits, 100);  // the outputs saw the terrain
+  // What `sandbox info` prints, from each config.
+  EXPECT_EQ(mounted[0].Describe(), "face 41x41x6 at 2 m on body");
+  EXPECT_EQ(mounted[1].Describe(), "ground +-25 m at 1 m on body");
+  EXPECT_EQ(mounted[2].Describe(), "lidar 4x64, 100 m on body");
+  EXPECT_EQ(mounted[3].Describe(), "ray 200 m on body");
+}
+
+// A lidar run with its robot's pose history starts its sweep from the pose
+// the robot had one rotation ago.
+TEST(SensorTest, ALidarSweepStartsWhereTheRobotWasOneRotationAgo) {
+  testing::TempDir dir;
+  const scene::Level level = EveryKindLevel(dir);
+  const std::vector<MountedSensor> mounted = MakeRobotSensors(level);
+  Sensor lidar(mounted[2]);
+  EXPECT_DOUBLE_EQ(lidar.history_s(), 0.2);  // two rotations at 10 Hz
+  EXPECT_EQ(Sensor(mounted[0]).history_s(), 0.0);
+  const scene::CollisionWorld world(level);
+  RayCaster caster(1);
+  scene::RobotState state(level.robots[0]);
+  PoseHistory history(lidar.history_s());
+  const Eigen::Isometry3d X_WR_then(Eigen::Translation3d(0.0, 0.0, 50.0));
+  history.Add(0.0, X_WR_then);
+  history.Add(0.1, state.pose());
+  const SensorContext at{world, caster, {}, mounted[2].Pose(state), state.pose(), &history, 0.1, 1};
+  const auto& scan = std::get<LidarScan>(lidar.Run(at));
+  // The mount on the robot as it was: the robot's offset from then, then the mount.
+  const Eigen::Isometry3d X_WS_start = X_WR_then * state.pose().inverse() * mounted[2].Pose(state);
+  EXPECT_TRUE(scan.X_WS_start.isApprox(X_WS_start, 1e-12));
+  EXPECT_TRUE(scan.X_WS_end.isApprox(mounted[2].Pose(state), 1e-12));
 }
 
 // The error an arm robot with one more [[robot.<kind>]] table (named "s" for
@@ -86,7 +195,7 @@ std::string ErrorOf(const std::string& kind, const std::string& table) {
 std::string Error(const std::string& sensor_table) { return ErrorOf("sensor", sensor_table); }
 std::string CameraError(const std::string& camera_table) { return ErrorOf("camera", camera_table); }
 
-TEST(RobotSensorsTest, MistakesNameTheSensorAndField) {
+TEST(SensorTest, MistakesNameTheSensorAndField) {
   EXPECT_EQ(Error("type = \"face\"\nmount = \"elbow\"\n"),
             "level.toml:6: sensor 's': mount 'elbow' is not a node of arm.gltf (nodes: base, "
             "link1, link2, link3, link4, link5, link6, tool)");
@@ -111,7 +220,7 @@ TEST(RobotSensorsTest, MistakesNameTheSensorAndField) {
             "level.toml:9: sensor 's': 'rate_hz' must be positive");
 }
 
-TEST(RobotSensorsTest, CameraMistakesNameTheCameraAndField) {
+TEST(SensorTest, CameraMistakesNameTheCameraAndField) {
   EXPECT_EQ(CameraError("type = \"payload\"\nmount = \"elbow\"\n"),
             "level.toml:6: camera 'c': mount 'elbow' is not a node of arm.gltf (nodes: base, "
             "link1, link2, link3, link4, link5, link6, tool)");
@@ -138,7 +247,7 @@ TEST(RobotSensorsTest, CameraMistakesNameTheCameraAndField) {
 namespace sandbox::sensors {
 namespace {
 
-TEST(RobotSensorsTest, SettingsThatMakeNoTraversalAreRefusedAtLoad) {
+TEST(SensorTest, SettingsThatMakeNoTraversalAreRefusedAtLoad) {
   EXPECT_EQ(Error("type = \"ray\"\nrange_m = 0\n"),
             "level.toml:6: sensor 's': range_m must be positive, got 0");
   EXPECT_EQ(Error("type = \"lidar\"\nrange_m = 0\n"),
