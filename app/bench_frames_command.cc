@@ -19,8 +19,8 @@
 #include "scene/level.h"
 #include "sensors/render/cameras.h"
 #include "sensors/render/debug_overlay.h"
-#include "sensors/render/renderer.h"
 #include "sensors/render/mounted_camera.h"
+#include "sensors/render/renderer.h"
 #include "sensors/sensor.h"
 
 namespace sandbox::app {

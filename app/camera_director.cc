@@ -62,7 +62,8 @@ int CameraDirector::Direct(const Shot& shot, FramePipeline* frames, bool write, 
       job.actor_poses.push_back(shot.world->actor_pose(int(a)));
     }
     job.robot_pose = state.pose();
-    if (run.camera->overlay != (shown && controls_.overlay)) AddOverlay(run, shot, &job);  // 'o' flips
+    if (run.camera->overlay != (shown && controls_.overlay))
+      AddOverlay(run, shot, &job);  // 'o' flips
     frames->Submit(std::move(job));
     ++submitted;
   }

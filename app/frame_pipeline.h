@@ -59,7 +59,7 @@ struct RenderJob {
   std::vector<scene::RobotState> robots;
   std::vector<Eigen::Isometry3d> actor_poses;
   Eigen::Isometry3d robot_pose{Eigen::Isometry3d::Identity()};  // for the index
-  render::Overlay overlay;                                     // empty: none
+  render::Overlay overlay;                                      // empty: none
   bool write{true};                                             // to the output folder
   bool show{false};  // to FramePipelineConfig::show (the live view)
 };

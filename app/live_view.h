@@ -38,7 +38,7 @@ std::optional<ViewKey> KeyFromCode(int code);
 
 // What the keys have set.
 struct ViewControls {
-  int camera{0};                   // index of the active camera
+  int camera{0};                  // index of the active camera
   render::TrailingCommand steer;  // added to the bridge's <ROBOT>/CAMERA command
   bool overlay{false};
   bool paused{false};

@@ -15,7 +15,8 @@ bool IsManifest(const std::string& file) {
 
 LoadedLevel LoadCheckedLevel(const std::string& file, const scene::AssetConversion& conversion,
                              Isolation isolation) {
-  if (isolation == Isolation::kAlways || (isolation == Isolation::kSceneFiles && !IsManifest(file))) {
+  if (isolation == Isolation::kAlways ||
+      (isolation == Isolation::kSceneFiles && !IsManifest(file))) {
     CheckLoadsInIsolation(file, conversion);
   }
   scene::LoadOptions options;

@@ -35,8 +35,8 @@ void ParseFrames(const std::string& text, FramePipelineConfig* config) {
 }  // namespace
 
 const std::set<std::string> kRunValueOptions = {
-    "--rate",   "--duration", "--lcm-url",     "--replay", "--record",  "--out",
-    "--frames", "--depth",    "--scans-every",  "--realtime"};
+    "--rate", "--duration", "--lcm-url", "--replay",      "--record",
+    "--out",  "--frames",   "--depth",   "--scans-every", "--realtime"};
 const std::set<std::string> kRunFlags = {"--lockstep", "--view", "--isolate"};
 
 RunOptions ParseRunOptions(const ParsedArgs& args) {

@@ -14,35 +14,45 @@ std::string PaceName(const RunOptions& options) {
   return out.str();
 }
 
+void PrintReplayProgress(const bridge::LogReader& replay, std::int64_t ticks, double wall_s,
+                         std::ostream& err) {
+  const double done = replay.fraction_read();
+  err << "\rreplay: " << std::setw(3) << int(100 * done) << "% | " << ticks << " ticks | "
+      << std::setprecision(0) << std::fixed << (wall_s > 0 ? double(ticks) / wall_s : 0.0)
+      << " ticks/s | " << (done > 0 ? wall_s * (1 - done) / done : 0.0) << " s left  "
+      << std::defaultfloat << std::setprecision(6) << std::flush;
+}
+
 bool ReportRun(const RunRecord& run, std::ostream& out, std::ostream& err) {
   const RunOptions& options = *run.options;
   bool output_lost = false;
   if (run.replay != nullptr) {
-    err << "\rreplay: " << (run.replay->stopped_early().empty() ? "100% | " : "") << run.ticks << " ticks"
-         << std::string(30, ' ') << "\n";
+    err << "\rreplay: " << (run.replay->stopped_early().empty() ? "100% | " : "") << run.ticks
+        << " ticks" << std::string(30, ' ') << "\n";
     if (!run.replay->stopped_early().empty()) {
-      err << "sandbox run: the log '" << options.replay_file << "' is " << run.replay->stopped_early()
-           << "; the " << run.replay->events() << " events before it were replayed\n";
+      err << "sandbox run: the log '" << options.replay_file << "' is "
+          << run.replay->stopped_early() << "; the " << run.replay->events()
+          << " events before it were replayed\n";
     } else if (run.ticks == 0) {
       err << "sandbox run: the log '" << options.replay_file << "' has " << run.replay->events()
-           << " events but no pose message for this level's robots\n";
+          << " events but no pose message for this level's robots\n";
     }
   }
   const StatsSummary summary = run.stats->Summary();
   out << "sandbox run: " << run.ticks << " ticks in " << std::fixed << std::setprecision(2)
-       << run.elapsed_s << " s (" << (run.elapsed_s > 0 ? double(run.ticks) / run.elapsed_s : 0.0)
-       << " Hz), mean tick " << std::setprecision(3) << summary.mean_ms << " ms, "
-       << summary.overruns << " overruns\n";
+      << run.elapsed_s << " s (" << (run.elapsed_s > 0 ? double(run.ticks) / run.elapsed_s : 0.0)
+      << " Hz), mean tick " << std::setprecision(3) << summary.mean_ms << " ms, "
+      << summary.overruns << " overruns\n";
   out << "  tick duration: p50 " << summary.p50_ms << " ms, p99 " << summary.p99_ms << " ms, max "
-       << summary.max_ms << " ms\n";
+      << summary.max_ms << " ms\n";
   const bool paced = !options.lockstep && !options.free_running();
   if (paced) {
     out << "  tick lateness: p50 " << summary.lateness_p50_ms << " ms, p99 "
-         << summary.lateness_p99_ms << " ms, max " << summary.lateness_max_ms << " ms\n";
+        << summary.lateness_p99_ms << " ms, max " << summary.lateness_max_ms << " ms\n";
   }
   if (run.origin_moves > 0) {
     out << "  floating origin: moved " << run.origin_moves << " times, longest "
-         << run.longest_origin_move_ms << " ms, now at (" << run.origin.transpose() << ")\n";
+        << run.longest_origin_move_ms << " ms, now at (" << run.origin.transpose() << ")\n";
   }
   if (!options.out_dir.empty()) {
     // Files that cannot be finished (a full disk) are reported; the run's results stand.
@@ -55,7 +65,8 @@ bool ReportRun(const RunRecord& run, std::ostream& out, std::ostream& err) {
         run.stats->PlotPoints()};
     series.frames_per_value = double(run.stats->ticks_per_point());
     try {
-      PlotFrameDurations({series}, run.level_name + ": " + std::to_string(run.ticks) + " ticks, " + mode,
+      PlotFrameDurations({series},
+                         run.level_name + ": " + std::to_string(run.ticks) + " ticks, " + mode,
                          paced ? 1e3 / options.rate_hz : 0.0, (dir / "ticks.png").string());
     } catch (const std::exception& error) {
       err << "sandbox run: warning: " << error.what() << "\n";
@@ -63,37 +74,38 @@ bool ReportRun(const RunRecord& run, std::ostream& out, std::ostream& err) {
     }
     if (!run.stats->Flush()) {
       err << "sandbox run: warning: " << (dir / "ticks.csv").string()
-           << " is incomplete (cannot write)\n";
+          << " is incomplete (cannot write)\n";
       output_lost = true;
     }
     out << "  statistics: " << (dir / "ticks.csv").string() << ", " << (dir / "ticks.png").string()
-         << "\n";
+        << "\n";
     if (options.scans_every_s > 0.0) {
       output_lost = output_lost || run.scan_files->failed() > 0;
       out << "  scans: " << run.scan_files->written() << " PLY files written, "
-           << run.scan_files->dropped() << " dropped, " << run.scan_files->failed() << " failed"
-           << (run.scan_files->failed() > 0 ? " (" + run.scan_files->error() + ")" : "") << " -> "
-           << (dir / "scans").string() << "\n";
+          << run.scan_files->dropped() << " dropped, " << run.scan_files->failed() << " failed"
+          << (run.scan_files->failed() > 0 ? " (" + run.scan_files->error() + ")" : "") << " -> "
+          << (dir / "scans").string() << "\n";
     }
   }
   if (run.live_view != nullptr) {
     out << "  live view: " << run.live_view->shown() << " frames shown, last camera "
-         << run.cameras->live_camera()
-         << (run.cameras->controls().overlay ? ", overlay toggled" : "")
-         << (run.cameras->controls().quit ? ", quit by key" : "") << "\n";
+        << run.cameras->live_camera()
+        << (run.cameras->controls().overlay ? ", overlay toggled" : "")
+        << (run.cameras->controls().quit ? ", quit by key" : "") << "\n";
   }
   if (!options.record_file.empty()) {
     output_lost = output_lost || !run.link->record_error().empty();
     out << "  recording: " << run.link->recorded() << " messages -> " << options.record_file
-         << (run.link->record_error().empty() ? "" : " (INCOMPLETE: " + run.link->record_error() + ")")
-         << "\n";
+        << (run.link->record_error().empty() ? ""
+                                             : " (INCOMPLETE: " + run.link->record_error() + ")")
+        << "\n";
   }
   if (run.frames != nullptr) {
     output_lost = output_lost || run.frames->failed() > 0;
     out << "  frames: " << run.frames->rendered() << " rendered, " << run.frames->written()
-         << " written, " << run.frames->dropped() << " dropped, " << run.frames->failed() << " failed"
-         << (run.frames->failed() > 0 ? " (" + run.frames->error() + ")" : "") << " -> "
-         << options.out_dir << "\n";
+        << " written, " << run.frames->dropped() << " dropped, " << run.frames->failed()
+        << " failed" << (run.frames->failed() > 0 ? " (" + run.frames->error() + ")" : "") << " -> "
+        << options.out_dir << "\n";
   }
   for (const bridge::RobotFeed* feed : run.feeds) {
     if (!feed->active_camera().empty()) {
@@ -102,8 +114,8 @@ bool ReportRun(const RunRecord& run, std::ostream& out, std::ostream& err) {
     }
     for (const bridge::ChannelStatus& channel : feed->Channels(bridge::NowUtime())) {
       out << "  " << channel.channel << ": " << channel.received << " received, "
-           << channel.superseded << " superseded, " << channel.rejected << " rejected"
-           << (channel.rejected > 0 ? " (last: " + channel.last_reject_reason + ")" : "") << "\n";
+          << channel.superseded << " superseded, " << channel.rejected << " rejected"
+          << (channel.rejected > 0 ? " (last: " + channel.last_reject_reason + ")" : "") << "\n";
     }
   }
   return !output_lost;

@@ -1,6 +1,7 @@
 #pragma once
-// The end of `sandbox run`: the summary it prints, the tick plot (ticks.png)
-// and the last of the statistics file, gathered from the parts that ran.
+// What `sandbox run` reports: a replay's progress while it runs; at the end,
+// the summary it prints, the tick plot (ticks.png) and the last of the
+// statistics file, gathered from the parts that ran.
 
 #include <Eigen/Geometry>
 #include <cstdint>
@@ -37,6 +38,10 @@ struct RunRecord {
   const FramePipeline* frames{nullptr};  // null unless frames were written
   std::vector<const bridge::RobotFeed*> feeds;
 };
+
+// A replay's progress bar, on one line of `err`: read, ticks, ticks/s, time left.
+void PrintReplayProgress(const bridge::LogReader& replay, std::int64_t ticks, double wall_s,
+                         std::ostream& err);
 
 // The name of the pace: "100 Hz", "free running" or "lock-step".
 std::string PaceName(const RunOptions& options);

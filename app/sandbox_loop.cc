@@ -79,14 +79,16 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
     sensor_schedules_.emplace_back(mounted.spec.rate_hz);
     RobotRun& robot = robots_[std::size_t(mounted.robot)];
     // Poses kept as far back as the robot's sensors look (and a tick more).
-    robot.history = sensors::PoseHistory(std::max(robot.history.keep_s(), sensors_.back().history_s()));
+    robot.history =
+        sensors::PoseHistory(std::max(robot.history.keep_s(), sensors_.back().history_s()));
     if (robot.face_sensor < 0 && mounted.kind == sensors::SensorKind::kFace) {
       robot.face_sensor = int(sensors_.size() - 1);
     }
   }
   // Cameras: rendered off the loop, into the output folder and/or the live view.
   if (options_.view) {
-    if (loaded_.cameras.empty()) throw CommandError("--view: the level declares no [[robot.camera]]");
+    if (loaded_.cameras.empty())
+      throw CommandError("--view: the level declares no [[robot.camera]]");
     live_view_ = std::make_unique<LiveView>("sandbox: " + level_.name);
   }
   write_frames_ = !options_.out_dir.empty() && !loaded_.cameras.empty() &&
@@ -189,8 +191,8 @@ void SandboxLoop::Tick(double wall_s, double drain_budget_s, TickRecord* record)
   if (hooks_.before_tick) hooks_.before_tick(link_, wall_s);
   std::int64_t now = bridge::NowUtime();
   const double t = ApplyInputs(wall_s, drain_budget_s, &now, record);  // 1-2
-  RunDueSensors(t, now);                                                 // 3, and 4: their outputs
-  PublishStates(now);                                                    // 4
+  RunDueSensors(t, now);                                               // 3, and 4: their outputs
+  PublishStates(now);                                                  // 4
   WriteDueScans(t);
   DirectCameras(t, record);    // 5
   PublishStatusIfDue(t, now);  // 4
@@ -234,11 +236,7 @@ bool SandboxLoop::NextLockstepInput(double wall_s, bool* wait) {
   if (!has_pose()) return false;  // the log has ended
   if (wall_s >= next_progress_s_) {
     next_progress_s_ = wall_s + 0.25;
-    const double done = log_->fraction_read();
-    err_ << "\rreplay: " << std::setw(3) << int(100 * done) << "% | " << tick_ << " ticks | "
-         << std::setprecision(0) << std::fixed << (wall_s > 0 ? double(tick_) / wall_s : 0.0)
-         << " ticks/s | " << (done > 0 ? wall_s * (1 - done) / done : 0.0) << " s left  "
-         << std::defaultfloat << std::setprecision(6) << std::flush;
+    PrintReplayProgress(*log_, tick_, wall_s, err_);
   }
   return true;
 }
@@ -274,8 +272,9 @@ void SandboxLoop::RunDueSensors(double t, std::int64_t now_utime) {
     RobotRun& robot = robots_[std::size_t(mounted.robot)];
     sensors::RayFilter filter;
     filter.ignore_robot = mounted.robot;
-    const sensors::SensorContext at{world_,           caster_, filter, mounted.Pose(*robot.state),
-                                    robot.state->pose(), &robot.history, t, tick_};
+    const sensors::SensorContext at{
+        world_,         caster_, filter, mounted.Pose(*robot.state), robot.state->pose(),
+        &robot.history, t,       tick_};
     robot.outputs->Publish(sensor.Run(at), {mounted.spec.name, mounted.channel}, tick_,
                            robot.feed->input(), now_utime);
   }

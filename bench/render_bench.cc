@@ -25,9 +25,9 @@
 #include "bench/bench_levels.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
+#include "sensors/face_scanner.h"
 #include "sensors/render/cameras.h"
 #include "sensors/render/debug_overlay.h"
-#include "sensors/face_scanner.h"
 #include "sensors/render/renderer.h"
 
 namespace {

@@ -70,8 +70,8 @@ void CheckOutputChannels(const scene::Level& level) {
       const std::string channel = sensors::OutputChannel(spec);
       const auto [it, fresh] = used.emplace(channel, &spec);
       const sensors::SensorKind kind = sensors::ParseSensorKind(spec);
-      if (!fresh && !(sensors::Info(kind).shares_channel &&
-                      kind == sensors::ParseSensorKind(*it->second))) {
+      if (!fresh &&
+          !(sensors::Info(kind).shares_channel && kind == sensors::ParseSensorKind(*it->second))) {
         throw scene::LevelError(spec.Where() + "publishes on " + channel + " like sensor '" +
                                 it->second->name + "'; give one of them its own 'channel'");
       }

@@ -4,10 +4,7 @@ namespace sandbox::bridge {
 
 RobotFeed::RobotFeed(LcmLink& link, const scene::Level& level, int robot,
                      const RobotBridgeConfig& config, bool lockstep, RejectLog* log)
-    : config_(config),
-      robot_(robot),
-      lockstep_(lockstep),
-      inputs_(link, level, robot, config) {
+    : config_(config), robot_(robot), lockstep_(lockstep), inputs_(link, level, robot, config) {
   inputs_.set_log(log);
   inputs_.set_lockstep(lockstep);
   if (config.net_fdm_port > 0) {

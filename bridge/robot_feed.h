@@ -32,9 +32,9 @@ class RobotFeed {
 
   // What one Apply() changed.
   struct Changes {
-    int messages{0};      // inputs applied (LCM messages and UDP packets)
-    bool moved{false};    // the pose or bones changed: the state and the world were updated
-    bool pose{false};     // an LCM pose message was applied
+    int messages{0};    // inputs applied (LCM messages and UDP packets)
+    bool moved{false};  // the pose or bones changed: the state and the world were updated
+    bool pose{false};   // an LCM pose message was applied
     std::int64_t pose_utime{-1};
   };
   // After LcmLink::Drain(): applies the newest good input of each kind (lock-step:

@@ -22,8 +22,6 @@ namespace sandbox::scene {
 ImportedAsset ImportAsset(const std::filesystem::path& file, const AssetConversion& conversion,
                           const LoadLimits& limits = {});
 
-
-
 // Applies an affine map to a mesh: positions, normals (inverse transpose), and
 // the triangle winding when the map mirrors.
 void TransformMesh(const Eigen::Affine3d& T, Mesh* mesh);

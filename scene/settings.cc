@@ -4,6 +4,15 @@
 
 namespace sandbox::scene {
 
+std::string ChoiceList(const std::vector<std::string_view>& choices) {
+  std::string list;
+  for (std::size_t i = 0; i < choices.size(); ++i) {
+    list += i == 0 ? "" : i + 1 == choices.size() ? " or " : ", ";
+    list += choices[i];
+  }
+  return list;
+}
+
 std::string SettingsTable::Where(const std::string& key) const {
   const auto at = lines.find(key);
   const int where = at == lines.end() ? line : at->second;

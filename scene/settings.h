@@ -7,6 +7,7 @@
 #include <map>
 #include <set>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -27,6 +28,9 @@ struct SettingsTable {
   // "level.toml:12: sensor 'scanner': ", at the key's line when it is known.
   std::string Where(const std::string& key = "") const;
 };
+
+// "a, b or c": the values a setting may take, for messages.
+std::string ChoiceList(const std::vector<std::string_view>& choices);
 
 // Typed access; remembers which keys were read so that the rest can be
 // rejected as unknown.

@@ -157,7 +157,8 @@ FaceScannerConfig FaceScannerConfig::Read(scene::SettingsReader& read) {
   } else if (refresh == "twelve_stage") {
     face.refresh = Refresh::kTwelveStage;
   } else {
-    read.Fail("refresh", "'refresh' must be full, six_stage or twelve_stage, got '" + refresh + "'");
+    read.Fail("refresh",
+              "'refresh' must be full, six_stage or twelve_stage, got '" + refresh + "'");
   }
   const std::string aligned = read.Text("aligned", "body");
   if (aligned != "body" && aligned != "world") {

@@ -15,7 +15,8 @@ void GroundScannerConfig::ValidateOrThrow() const {
   grid.half_extent_m = half_extent_m;
   grid.ValidateOrThrow();
   if (!(std::isfinite(depth_m) && depth_m > 0.0)) {
-    throw std::invalid_argument("depth_m must be positive, got " + (std::ostringstream() << depth_m).str());
+    throw std::invalid_argument("depth_m must be positive, got " +
+                                (std::ostringstream() << depth_m).str());
   }
 }
 

@@ -6,10 +6,9 @@
 // sensor, or NaN where there is none.
 
 #include <Eigen/Geometry>
-#include <vector>
-
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "scene/settings.h"
 #include "sensors/ray_caster.h"

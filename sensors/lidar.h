@@ -10,10 +10,9 @@
 
 #include <Eigen/Geometry>
 #include <cstdint>
-#include <vector>
-
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "scene/settings.h"
 #include "sensors/ray_caster.h"

@@ -11,7 +11,8 @@ void RangeSensorConfig::ValidateOrThrow() const {
     throw std::invalid_argument("direction must be a unit vector");
   }
   if (!(std::isfinite(range_m) && range_m > 0.0)) {
-    throw std::invalid_argument("range_m must be positive, got " + (std::ostringstream() << range_m).str());
+    throw std::invalid_argument("range_m must be positive, got " +
+                                (std::ostringstream() << range_m).str());
   }
 }
 

@@ -2,7 +2,6 @@
 // A single ray (rangefinder, altimeter) along a fixed axis of the sensor frame.
 
 #include <Eigen/Geometry>
-
 #include <string>
 #include <string_view>
 
@@ -24,7 +23,7 @@ struct RangeSensorConfig {
 };
 
 struct RangeReading {
-  Eigen::Vector3d origin_W{Eigen::Vector3d::Zero()};     // the ray, in the world frame
+  Eigen::Vector3d origin_W{Eigen::Vector3d::Zero()};      // the ray, in the world frame
   Eigen::Vector3d direction_W{Eigen::Vector3d::UnitZ()};  // unit
   bool hit{false};
   double range_m{0.0};  // to the hit, or range_m when nothing

@@ -4,6 +4,9 @@
 #include <stdexcept>
 #include <type_traits>
 #include <utility>
+#include <vector>
+
+#include "scene/settings.h"
 
 namespace sandbox::sensors {
 namespace {
@@ -59,14 +62,13 @@ struct HistoryOf<Class, std::void_t<decltype(std::declval<const Class&>().histor
 const SensorKindInfo& Info(SensorKind kind) { return kSensorKinds[std::size_t(kind)]; }
 
 SensorKind ParseSensorKind(const scene::SensorSpec& spec) {
-  std::string names;
-  for (std::size_t i = 0; i < kSensorKinds.size(); ++i) {
-    if (kSensorKinds[i].type == spec.type) return kSensorKinds[i].kind;
-    names += (i == 0 ? "" : i + 1 == kSensorKinds.size() ? " or " : ", ");
-    names += kSensorKinds[i].type;
+  std::vector<std::string_view> types;
+  for (const SensorKindInfo& info : kSensorKinds) {
+    if (info.type == spec.type) return info.kind;
+    types.push_back(info.type);
   }
-  throw scene::LevelError(spec.settings.Where("type") + "'type' must be " + names + ", got '" +
-                          spec.type + "'");
+  throw scene::LevelError(spec.settings.Where("type") + "'type' must be " +
+                          scene::ChoiceList(types) + ", got '" + spec.type + "'");
 }
 
 std::string OutputChannel(const scene::SensorSpec& spec) {
@@ -76,8 +78,8 @@ std::string OutputChannel(const scene::SensorSpec& spec) {
 
 std::string MountedSensor::Describe() const {
   std::ostringstream out;
-  out << spec.type << " " << std::visit([](const auto& c) { return c.Summary(); }, config)
-      << " on " << (spec.mount.empty() ? "body" : spec.mount);
+  out << spec.type << " " << std::visit([](const auto& c) { return c.Summary(); }, config) << " on "
+      << (spec.mount.empty() ? "body" : spec.mount);
   if (spec.rate_hz > 0.0) out << " at " << spec.rate_hz << " Hz";
   return out.str();
 }
@@ -108,8 +110,9 @@ std::vector<MountedSensor> MakeRobotSensors(const scene::Level& level) {
 
 Sensor::Sensor(const MountedSensor& mounted)
     : mounted_(&mounted), sensor_(MakeClass(mounted.config, kAlternatives)) {
-  std::visit([this](const auto& s) { output_.emplace<typename std::decay_t<decltype(s)>::Output>(); },
-             sensor_);
+  std::visit(
+      [this](const auto& s) { output_.emplace<typename std::decay_t<decltype(s)>::Output>(); },
+      sensor_);
 }
 
 const SensorOutput& Sensor::Run(const SensorContext& at) {
@@ -123,8 +126,8 @@ const SensorOutput& Sensor::Run(const SensorContext& at) {
 }
 
 double Sensor::history_s() const {
-  return std::visit(
-      [](const auto& s) { return HistoryOf<std::decay_t<decltype(s)>>::Of(s); }, sensor_);
+  return std::visit([](const auto& s) { return HistoryOf<std::decay_t<decltype(s)>>::Of(s); },
+                    sensor_);
 }
 
 }  // namespace sandbox::sensors

@@ -15,11 +15,11 @@ namespace sandbox::sensors {
 struct SensorContext {
   const scene::CollisionWorld& world;
   RayCaster& caster;
-  RayFilter filter;             // its own robot ignored
-  Eigen::Isometry3d X_WS;       // the sensor now
-  Eigen::Isometry3d X_WR;       // its robot now
-  const PoseHistory* history;   // its robot's recent poses; null: none kept
-  double t_s{0.0};              // loop time
+  RayFilter filter;            // its own robot ignored
+  Eigen::Isometry3d X_WS;      // the sensor now
+  Eigen::Isometry3d X_WR;      // its robot now
+  const PoseHistory* history;  // its robot's recent poses; null: none kept
+  double t_s{0.0};             // loop time
   std::int64_t tick{0};
 };
 

@@ -12,10 +12,10 @@ namespace sandbox::render {
 Eigen::Isometry3d LookAt(const Eigen::Vector3d& p_W, const Eigen::Vector3d& target_W);
 
 struct ChaseConfig {
-  double arm_length_m{30.0};     // behind the robot
-  double arm_height_m{8.0};      // above it
-  double position_lag_s{0.3};    // time constant of the arm's end following the robot
-  double rotation_lag_s{0.6};    // time constant of the arm turning with the robot's heading
+  double arm_length_m{30.0};   // behind the robot
+  double arm_height_m{8.0};    // above it
+  double position_lag_s{0.3};  // time constant of the arm's end following the robot
+  double rotation_lag_s{0.6};  // time constant of the arm turning with the robot's heading
 };
 
 // A spring arm: its end follows the point behind and above the robot with a

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <utility>
+#include <vector>
 
 #include "scene/settings.h"
 
@@ -18,14 +19,13 @@ constexpr std::array<std::pair<CameraKind, std::string_view>, 4> kCameraTypes{{
 }};
 
 CameraKind ParseCameraKind(const scene::SensorSpec& spec) {
-  std::string names;
-  for (std::size_t i = 0; i < kCameraTypes.size(); ++i) {
-    if (kCameraTypes[i].second == spec.type) return kCameraTypes[i].first;
-    names += (i == 0 ? "" : i + 1 == kCameraTypes.size() ? " or " : ", ");
-    names += kCameraTypes[i].second;
+  std::vector<std::string_view> types;
+  for (const auto& [kind, type] : kCameraTypes) {
+    if (type == spec.type) return kind;
+    types.push_back(type);
   }
-  throw scene::LevelError(spec.settings.Where("type") + "'type' must be " + names + ", got '" +
-                          spec.type + "'");
+  throw scene::LevelError(spec.settings.Where("type") + "'type' must be " +
+                          scene::ChoiceList(types) + ", got '" + spec.type + "'");
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 // writes its frames at its own rate, each listed in its index, with depth
 // where the manifest asks for it; bad options fail with a clear message.
 
+#include "app/run_command.h"
+
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
@@ -15,7 +17,6 @@
 #include <sstream>
 #include <thread>
 
-#include "app/run_command.h"
 #include "app/run_hooks.h"
 #include "assets/generators/sample_terrain.h"
 #include "scene/level.h"

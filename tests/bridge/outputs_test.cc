@@ -11,8 +11,8 @@
 #include "sandbox_msgs/ground_map_t.hpp"
 #include "sandbox_msgs/lidar_scan_t.hpp"
 #include "sandbox_msgs/range_t.hpp"
-#include "sandbox_msgs/scan_face_t.hpp"
 #include "sandbox_msgs/robot_state_t.hpp"
+#include "sandbox_msgs/scan_face_t.hpp"
 #include "scene/collision_world.h"
 #include "scene/level.h"
 #include "sensors/face_scanner.h"
@@ -170,7 +170,8 @@ TEST(RobotOutputsTest, EachChannelCountsItsOwnMessages) {
   for (int i = 0; i < 3; ++i) {
     outputs.Publish(reading, {"a", "RANGE"}, i, InputTag{i, i}, 1000 + i);
     outputs.PublishState(wing, InputTag{i, i}, 1000 + i);
-    outputs.Publish(reading, {"b", "RANGE"}, i, InputTag{i, i}, 1000 + i);  // a second sensor, same channel
+    outputs.Publish(reading, {"b", "RANGE"}, i, InputTag{i, i},
+                    1000 + i);  // a second sensor, same channel
     link.Drain();
     sandbox_msgs::range_t r;
     const std::vector<std::uint8_t>* bytes = range.TakeNewest();

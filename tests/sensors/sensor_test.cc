@@ -1,7 +1,6 @@
 // The sensor family: sensors declared in level manifests, their configs and
 // mounts, one clear message per mistake, and every kind run through Sensor.
 
-#include "sensors/render/mounted_camera.h"
 #include "sensors/sensor.h"
 
 #include <gtest/gtest.h>
@@ -9,6 +8,7 @@
 #include <cmath>
 
 #include "scene/collision_world.h"
+#include "sensors/render/mounted_camera.h"
 #include "tests/test_util.h"
 
 namespace sandbox::sensors {
@@ -67,19 +67,19 @@ TEST(SensorTest, ASensorOnABoneMovesWithTheBone) {
 // The sample terrain with the wing carrying one sensor of every kind.
 scene::Level EveryKindLevel(testing::TempDir& dir) {
   const std::filesystem::path assets = std::filesystem::path(SANDBOX_SOURCE_DIR) / "assets";
-  return scene::LoadLevel(dir.Write(
-      "level.toml",
-      "[[actor]]\nname = \"terrain\"\nfile = \"" +
-          (assets / "sample/generated/terrain.gltf").string() +
-          "\"\n[[robot]]\nname = \"W\"\nfile = \"" +
-          (assets / "robots/generated/flying_wing.gltf").string() +
-          "\"\nbones = [\"root\"]\nposition = [10, -20, 40]\nrpy_deg = [0, 10, 30]\n"
-          "[[robot.sensor]]\nname = \"box\"\ntype = \"face\"\nrefresh = \"full\"\n"
-          "resolution_m = 2\nhalf_extent_m = 40\n"
-          "[[robot.sensor]]\nname = \"below\"\ntype = \"ground\"\nposition = [1, 0, 0]\n"
-          "[[robot.sensor]]\nname = \"spin\"\ntype = \"lidar\"\nchannels = 4\n"
-          "azimuth_steps = 64\nrpy_deg = [0, 20, 0]\n"
-          "[[robot.sensor]]\nname = \"alt\"\ntype = \"ray\"\nrange_m = 200\n"));
+  return scene::LoadLevel(
+      dir.Write("level.toml",
+                "[[actor]]\nname = \"terrain\"\nfile = \"" +
+                    (assets / "sample/generated/terrain.gltf").string() +
+                    "\"\n[[robot]]\nname = \"W\"\nfile = \"" +
+                    (assets / "robots/generated/flying_wing.gltf").string() +
+                    "\"\nbones = [\"root\"]\nposition = [10, -20, 40]\nrpy_deg = [0, 10, 30]\n"
+                    "[[robot.sensor]]\nname = \"box\"\ntype = \"face\"\nrefresh = \"full\"\n"
+                    "resolution_m = 2\nhalf_extent_m = 40\n"
+                    "[[robot.sensor]]\nname = \"below\"\ntype = \"ground\"\nposition = [1, 0, 0]\n"
+                    "[[robot.sensor]]\nname = \"spin\"\ntype = \"lidar\"\nchannels = 4\n"
+                    "azimuth_steps = 64\nrpy_deg = [0, 20, 0]\n"
+                    "[[robot.sensor]]\nname = \"alt\"\ntype = \"ray\"\nrange_m = 200\n"));
 }
 
 // Each kind made and run through the family gives its own output, equal to

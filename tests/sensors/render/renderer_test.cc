@@ -14,10 +14,10 @@
 #include "app/images.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
-#include "sensors/render/cameras.h"
-#include "sensors/render/debug_overlay.h"
 #include "sensors/face_scanner.h"
 #include "sensors/ray_caster.h"
+#include "sensors/render/cameras.h"
+#include "sensors/render/debug_overlay.h"
 #include "tests/test_util.h"
 
 namespace sandbox::render {
