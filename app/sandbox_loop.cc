@@ -309,27 +309,25 @@ void SandboxLoop::WriteDueScans(double t) {
 }
 
 void SandboxLoop::DirectCameras(double t, TickRecord* record) {
-  CameraDirector::Shot shot;
-  shot.t_s = t;
-  shot.tick = tick_;
-  for (const RobotRun& robot : robots_) {
-    shot.robots.push_back(robot.state.get());
-    shot.feeds.push_back(robot.feed.get());
+  if (shot_.robots.empty()) {  // what the cameras look at, gathered once
+    for (const RobotRun& robot : robots_) {
+      shot_.robots.push_back(robot.state.get());
+      shot_.feeds.push_back(robot.feed.get());
+    }
+    shot_.world = &world_;
+    shot_.sensors = &sensors_;
   }
-  shot.world = &world_;
-  shot.sensors = &sensors_;
-  record->frames += cameras_.Direct(shot, frames_.get(), write_frames_, live_view_ != nullptr);
+  shot_.t_s = t;
+  shot_.tick = tick_;
+  record->frames += cameras_.Direct(shot_, frames_.get(), write_frames_, live_view_ != nullptr);
 }
 
 void SandboxLoop::PublishStatusIfDue(double t, std::int64_t now_utime) {
   // Once a second, and at once when an input turns stale or fresh.
-  std::vector<bool> stale;
-  for (const RobotRun& robot : robots_) {
-    const std::vector<bool> robot_stale = robot.feed->Stale(now_utime);
-    stale.insert(stale.end(), robot_stale.begin(), robot_stale.end());
-  }
-  const bool changed = stale != stale_;
-  stale_ = std::move(stale);
+  stale_now_.clear();
+  for (const RobotRun& robot : robots_) robot.feed->AppendStale(now_utime, &stale_now_);
+  const bool changed = stale_now_ != stale_;
+  stale_.swap(stale_now_);
   if (t < next_status_s_ && !changed) return;
   next_status_s_ = t + 1.0;
   const double rate_now = t > 0.0 ? double(tick_) / t : 0.0;

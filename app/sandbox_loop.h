@@ -125,7 +125,8 @@ class SandboxLoop {
   std::unique_ptr<FramePipeline> frames_;
 
   std::int64_t tick_{0};
-  std::vector<bool> stale_;  // per robot and input, as last published
+  std::vector<bool> stale_, stale_now_;  // per robot and input: as last published, now
+  CameraDirector::Shot shot_;
   bool recording_failure_reported_{false};
   std::int64_t first_input_utime_{-1};
   double next_status_s_{0.0}, next_progress_s_{0.0};

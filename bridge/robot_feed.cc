@@ -68,12 +68,10 @@ std::vector<ChannelStatus> RobotFeed::Channels(std::int64_t now_utime) const {
   return channels;
 }
 
-std::vector<bool> RobotFeed::Stale(std::int64_t now_utime) const {
-  std::vector<bool> stale;
+void RobotFeed::AppendStale(std::int64_t now_utime, std::vector<bool>* stale) const {
   for (const LatestInput* in : {&inputs_.pose(), &inputs_.bones(), &inputs_.actors()}) {
-    stale.push_back(in->Stale(now_utime, config_.stale_after_s));
+    stale->push_back(in->Stale(now_utime, config_.stale_after_s));
   }
-  return stale;
 }
 
 }  // namespace sandbox::bridge

@@ -52,8 +52,8 @@ class RobotFeed {
   const std::string& active_camera() const { return inputs_.active_camera(); }
   // Every input's counters: the LCM channels, then the UDP sockets.
   std::vector<ChannelStatus> Channels(std::int64_t now_utime) const;
-  // Whether pose, bones and actors (in that order) are stale at `now_utime`.
-  std::vector<bool> Stale(std::int64_t now_utime) const;
+  // Appends whether pose, bones and actors (in that order) are stale at `now_utime`.
+  void AppendStale(std::int64_t now_utime, std::vector<bool>* stale) const;
   const RobotBridgeConfig& config() const { return config_; }
 
  private:
