@@ -44,11 +44,11 @@ class RobotOutputs {
   RobotOutputs(LcmLink& link, std::string channel_prefix,
                const Translation& state_translation = {});
 
-  // Where and when an output goes: on <prefix>/<channel>, from sensor
-  // `sensor` (range readings carry it), at loop tick `tick`.
+  // Where an output goes: on <prefix>/<channel>, from sensor `sensor` (range
+  // readings carry it). References: nothing is copied per tick.
   struct Address {
-    std::string sensor;
-    std::string channel;  // sensors::MountedSensor::channel
+    const std::string& sensor;
+    const std::string& channel;  // sensors::MountedSensor::channel
   };
   // Any sensor's output, each kind by its publish function in outputs.cc
   // (a face scan: the faces scanned at `tick`, one message each).
