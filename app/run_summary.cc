@@ -107,15 +107,23 @@ bool ReportRun(const RunRecord& run, std::ostream& out, std::ostream& err) {
         << " failed" << (run.frames->failed() > 0 ? " (" + run.frames->error() + ")" : "") << " -> "
         << options.out_dir << "\n";
   }
-  for (const bridge::RobotFeed* feed : run.feeds) {
-    if (!feed->active_camera().empty()) {
-      out << "  " << feed->config().channel_prefix << " active camera: " << feed->active_camera()
-          << "\n";
-    }
+  for (std::size_t r = 0; r < run.feeds.size(); ++r) {
+    const bridge::RobotFeed* feed = run.feeds[r];
+    out << "  robot " << feed->config().channel_prefix << ": " << run.published[r]
+        << " messages published, last input seq " << feed->input().seq
+        << (feed->active_camera().empty() ? "" : ", active camera " + feed->active_camera())
+        << "\n";
     for (const bridge::ChannelStatus& channel : feed->Channels(bridge::NowUtime())) {
-      out << "  " << channel.channel << ": " << channel.received << " received, "
+      out << "    " << channel.channel << ": " << channel.received << " received, "
           << channel.superseded << " superseded, " << channel.rejected << " rejected"
           << (channel.rejected > 0 ? " (last: " + channel.last_reject_reason + ")" : "") << "\n";
+    }
+  }
+  if (run.unknown_robots != nullptr && run.unknown_robots->total() > 0) {
+    out << "  poses for robots this level does not have, not applied: "
+        << run.unknown_robots->total() << "\n";
+    for (const auto& [channel, poses] : run.unknown_robots->poses()) {
+      out << "    " << bridge::Printable(channel, 64) << ": " << poses << "\n";
     }
   }
   return !output_lost;

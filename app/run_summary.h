@@ -17,6 +17,7 @@
 #include "app/tick_stats.h"
 #include "bridge/lcm_link.h"
 #include "bridge/robot_feed.h"
+#include "bridge/unknown_robots.h"
 
 namespace sandbox::app {
 
@@ -37,6 +38,8 @@ struct RunRecord {
   const bridge::LcmLink* link{nullptr};
   const FramePipeline* frames{nullptr};  // null unless frames were written
   std::vector<const bridge::RobotFeed*> feeds;
+  std::vector<std::int64_t> published;  // messages each robot published, as feeds
+  const bridge::UnknownRobots* unknown_robots{nullptr};
 };
 
 // A replay's progress bar, on one line of `err`: read, ticks, ticks/s, time left.

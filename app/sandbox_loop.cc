@@ -74,6 +74,11 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
         link_, config.channel_prefix,
         config.state_in_pose_convention ? config.pose : bridge::Translation{});
   }
+  std::vector<std::string> prefixes;
+  for (const bridge::RobotBridgeConfig& config : loaded_.bridges) {
+    prefixes.push_back(config.channel_prefix);
+  }
+  unknown_robots_ = std::make_unique<bridge::UnknownRobots>(link_, prefixes, &reject_log_);
   for (const sensors::MountedSensor& mounted : loaded_.sensors) {
     sensors_.emplace_back(mounted);
     sensor_schedules_.emplace_back(mounted.spec.rate_hz);
@@ -371,7 +376,11 @@ bool SandboxLoop::Report(double elapsed_s) {
   run.cameras = &cameras_;
   run.link = &link_;
   run.frames = write_frames_ ? frames_.get() : nullptr;
-  for (const RobotRun& robot : robots_) run.feeds.push_back(robot.feed.get());
+  for (const RobotRun& robot : robots_) {
+    run.feeds.push_back(robot.feed.get());
+    run.published.push_back(robot.outputs->published());
+  }
+  run.unknown_robots = unknown_robots_.get();
   return ReportRun(run, out_, err_);
 }
 

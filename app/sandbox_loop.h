@@ -36,6 +36,7 @@
 #include "bridge/outputs.h"
 #include "bridge/reject_log.h"
 #include "bridge/robot_feed.h"
+#include "bridge/unknown_robots.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
 #include "scene/robot_state.h"
@@ -115,6 +116,7 @@ class SandboxLoop {
   sensors::RayCaster caster_;
   bridge::RejectLog reject_log_;
   std::vector<RobotRun> robots_;
+  std::unique_ptr<bridge::UnknownRobots> unknown_robots_;  // poses for robots not here
   std::vector<sensors::Sensor> sensors_;
   std::vector<RateSchedule> sensor_schedules_;  // one per sensor
   CameraDirector cameras_;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -388,13 +389,16 @@ std::vector<Spec> ParseTables(const fs::path& file, TableReader& top, const std:
   if (array == nullptr || !array->is_array_of_tables()) {
     top.Fail(node, "'" + key + "' must be an array of tables: [[" + key + "]]");
   }
-  std::set<std::string> names;
+  std::map<std::string, int> first_lines;  // name -> line of its table
   int index = 0;
   for (const toml::node& item : *array) {
     const toml::table& table = *item.as_table();  // is_array_of_tables() holds
     Spec spec = parse(file, table, ++index);
-    if (!names.insert(spec.name).second) {
-      TableReader(file, table, "").Fail(nullptr, "duplicate " + key + " name '" + spec.name + "'");
+    const auto [first, fresh] = first_lines.emplace(spec.name, int(table.source().begin.line));
+    if (!fresh) {
+      TableReader(file, table, "")
+          .Fail(nullptr, "duplicate " + key + " name '" + spec.name + "': the [[" + key +
+                             "]] on line " + std::to_string(first->second) + " has it too");
     }
     specs.push_back(std::move(spec));
   }

@@ -17,9 +17,11 @@ namespace sandbox::testing {
 // `poses` ELAHA/POSE messages `period_us` apart from t = 1 s, circling
 // `radius_m` around the origin 60 m up (0: hovering over it, turning slowly),
 // level, nose along the circle: pose i at angle a = 0.01 i, heading a + 90 deg.
+// `mode` "a" appends to the log; `channel` is where the poses go.
 inline void WriteFlightLog(const std::string& path, int poses, std::int64_t period_us = 20'000,
-                           double radius_m = 100.0) {
-  lcm::LogFile log(path, "w");
+                           double radius_m = 100.0, const char* mode = "w",
+                           const std::string& channel = "ELAHA/POSE") {
+  lcm::LogFile log(path, mode);
   ASSERT_TRUE(log.good()) << path;
   for (int i = 0; i < poses; ++i) {
     sandbox_msgs::robot_pose_t pose{};
@@ -36,7 +38,7 @@ inline void WriteFlightLog(const std::string& path, int poses, std::int64_t peri
     lcm::LogEvent event;
     event.eventnum = i;
     event.timestamp = pose.utime;
-    event.channel = "ELAHA/POSE";
+    event.channel = channel;
     event.datalen = int32_t(bytes.size());
     event.data = bytes.data();
     ASSERT_EQ(log.writeEvent(&event), 0);

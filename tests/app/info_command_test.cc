@@ -86,6 +86,9 @@ TEST(InfoCommandTest, WhatRunRefusesInfoRefusesWithTheSameMessage) {
     return "[[robot]]\nname = \"" + name + "\"\nfile = \"" + robots + "\"\n" + extra;
   };
   const std::vector<std::pair<std::string, std::string>> cases = {
+      // Two robots of one name.
+      {level("names.toml", robot("A", "") + robot("A", "")),
+       ":4: duplicate robot name 'A': the [[robot]] on line 1 has it too"},
       // Two robots on one channel prefix.
       {level("prefix.toml",
              robot("A", "") + robot("B", "[robot.bridge]\nchannel_prefix = \"A\"\n")),

@@ -60,6 +60,28 @@ TEST(ReplayTest, TwoReplaysGiveOneTickPerPoseAndIdenticalFrameIndexesAndScans) {
   EXPECT_EQ(scans, 5);  // at 0, 0.5, 1.0, 1.5 and 2.0 s of input time
 }
 
+TEST(ReplayTest, PosesForRobotsTheLevelDoesNotHaveAreCountedAndReportedNotApplied) {
+  sandbox::testing::TempDir dir;
+  const std::string log = (dir.path() / "flight.lcmlog").string();
+  WriteFlightLog(log, 50);
+  WriteFlightLog(log, 30, 20'000, 10.0, "a", "GHOST/POSE");  // a robot the sample level lacks
+  const auto run = RunSandbox("run --replay " + log);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("sandbox run: 50 ticks"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("    ELAHA/POSE: 50 received, 0 superseded, 0 rejected"),
+            std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("poses for robots this level does not have, not applied: 30\n"
+                         "    GHOST/POSE: 30\n"),
+            std::string::npos)
+      << run.out;
+  // Logged as it happens, naming the channel and the robots there are.
+  EXPECT_NE(run.out.find("GHOST/POSE: rejected (a pose for a robot this level does not have; "
+                         "its robots are ELAHA)"),
+            std::string::npos)
+      << run.out;
+}
+
 TEST(ReplayTest, TruncatedLogIsReplayedUpToTheBreakAndNotALogIsRefused) {
   sandbox::testing::TempDir dir;
   const std::string log = (dir.path() / "flight.lcmlog").string();

@@ -16,8 +16,8 @@ run_log=$(mktemp /tmp/sandbox-flood-run-XXXXXX.log)
 record=$(mktemp /tmp/sandbox-flood-XXXXXX.lcmlog)
 trap 'rm -f "$run_log" "$record"' EXIT
 status=0
-# The count on one channel of the summary: "  ELAHA/POSE: 1 received, 2 superseded, 3 rejected".
-count() { sed -n "s|^  ELAHA/$1: \([0-9]*\) received, \([0-9]*\) superseded, \([0-9]*\) rejected.*|\\$2|p" "$run_log"; }
+# The count on one channel of the summary: "    ELAHA/POSE: 1 received, 2 superseded, 3 rejected".
+count() { sed -n "s|^ *ELAHA/$1: \([0-9]*\) received, \([0-9]*\) superseded, \([0-9]*\) rejected.*|\\$2|p" "$run_log"; }
 
 # 1. Paced at 100 Hz.
 start_sandbox "$run_log" "$sandbox" run "$level"

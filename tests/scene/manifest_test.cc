@@ -151,7 +151,7 @@ TEST_F(ManifestTest, MissingAndConflictingKeys) {
             std::string::npos);
   EXPECT_NE(Error("[[actor]]\nname = \"a\"\nfile = \"box.obj\"\n[[actor]]\nname = \"a\"\n"
                   "file = \"box.obj\"\n")
-                .find(":4: duplicate actor name 'a'"),
+                .find(":4: duplicate actor name 'a': the [[actor]] on line 1 has it too"),
             std::string::npos);
   EXPECT_NE(Error("[[actor]]\nname = \"a\"\nfile = \"box.obj\"\nrpy_deg = [0, 0, 0]\n"
                   "quaternion_wxyz = [1, 0, 0, 0]\n")

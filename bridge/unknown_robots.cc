@@ -1,0 +1,46 @@
+#include "bridge/unknown_robots.h"
+
+#include <stdexcept>
+
+#include "bridge/lcm_link_impl.h"
+
+namespace sandbox::bridge {
+namespace {
+
+void Deliver(const lcm::ReceiveBuffer*, const std::string& channel, UnknownRobots* watcher) {
+  watcher->OnPose(channel);
+}
+
+}  // namespace
+
+UnknownRobots::UnknownRobots(LcmLink& link, const std::vector<std::string>& prefixes,
+                             RejectLog* log)
+    : link_(link), log_(log) {
+  for (const std::string& prefix : prefixes) {
+    known_.insert(prefix + "/POSE");
+    robots_ += (robots_.empty() ? "" : ", ") + prefix;
+  }
+  // LCM matches the whole channel name against the expression.
+  lcm::Subscription* subscription = link_.impl().lcm.subscribeFunction(".*/POSE", &Deliver, this);
+  if (subscription == nullptr) throw std::runtime_error("UnknownRobots: cannot subscribe");
+  subscription->setQueueCapacity(LatestInput::kQueueCapacity);
+  subscription_ = subscription;
+}
+
+UnknownRobots::~UnknownRobots() {
+  link_.impl().lcm.unsubscribe(static_cast<lcm::Subscription*>(subscription_));
+}
+
+void UnknownRobots::OnPose(const std::string& channel) {
+  if (known_.count(channel)) return;
+  ++total_;
+  const bool counted_apart = poses_.count(channel) || poses_.size() < kMaxChannels;
+  const std::string key = counted_apart ? channel : "(other channels)";
+  ++poses_[key];
+  if (log_ != nullptr) {
+    log_->Note(Printable(key, 64),
+               "a pose for a robot this level does not have; its robots are " + robots_);
+  }
+}
+
+}  // namespace sandbox::bridge
