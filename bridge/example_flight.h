@@ -3,7 +3,8 @@
 // around the sample level's centre, 60 m up, banked, bending both wings and
 // working the elevators. examples/fly_wing publishes it over LCM as an
 // external model would; `sandbox demo` publishes it in-process when it
-// cannot make a private network namespace.
+// cannot make a private network namespace. Its two wingmen are quadrotors
+// (assets/formation): `fly_wing --slot left|right`.
 
 #include <cstdint>
 
@@ -16,5 +17,13 @@ namespace sandbox::bridge {
 // `seq` and `utime`.
 void ExampleFlight(double t, std::int64_t seq, std::int64_t utime, sandbox_msgs::robot_pose_t* pose,
                    sandbox_msgs::bone_values_t* bones);
+
+// A quadrotor wingman (bones: body, rotor1-rotor4, one angle about z each) at
+// t seconds: 1.2 s (18 m) behind the wing on its circle, 12 m inside (side
+// -1, left) or outside (side +1, right) of it and 4 m lower, nose on the
+// circle's tangent and pitched 6 degrees down, rotors spinning at 3 turns a
+// second (1 and 3 one way, 2 and 4 the other).
+void WingmanFlight(int side, double t, std::int64_t seq, std::int64_t utime,
+                   sandbox_msgs::robot_pose_t* pose, sandbox_msgs::bone_values_t* bones);
 
 }  // namespace sandbox::bridge

@@ -1,10 +1,14 @@
 // An external model in miniature: flies the bundled flying wing (ELAHA) in a
 // circle 60 m above the sample level, bending both wings and working the
 // elevators, and publishes its pose and bones over LCM as a Simulink model or
-// a C++ solver would.
+// a C++ solver would. With --slot left or right it flies one of the wing's
+// two quadrotor wingmen instead (assets/formation: QUAD1, QUAD2), one
+// process per robot as separate models would be.
 //
-//   fly_wing [--rate HZ] [--duration S] [--poses N] [--lcm-url URL] [--robot NAME]
+//   fly_wing [--slot wing|left|right] [--rate HZ] [--duration S] [--poses N]
+//            [--lcm-url URL] [--robot NAME]
 //
+// --robot: the channel prefix (default ELAHA, QUAD1 for left, QUAD2 for right).
 // It stops after --duration seconds or after --poses poses, whichever comes first.
 
 #include <chrono>
@@ -21,7 +25,7 @@
 int main(int argc, char** argv) {
   double rate_hz = 100.0, duration_s = 10.0;
   long long poses = -1;
-  std::string url, robot = "ELAHA";
+  std::string url, robot, slot = "wing";
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--rate"))
       rate_hz = std::atof(argv[i + 1]);
@@ -33,13 +37,21 @@ int main(int argc, char** argv) {
       url = argv[i + 1];
     else if (!std::strcmp(argv[i], "--robot"))
       robot = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--slot"))
+      slot = argv[i + 1];
     else {
-      std::fprintf(stderr,
-                   "usage: fly_wing [--rate HZ] [--duration S] [--poses N] [--lcm-url URL] "
-                   "[--robot NAME]\n");
-      return 2;
+      argc = -1;
+      break;
     }
   }
+  const int side = slot == "left" ? -1 : slot == "right" ? 1 : 0;
+  if (argc < 0 || argc % 2 == 0 || (side == 0 && slot != "wing") || !(rate_hz > 0.0)) {
+    std::fprintf(stderr,
+                 "usage: fly_wing [--slot wing|left|right] [--rate HZ] [--duration S] [--poses N]\n"
+                 "                [--lcm-url URL] [--robot NAME]\n");
+    return 2;
+  }
+  if (robot.empty()) robot = side < 0 ? "QUAD1" : side > 0 ? "QUAD2" : "ELAHA";
   lcm::LCM lcm(url);
   if (!lcm.good()) {
     std::fprintf(stderr, "fly_wing: cannot open LCM URL '%s'\n", url.c_str());
@@ -58,7 +70,11 @@ int main(int argc, char** argv) {
                                    .count();
     sandbox_msgs::robot_pose_t pose;
     sandbox_msgs::bone_values_t bones;
-    sandbox::bridge::ExampleFlight(t, seq, utime, &pose, &bones);  // the flight itself
+    if (side == 0) {  // the flight itself
+      sandbox::bridge::ExampleFlight(t, seq, utime, &pose, &bones);
+    } else {
+      sandbox::bridge::WingmanFlight(side, t, seq, utime, &pose, &bones);
+    }
     std::vector<std::uint8_t> bytes(std::size_t(pose.getEncodedSize()));
     pose.encode(bytes.data(), 0, int(bytes.size()));
     lcm.publish(robot + "/POSE", bytes.data(), unsigned(bytes.size()));
