@@ -15,11 +15,13 @@ const char* kUsage =
     "usage: sandbox run [LEVEL] [--rate HZ|max] [--duration S] [--lcm-url URL] [--lockstep]\n"
     "                   [--replay LOG] [--record LOG] [--out DIR] [--frames LIST] [--depth D]\n"
     "                   [--scans-every S] [--view] [--realtime auto|off] [--isolate]\n"
+    "                   [--ticks N] [--no-sensors | --frames-only]\n"
     "  LEVEL          a level (default: the bundled sample level)\n"
     "  --isolate      read a manifest's files in a separate process first: a file that crashes\n"
     "                 assimp is then an error naming it (a scene file as LEVEL always is read so)\n"
     "  --rate         loop rate in Hz (default 100); max: free running, as fast as it can\n"
     "  --duration     stop after this many seconds (default: run until Ctrl-C)\n"
+    "  --ticks        stop after this many ticks (lock-step: after N poses)\n"
     "  --lcm-url      LCM URL (default: LCM's own; multicast URLs get a 4 MB receive buffer)\n"
     "  --lockstep     each tick consumes exactly one pose message (waits for it); outputs and\n"
     "                 frames are a function of the inputs alone\n"
@@ -38,6 +40,9 @@ const char* kUsage =
     "                 a/d pan, w/s tilt, +/- zoom (trailing), o overlay, space pause, q quit\n"
     "  --realtime     auto (default): the loop thread at real-time priority (SCHED_FIFO) when\n"
     "                 the user may (root, CAP_SYS_NICE or ulimit -r); off: normal priority\n"
+    "  --no-sensors   run no sensor (robots' STATE and STATUS are still published)\n"
+    "  --frames-only  run no sensor and publish nothing: only render the cameras, beside a\n"
+    "                 sandbox that scans the same pose stream (docs/distributed.md)\n"
     "Inputs per robot: <ROBOT>/POSE, /BONES, /ACTORS, /CAMERA (trailing pan, tilt, zoom).\n"
     "Outputs: <ROBOT>/SCAN_FACE, /GROUND, /LIDAR, /RANGE, /STATE, /STATUS (docs/bridge.md).\n";
 

@@ -1,5 +1,6 @@
 #include "app/run_options.h"
 
+#include <cmath>
 #include <sstream>
 
 #include "app/defaults.h"
@@ -36,8 +37,9 @@ void ParseFrames(const std::string& text, FramePipelineConfig* config) {
 
 const std::set<std::string> kRunValueOptions = {
     "--rate", "--duration", "--lcm-url", "--replay",      "--record",
-    "--out",  "--frames",   "--depth",   "--scans-every", "--realtime"};
-const std::set<std::string> kRunFlags = {"--lockstep", "--view", "--isolate"};
+    "--out",  "--frames",   "--depth",   "--scans-every", "--realtime", "--ticks"};
+const std::set<std::string> kRunFlags = {"--lockstep", "--view", "--isolate", "--no-sensors",
+                                         "--frames-only"};
 
 RunOptions ParseRunOptions(const ParsedArgs& args) {
   RunOptions options;
@@ -84,6 +86,32 @@ RunOptions ParseRunOptions(const ParsedArgs& args) {
     throw UsageError("--realtime must be auto or off, got '" + realtime + "'");
   }
   options.realtime = realtime == "auto";
+  if (args.values.count("--ticks")) {
+    const double ticks = number("--ticks", 0.0);
+    if (!(ticks >= 1.0 && ticks <= 1e15 && ticks == std::floor(ticks))) {
+      throw UsageError("--ticks must be a whole number of ticks, 1 or more, got '" +
+                       args.Value("--ticks") + "'");
+    }
+    options.ticks = std::int64_t(ticks);
+  }
+  // Splitting the work over two sandboxes on one pose stream: one scans and
+  // publishes, the other only renders (docs/distributed.md).
+  options.publish = args.flags.count("--frames-only") == 0;
+  options.sensors = options.publish && args.flags.count("--no-sensors") == 0;
+  if (!options.publish) {
+    const bool writes_frames = !options.out_dir.empty() && (!options.frames.image_format.empty() ||
+                                                            !options.frames.video_format.empty());
+    if (!writes_frames && !options.view) {
+      throw UsageError("--frames-only renders the cameras: it needs --out DIR (with --frames "
+                       "other than none) or --view");
+    }
+    if (!options.record_file.empty() || options.scans_every_s > 0.0) {
+      throw UsageError("--frames-only publishes and scans nothing: no --record or --scans-every");
+    }
+  }
+  if (!options.sensors && options.scans_every_s > 0.0) {
+    throw UsageError("--no-sensors scans nothing: no --scans-every");
+  }
   return options;
 }
 

@@ -2,6 +2,7 @@
 // What `sandbox run` is asked to do, as values: its command line parsed and
 // checked. ParseRunOptions throws CommandError naming the option.
 
+#include <cstdint>
 #include <set>
 #include <string>
 
@@ -28,6 +29,9 @@ struct RunOptions {
   bool view{false};            // the live view
   bool isolate{false};         // load the level in a child process first
   bool realtime{true};         // ask for SCHED_FIFO
+  std::int64_t ticks{0};       // stop after this many ticks; 0: no limit
+  bool sensors{true};          // false: no sensor runs (--no-sensors, --frames-only)
+  bool publish{true};          // false: nothing published (--frames-only)
 
   bool free_running() const { return rate_hz == 0.0; }
   bool replay() const { return !replay_file.empty(); }

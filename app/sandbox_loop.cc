@@ -136,7 +136,8 @@ int SandboxLoop::Run() {
   }
   const SignalRoute signals(stop_);  // SIGINT and SIGTERM end the loop, and wake its waits
   out_ << "sandbox run: " << level_.name << ", " << level_.robots.size() << " robots, "
-       << sensors_.size() << " sensors, "
+       << (options_.sensors ? std::to_string(sensors_.size()) + " sensors, " : "sensors off, ")
+       << (options_.publish ? "" : "publishing nothing, ")
        << (options_.replay() ? "replaying " + options_.replay_file
                              : PaceName(options_) + ", LCM " + link_.url())
        << priority << "\n"
@@ -174,6 +175,7 @@ int SandboxLoop::Run() {
     record.lateness_ms = 1e3 * pacer.Lateness(record.start_s);
     Tick(wall_s, drain_budget_s, &record);
     ++tick_;
+    if (options_.ticks > 0 && tick_ >= options_.ticks) stop_.Request();
     // 6. Record the tick; wait for the next (or the end of the run, or a stop).
     const auto tick_end = Clock::now();
     record.duration_ms = std::chrono::duration<double, std::milli>(tick_end - tick_start).count();
@@ -196,11 +198,11 @@ void SandboxLoop::Tick(double wall_s, double drain_budget_s, TickRecord* record)
   if (hooks_.before_tick) hooks_.before_tick(link_, wall_s);
   std::int64_t now = bridge::NowUtime();
   const double t = ApplyInputs(wall_s, drain_budget_s, &now, record);  // 1-2
-  RunDueSensors(t, now);                                               // 3, and 4: their outputs
-  PublishStates(now);                                                  // 4
+  if (options_.sensors) RunDueSensors(t, now);                         // 3, and 4: their outputs
+  if (options_.publish) PublishStates(now);                            // 4
   WriteDueScans(t);
-  DirectCameras(t, record);    // 5
-  PublishStatusIfDue(t, now);  // 4
+  DirectCameras(t, record);                          // 5
+  if (options_.publish) PublishStatusIfDue(t, now);  // 4
   ReportRecordingFailure();
   if (hooks_.end_of_tick) hooks_.end_of_tick(tick_);
   record->rays = caster_.rays_cast() - rays_before;

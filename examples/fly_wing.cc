@@ -6,8 +6,10 @@
 // process per robot as separate models would be.
 //
 //   fly_wing [--slot wing|left|right] [--rate HZ] [--duration S] [--poses N]
-//            [--lcm-url URL] [--robot NAME]
+//            [--lcm-url URL] [--robot NAME] [--log FILE]
 //
+// --log: also writes every message it publishes to an LCM log (`sandbox run
+// --replay FILE` then runs the same inputs again).
 // --robot: the channel prefix (default ELAHA, QUAD1 for left, QUAD2 for right).
 // It stops after --duration seconds or after --poses poses, whichever comes first.
 
@@ -16,6 +18,7 @@
 #include <cstdio>
 #include <cstring>
 #include <lcm/lcm-cpp.hpp>
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
@@ -25,7 +28,7 @@
 int main(int argc, char** argv) {
   double rate_hz = 100.0, duration_s = 10.0;
   long long poses = -1;
-  std::string url, robot, slot = "wing";
+  std::string url, robot, slot = "wing", log_file;
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--rate"))
       rate_hz = std::atof(argv[i + 1]);
@@ -39,6 +42,8 @@ int main(int argc, char** argv) {
       robot = argv[i + 1];
     else if (!std::strcmp(argv[i], "--slot"))
       slot = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--log"))
+      log_file = argv[i + 1];
     else {
       argc = -1;
       break;
@@ -48,7 +53,7 @@ int main(int argc, char** argv) {
   if (argc < 0 || argc % 2 == 0 || (side == 0 && slot != "wing") || !(rate_hz > 0.0)) {
     std::fprintf(stderr,
                  "usage: fly_wing [--slot wing|left|right] [--rate HZ] [--duration S] [--poses N]\n"
-                 "                [--lcm-url URL] [--robot NAME]\n");
+                 "                [--lcm-url URL] [--robot NAME] [--log FILE]\n");
     return 2;
   }
   if (robot.empty()) robot = side < 0 ? "QUAD1" : side > 0 ? "QUAD2" : "ELAHA";
@@ -57,6 +62,25 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "fly_wing: cannot open LCM URL '%s'\n", url.c_str());
     return 1;
   }
+  std::unique_ptr<lcm::LogFile> log;
+  if (!log_file.empty()) {
+    log = std::make_unique<lcm::LogFile>(log_file, "w");
+    if (!log->good()) {
+      std::fprintf(stderr, "fly_wing: cannot write the log '%s'\n", log_file.c_str());
+      return 1;
+    }
+  }
+  auto publish = [&](const std::string& channel, std::vector<std::uint8_t>* bytes,
+                     std::int64_t utime) {
+    lcm.publish(channel, bytes->data(), unsigned(bytes->size()));
+    if (!log) return;
+    lcm::LogEvent event{};
+    event.timestamp = utime;
+    event.channel = channel;
+    event.datalen = std::int32_t(bytes->size());
+    event.data = bytes->data();
+    log->writeEvent(&event);
+  };
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   const auto period = std::chrono::duration<double>(1.0 / rate_hz);
@@ -75,12 +99,14 @@ int main(int argc, char** argv) {
     } else {
       sandbox::bridge::WingmanFlight(side, t, seq, utime, &pose, &bones);
     }
-    std::vector<std::uint8_t> bytes(std::size_t(pose.getEncodedSize()));
-    pose.encode(bytes.data(), 0, int(bytes.size()));
-    lcm.publish(robot + "/POSE", bytes.data(), unsigned(bytes.size()));
-    bytes.resize(std::size_t(bones.getEncodedSize()));
+    // Bones first: a lock-step sandbox ticks on the pose and applies the
+    // bones of its seq that have arrived by then.
+    std::vector<std::uint8_t> bytes(std::size_t(bones.getEncodedSize()));
     bones.encode(bytes.data(), 0, int(bytes.size()));
-    lcm.publish(robot + "/BONES", bytes.data(), unsigned(bytes.size()));
+    publish(robot + "/BONES", &bytes, utime);
+    bytes.resize(std::size_t(pose.getEncodedSize()));
+    pose.encode(bytes.data(), 0, int(bytes.size()));
+    publish(robot + "/POSE", &bytes, utime);
     ++seq;
     next += std::chrono::duration_cast<Clock::duration>(period);
     std::this_thread::sleep_until(next);
