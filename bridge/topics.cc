@@ -1,8 +1,10 @@
 #include "bridge/topics.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <stdexcept>
 
 #include "bridge/lcm_link_impl.h"
 #include "sandbox_msgs/actor_placements_t.hpp"
@@ -55,16 +57,15 @@ void Count(const std::string& channel, const std::uint8_t* data, std::uint32_t s
   }
   ++s.messages;
   s.bytes += size;
+  ++s.window_messages;
+  s.window_bytes += size;
   s.last_utime = utime;
 }
 
-struct Collector {
-  std::map<std::string, ChannelStats>* stats;
-  void On(const lcm::ReceiveBuffer* buffer, const std::string& channel) {
-    Count(channel, static_cast<const std::uint8_t*>(buffer->data), buffer->data_size,
-          buffer->recv_utime, stats);
-  }
-};
+void Deliver(const lcm::ReceiveBuffer* buffer, const std::string& channel, TopicMonitor* monitor) {
+  monitor->OnMessage(channel, static_cast<const std::uint8_t*>(buffer->data), buffer->data_size,
+                     buffer->recv_utime);
+}
 
 }  // namespace
 
@@ -74,14 +75,46 @@ double ChannelStats::rate_hz() const {
              : 0.0;
 }
 
-std::map<std::string, ChannelStats> ListenToAll(LcmLink& link, double seconds) {
-  std::map<std::string, ChannelStats> stats;
-  Collector collector{&stats};
-  lcm::Subscription* subscription = link.impl().lcm.subscribe(".*", &Collector::On, &collector);
+double ChannelStats::bandwidth_Bps() const {
+  return messages > 1 && last_utime > first_utime
+             ? double(bytes) * double(messages - 1) / double(messages) /
+                   (double(last_utime - first_utime) * 1e-6)
+             : 0.0;
+}
+
+TopicMonitor::TopicMonitor(LcmLink& link) : link_(link) {
+  lcm::Subscription* subscription = link_.impl().lcm.subscribeFunction(".*", &Deliver, this);
+  if (subscription == nullptr) throw std::runtime_error("sandbox topics: cannot subscribe");
+  subscription->setQueueCapacity(LatestInput::kQueueCapacity);
+  subscription_ = subscription;
+}
+
+TopicMonitor::~TopicMonitor() {
+  link_.impl().lcm.unsubscribe(static_cast<lcm::Subscription*>(subscription_));
+}
+
+void TopicMonitor::OnMessage(const std::string& channel, const std::uint8_t* data,
+                             std::uint32_t size, std::int64_t utime) {
+  Count(channel, data, size, utime, &stats_);
+}
+
+void TopicMonitor::Listen(double seconds) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (std::chrono::steady_clock::now() < end) link.impl().lcm.handleTimeout(20);
-  link.impl().lcm.unsubscribe(subscription);
-  return stats;
+  for (auto now = std::chrono::steady_clock::now(); now < end;
+       now = std::chrono::steady_clock::now()) {
+    const int ms = int(std::chrono::duration<double, std::milli>(end - now).count()) + 1;
+    link_.impl().lcm.handleTimeout(std::min(ms, 20));
+  }
+}
+
+void TopicMonitor::StartWindow() {
+  for (auto& [channel, s] : stats_) s.window_messages = s.window_bytes = 0;
+}
+
+std::map<std::string, ChannelStats> ListenToAll(LcmLink& link, double seconds) {
+  TopicMonitor monitor(link);
+  monitor.Listen(seconds);
+  return monitor.stats();
 }
 
 std::map<std::string, ChannelStats> ReadLogTopics(const std::string& path,

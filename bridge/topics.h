@@ -1,6 +1,7 @@
 #pragma once
 // What is on an LCM network: per channel, how many messages, how often, how
 // big, and of which sandbox type (LCM 1.3.1 does not say who published them).
+// Threads: the link's (the caller's).
 
 #include <cstdint>
 #include <map>
@@ -15,11 +16,38 @@ struct ChannelStats {
   std::int64_t bytes{0};
   std::int64_t first_utime{0}, last_utime{0};
   std::string type;  // "robot_pose_t", or the fingerprint in hex for other types
+  // Since the last TopicMonitor::StartWindow().
+  std::int64_t window_messages{0}, window_bytes{0};
 
-  double rate_hz() const;  // over the time between first and last message
+  double rate_hz() const;        // over the time between first and last message
+  double bandwidth_Bps() const;  // bytes over that time
 };
 
-// Listens to every channel on `link` for `seconds`.
+// Every channel heard on a link, counted as messages arrive: totals, and
+// counts over a window the caller restarts (the live table's rates).
+class TopicMonitor {
+ public:
+  explicit TopicMonitor(LcmLink& link);  // subscribes to every channel
+  ~TopicMonitor();
+  TopicMonitor(const TopicMonitor&) = delete;
+  TopicMonitor& operator=(const TopicMonitor&) = delete;
+
+  // Handles what arrives for `seconds`.
+  void Listen(double seconds);
+  // Starts a new window (the window counts go back to zero).
+  void StartWindow();
+  const std::map<std::string, ChannelStats>& stats() const { return stats_; }
+
+  void OnMessage(const std::string& channel, const std::uint8_t* data, std::uint32_t size,
+                 std::int64_t utime);
+
+ private:
+  LcmLink& link_;
+  void* subscription_{nullptr};
+  std::map<std::string, ChannelStats> stats_;
+};
+
+// Every channel on `link` for `seconds`.
 std::map<std::string, ChannelStats> ListenToAll(LcmLink& link, double seconds);
 
 // The same for every event of an LCM log file (times are the events' own).

@@ -82,6 +82,35 @@ TEST(ReplayTest, PosesForRobotsTheLevelDoesNotHaveAreCountedAndReportedNotApplie
       << run.out;
 }
 
+TEST(ReplayTest, TopicsOfALogGiveTypeRateSizeAndBandwidthAsTableOrJson) {
+  sandbox::testing::TempDir dir;
+  const std::string log = (dir.path() / "flight.lcmlog").string();
+  WriteFlightLog(log, 120);  // every 20 ms: 50 Hz, 119 intervals over 2.38 s
+  // robot_pose_t on the wire: fingerprint, utime, seq (8 bytes each), 7 doubles.
+  const int bytes = 8 + 8 + 8 + 7 * 8;
+  const auto table = RunSandbox("topics --log " + log);
+  ASSERT_EQ(table.exit_code, 0) << table.out;
+  std::istringstream rows(table.out);
+  std::string header, channel, type, total;
+  double messages = 0, rate = 0, mean = 0, kBps = 0;
+  std::getline(rows, header);
+  rows >> channel >> type >> messages >> rate >> mean >> kBps >> total;
+  EXPECT_EQ(channel, "ELAHA/POSE");
+  EXPECT_EQ(type, "robot_pose_t");
+  EXPECT_EQ(messages, 120);
+  EXPECT_DOUBLE_EQ(rate, 50.0);
+  EXPECT_DOUBLE_EQ(mean, bytes);
+  EXPECT_DOUBLE_EQ(kBps, 4.0);  // 119 messages' bytes over 2.38 s
+  EXPECT_EQ(total, "total");
+  const auto json = RunSandbox("topics --log " + log + " --json");
+  ASSERT_EQ(json.exit_code, 0) << json.out;
+  EXPECT_NE(
+      json.out.find("{\"channel\":\"ELAHA/POSE\",\"type\":\"robot_pose_t\",\"messages\":120,"
+                    "\"bytes\":9600,\"rate_hz\":50,\"mean_bytes\":80,\"bandwidth_Bps\":4000}"),
+      std::string::npos)
+      << json.out;
+}
+
 TEST(ReplayTest, TruncatedLogIsReplayedUpToTheBreakAndNotALogIsRefused) {
   sandbox::testing::TempDir dir;
   const std::string log = (dir.path() / "flight.lcmlog").string();
