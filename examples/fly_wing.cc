@@ -6,8 +6,9 @@
 // process per robot as separate models would be.
 //
 //   fly_wing [--slot wing|left|right] [--rate HZ] [--duration S] [--poses N]
-//            [--lcm-url URL] [--robot NAME] [--log FILE]
+//            [--lcm-url URL] [--robot NAME] [--log FILE] [--phase S]
 //
+// --phase: fly S seconds ahead on the circle (robots spread along it).
 // --log: also writes every message it publishes to an LCM log (`sandbox run
 // --replay FILE` then runs the same inputs again).
 // --robot: the channel prefix (default ELAHA, QUAD1 for left, QUAD2 for right).
@@ -26,7 +27,7 @@
 #include "bridge/example_flight.h"
 
 int main(int argc, char** argv) {
-  double rate_hz = 100.0, duration_s = 10.0;
+  double rate_hz = 100.0, duration_s = 10.0, phase_s = 0.0;
   long long poses = -1;
   std::string url, robot, slot = "wing", log_file;
   for (int i = 1; i + 1 < argc; i += 2) {
@@ -44,6 +45,8 @@ int main(int argc, char** argv) {
       slot = argv[i + 1];
     else if (!std::strcmp(argv[i], "--log"))
       log_file = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--phase"))
+      phase_s = std::atof(argv[i + 1]);
     else {
       argc = -1;
       break;
@@ -53,7 +56,7 @@ int main(int argc, char** argv) {
   if (argc < 0 || argc % 2 == 0 || (side == 0 && slot != "wing") || !(rate_hz > 0.0)) {
     std::fprintf(stderr,
                  "usage: fly_wing [--slot wing|left|right] [--rate HZ] [--duration S] [--poses N]\n"
-                 "                [--lcm-url URL] [--robot NAME] [--log FILE]\n");
+                 "                [--lcm-url URL] [--robot NAME] [--log FILE] [--phase S]\n");
     return 2;
   }
   if (robot.empty()) robot = side < 0 ? "QUAD1" : side > 0 ? "QUAD2" : "ELAHA";
@@ -95,9 +98,9 @@ int main(int argc, char** argv) {
     sandbox_msgs::robot_pose_t pose;
     sandbox_msgs::bone_values_t bones;
     if (side == 0) {  // the flight itself
-      sandbox::bridge::ExampleFlight(t, seq, utime, &pose, &bones);
+      sandbox::bridge::ExampleFlight(t + phase_s, seq, utime, &pose, &bones);
     } else {
-      sandbox::bridge::WingmanFlight(side, t, seq, utime, &pose, &bones);
+      sandbox::bridge::WingmanFlight(side, t + phase_s, seq, utime, &pose, &bones);
     }
     // Bones first: a lock-step sandbox ticks on the pose and applies the
     // bones of its seq that have arrived by then.

@@ -124,6 +124,9 @@ void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
   const std::vector<Part> parts = DueAt(tick);
   RayBatch rays;
   rays.origin_W = X_WS.translation();
+  std::size_t count = 0;
+  for (const Part& part : parts) count += std::size_t(part.row_end - part.row_begin) * std::size_t(n_);
+  rays.start.reserve(count), rays.direction.reserve(count), rays.length_m.reserve(count);
   for (const Part& part : parts) AppendRays(part, X_WS, &rays);
   RayHits hits;
   caster.Cast(world, rays, filter, &hits);
