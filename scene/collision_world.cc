@@ -1,6 +1,7 @@
 #include "scene/collision_world.h"
 
 #include <algorithm>
+#include <atomic>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -30,6 +31,8 @@ struct ClosestHitIgnoring : btCollisionWorld::ClosestRayResultCallback {
 }  // namespace
 
 CollisionWorld::CollisionWorld(const Level& level) : impl_(std::make_unique<Impl>()) {
+  static std::atomic<std::uint64_t> instances{0};
+  instance_ = ++instances;
   Impl& w = *impl_;
   w.broadphase.m_deferedcollide = true;  // no overlap search when objects are added
   w.num_actors = static_cast<int>(level.actors.size());
@@ -124,6 +127,7 @@ void CollisionWorld::SetActorPose(int actor, const Eigen::Isometry3d& X_WA) {
   }
   impl_->X_W[static_cast<std::size_t>(actor)] = X_WA;
   impl_->Place(actor, p_WO_);
+  ++revision_;
 }
 
 void CollisionWorld::SetActorPose(std::string_view actor, const Eigen::Isometry3d& X_WA) {
@@ -153,11 +157,13 @@ void CollisionWorld::UpdateRobot(int robot, const RobotState& state) {
         RigidPart(state.node_poses_B()[static_cast<std::size_t>(pieces[p]->node)]);
   }
   w.Place(body, p_WO_);
+  ++revision_;
 }
 
 void CollisionWorld::SetOrigin(const Eigen::Vector3d& p_WO) {
   p_WO_ = p_WO;
   for (std::size_t b = 0; b < impl_->X_W.size(); ++b) impl_->Place(static_cast<int>(b), p_WO_);
+  ++revision_;
 }
 
 int CollisionWorld::num_collision_objects() const {

@@ -82,6 +82,12 @@ class CollisionWorld {
   int num_collision_objects() const;
   int num_parts() const;  // Bullet mesh parts over all shapes
 
+  // A number no other world of this process has, and one counting the
+  // changes to its placements and origin: together they name the world's
+  // state (a ray caster keeps what it derived from one state until it changes).
+  std::uint64_t instance() const { return instance_; }
+  std::uint64_t revision() const { return revision_; }
+
   // The Bullet objects inside, for sensors/ (scene/collision_world_internal.h).
   struct Impl;
   const Impl& internals() const { return *impl_; }
@@ -90,6 +96,7 @@ class CollisionWorld {
   std::unique_ptr<Impl> impl_;
   std::vector<std::string> actor_names_;
   Eigen::Vector3d p_WO_{Eigen::Vector3d::Zero()};
+  std::uint64_t instance_{0}, revision_{0};
 };
 
 }  // namespace sandbox::scene

@@ -105,13 +105,20 @@ void FaceScanner::AppendRays(const Part& part, const Eigen::Isometry3d& X_WS,
   const Eigen::Vector3d u_W = R_WS * u, v_W = R_WS * v;
   const double E = config_.half_extent_m, res = config_.resolution_m;
   const Eigen::Vector3d offset = X_WS.translation() - rays->origin_W;
+  // Start c, r = offset + u (-E + c res) + v (-E + r res), summed in that
+  // order; the columns' first two terms are the same on every row.
+  thread_local std::vector<Eigen::Vector3d> columns;
+  columns.resize(std::size_t(n_));
+  for (int c = 0; c < n_; ++c) columns[std::size_t(c)] = offset + u_W * (-E + c * res);
+  const std::size_t first = rays->start.size();
+  const std::size_t count = std::size_t(part.row_end - part.row_begin) * std::size_t(n_);
+  rays->start.resize(first + count);
+  rays->direction.resize(first + count, axis_W);
+  rays->length_m.resize(first + count, static_cast<float>(E));
+  Eigen::Vector3f* start = rays->start.data() + first;
   for (int r = part.row_begin; r < part.row_end; ++r) {
-    for (int c = 0; c < n_; ++c) {
-      const Eigen::Vector3d start = offset + u_W * (-E + c * res) + v_W * (-E + r * res);
-      rays->start.push_back(start.cast<float>());
-      rays->direction.push_back(axis_W);
-      rays->length_m.push_back(static_cast<float>(E));
-    }
+    const Eigen::Vector3d row = v_W * (-E + r * res);
+    for (int c = 0; c < n_; ++c) *start++ = (columns[std::size_t(c)] + row).cast<float>();
   }
 }
 
@@ -122,13 +129,12 @@ void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
     throw std::invalid_argument("FaceScanner::Scan(): non-finite pose");
   if (scan->n != n_) *scan = EmptyScan();
   const std::vector<Part> parts = DueAt(tick);
-  RayBatch rays;
+  // The rays and hits keep their memory from scan to scan (no allocation a tick).
+  thread_local RayBatch rays;
+  thread_local RayHits hits;
   rays.origin_W = X_WS.translation();
-  std::size_t count = 0;
-  for (const Part& part : parts) count += std::size_t(part.row_end - part.row_begin) * std::size_t(n_);
-  rays.start.reserve(count), rays.direction.reserve(count), rays.length_m.reserve(count);
+  rays.start.clear(), rays.direction.clear(), rays.length_m.clear();
   for (const Part& part : parts) AppendRays(part, X_WS, &rays);
-  RayHits hits;
   caster.Cast(world, rays, filter, &hits);
   // Write each part's results back into its face.
   std::size_t i = 0;

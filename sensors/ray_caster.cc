@@ -23,11 +23,15 @@ constexpr int kStackInPlace = RayCaster::kStackInPlace;
 // One Bullet object as a ray sees it: where it is, its BVH nodes and triangles.
 struct Target {
   int body{-1};
+  std::uint32_t group{0};  // the object's collision group (scene::kWorldStatic, ...)
+  // The box around this object and the other objects of its body next to it
+  // in the list (a robot's pieces): a packet that misses it skips them all.
+  Eigen::Vector3f body_min{Eigen::Vector3f::Zero()}, body_max{Eigen::Vector3f::Zero()};
   Eigen::Vector3f aabb_min, aabb_max;  // in the Bullet frame (world minus origin)
   Eigen::Matrix3f R_LB;                // local from Bullet frame
   Eigen::Vector3f p_LB;
-  btTransform X_BL;                    // Bullet frame from local: where triangles are tested
-  bool identity{false};                // X_BL is exactly the identity
+  btTransform X_BL;      // Bullet frame from local: where triangles are tested
+  bool identity{false};  // X_BL is exactly the identity
   const btQuantizedBvhNode* nodes{nullptr};
   Eigen::Vector3f bvh_min, quantization;  // quantized = (local - bvh_min) * quantization
   struct Part {
@@ -41,18 +45,16 @@ struct Target {
 
 Eigen::Vector3f ToEigen(const btVector3& v) { return {float(v.x()), float(v.y()), float(v.z())}; }
 
-std::vector<Target> CollectTargets(const scene::CollisionWorld& world, const RayFilter& filter) {
+// Every object of the world, in the world's order (a body's objects next to
+// each other), with the boxes around each run of one body's objects.
+std::vector<Target> CollectTargets(const scene::CollisionWorld& world) {
   const scene::CollisionWorld::Impl& w = world.internals();
   std::vector<Target> targets;
   for (const scene::MeshObject& object : w.objects) {
     const btCollisionObject& o = *object.object;
-    const int body = o.getUserIndex();
-    const int group = o.getBroadphaseHandle()->m_collisionFilterGroup;
-    if ((static_cast<std::uint32_t>(group) & filter.group_mask) == 0) continue;
-    if (body == filter.ignore_actor && filter.ignore_actor >= 0) continue;
-    if (filter.ignore_robot >= 0 && body == w.num_actors + filter.ignore_robot) continue;
     Target t;
-    t.body = body;
+    t.body = o.getUserIndex();
+    t.group = static_cast<std::uint32_t>(o.getBroadphaseHandle()->m_collisionFilterGroup);
     t.aabb_min = ToEigen(o.getBroadphaseHandle()->m_aabbMin);
     t.aabb_max = ToEigen(o.getBroadphaseHandle()->m_aabbMax);
     const btTransform& X = o.getWorldTransform();
@@ -75,6 +77,13 @@ std::vector<Target> CollectTargets(const scene::CollisionWorld& world, const Ray
                          meshes[m].m_triangleIndexBase, meshes[m].m_triangleIndexStride});
     }
     targets.push_back(std::move(t));
+  }
+  for (std::size_t first = 0, end = 0; first < targets.size(); first = end) {
+    Eigen::Vector3f lo = targets[first].aabb_min, hi = targets[first].aabb_max;
+    for (end = first + 1; end < targets.size() && targets[end].body == targets[first].body; ++end) {
+      lo = lo.cwiseMin(targets[end].aabb_min), hi = hi.cwiseMax(targets[end].aabb_max);
+    }
+    for (std::size_t t = first; t < end; ++t) targets[t].body_min = lo, targets[t].body_max = hi;
   }
   return targets;
 }
@@ -271,8 +280,12 @@ inline __m128 EnterBox4(const btQuantizedBvhNode& node, const __m128 qo[3], cons
 struct Vec4 {  // a vector per lane
   __m128 x, y, z;
 };
-inline Vec4 Sub(const Vec4& a, const Vec4& b) { return {Sub(a.x, b.x), Sub(a.y, b.y), Sub(a.z, b.z)}; }
-inline Vec4 Add(const Vec4& a, const Vec4& b) { return {Add(a.x, b.x), Add(a.y, b.y), Add(a.z, b.z)}; }
+inline Vec4 Sub(const Vec4& a, const Vec4& b) {
+  return {Sub(a.x, b.x), Sub(a.y, b.y), Sub(a.z, b.z)};
+}
+inline Vec4 Add(const Vec4& a, const Vec4& b) {
+  return {Add(a.x, b.x), Add(a.y, b.y), Add(a.z, b.z)};
+}
 inline __m128 Abs(__m128 x) { return _mm_andnot_ps(_mm_set1_ps(-0.0f), x); }
 inline __m128 L1(const Vec4& a) { return Add(Add(Abs(a.x), Abs(a.y)), Abs(a.z)); }
 inline __m128 Select(__m128 mask, __m128 a, __m128 b) {
@@ -288,8 +301,8 @@ inline __m128 MeetsCornerBox4(const Eigen::Vector3f corner[3], const Vec4& o, co
     const float hi = std::max({corner[0][k], corner[1][k], corner[2][k]});
     // A zero component counts as an infinitesimally positive one.
     const __m128 zero = _mm_cmpeq_ps(direction[k], _mm_setzero_ps());
-    const __m128 inverse = Select(zero, _mm_set1_ps(kHuge),
-                                  _mm_div_ps(_mm_set1_ps(1.0f), direction[k]));
+    const __m128 inverse =
+        Select(zero, _mm_set1_ps(kHuge), _mm_div_ps(_mm_set1_ps(1.0f), direction[k]));
     const __m128 t1 = Mul(Sub(_mm_set1_ps(lo), origin[k]), inverse);
     const __m128 t2 = Mul(Sub(_mm_set1_ps(hi), origin[k]), inverse);
     t_enter = _mm_max_ps(t_enter, _mm_min_ps(t1, t2));
@@ -354,12 +367,13 @@ inline void WalkTarget4(const Target& target, Packet* packet) {
 }
 
 // Lanes whose rays enter an axis-aligned box (Bullet frame) before their t_max.
-inline int PacketMeetsBox(const Packet& packet, const __m128 inverse[3], const Target& target) {
+inline int PacketMeetsBox(const Packet& packet, const __m128 inverse[3],
+                          const Eigen::Vector3f& box_min, const Eigen::Vector3f& box_max) {
   const __m128 o[3] = {packet.ox, packet.oy, packet.oz};
   __m128 t_enter = _mm_setzero_ps(), t_exit = packet.t_max;
   for (int k = 0; k < 3; ++k) {
-    const __m128 t1 = Mul(Sub(_mm_set1_ps(target.aabb_min[k]), o[k]), inverse[k]);
-    const __m128 t2 = Mul(Sub(_mm_set1_ps(target.aabb_max[k]), o[k]), inverse[k]);
+    const __m128 t1 = Mul(Sub(_mm_set1_ps(box_min[k]), o[k]), inverse[k]);
+    const __m128 t2 = Mul(Sub(_mm_set1_ps(box_max[k]), o[k]), inverse[k]);
     t_enter = _mm_max_ps(t_enter, _mm_min_ps(t1, t2));
     t_exit = _mm_min_ps(t_exit, _mm_max_ps(t1, t2));
   }
@@ -368,6 +382,11 @@ inline int PacketMeetsBox(const Packet& packet, const __m128 inverse[3], const T
 #endif
 
 }  // namespace
+
+struct RayCaster::Targets {
+  std::uint64_t instance{0}, revision{0};
+  std::vector<Target> all;
+};
 
 const char* RayCaster::kernel() {
 #if defined(__SSE2__)
@@ -439,6 +458,16 @@ void RayCaster::RunParallel(int chunks, const std::function<void(int)>& job) {
   while (unfinished_.load(std::memory_order_acquire) > 0) std::this_thread::yield();
 }
 
+const RayCaster::Targets& RayCaster::TargetsOf(const scene::CollisionWorld& world) {
+  if (!targets_) targets_ = std::make_unique<Targets>();
+  if (targets_->instance != world.instance() || targets_->revision != world.revision()) {
+    targets_->all = CollectTargets(world);
+    targets_->instance = world.instance();
+    targets_->revision = world.revision();
+  }
+  return *targets_;
+}
+
 void RayCaster::Cast(const scene::CollisionWorld& world, const RayBatch& rays,
                      const RayFilter& filter, RayHits* hits) {
   const std::size_t n = rays.size();
@@ -449,7 +478,13 @@ void RayCaster::Cast(const scene::CollisionWorld& world, const RayBatch& rays,
   if (n == 0) return;
   // The batch in Bullet's frame (world minus the floating origin).
   const Eigen::Vector3f origin_B = (rays.origin_W - world.origin()).cast<float>();
-  const std::vector<Target> all_targets = CollectTargets(world, filter);
+  const std::vector<Target>& all_targets = TargetsOf(world).all;
+  const int num_actors = world.internals().num_actors;
+  auto wanted = [&filter, num_actors](const Target& t) {
+    return (t.group & filter.group_mask) != 0 &&
+           !(filter.ignore_actor >= 0 && t.body == filter.ignore_actor) &&
+           !(filter.ignore_robot >= 0 && t.body == num_actors + filter.ignore_robot);
+  };
 
   const std::function<void(int)> job = [&](int chunk) {
     const std::size_t first = std::size_t(chunk) * kRaysPerChunk;
@@ -467,7 +502,7 @@ void RayCaster::Cast(const scene::CollisionWorld& world, const RayBatch& rays,
     std::vector<const Target*> many;
     std::size_t count = 0;
     for (const Target& target : all_targets) {
-      if ((target.aabb_min.array() > chunk_max.array()).any() ||
+      if (!wanted(target) || (target.aabb_min.array() > chunk_max.array()).any() ||
           (target.aabb_max.array() < chunk_min.array()).any()) {
         continue;
       }
@@ -504,8 +539,22 @@ void RayCaster::Cast(const scene::CollisionWorld& world, const RayBatch& rays,
                                  _mm_div_ps(_mm_set1_ps(1.0f), AwayFromZero(packet.dy)),
                                  _mm_div_ps(_mm_set1_ps(1.0f), AwayFromZero(packet.dz))};
       for (int l = 0; l < 4; ++l) packet.body[l] = RayHits::kNoHit;
-      for (std::size_t t = 0; t < num_targets; ++t) {
-        if (PacketMeetsBox(packet, inverse, *targets[t]) != 0) WalkTarget4(*targets[t], &packet);
+      for (std::size_t t = 0; t < num_targets;) {
+        // A run of one body's objects (a robot's pieces): skipped whole when
+        // the packet misses the box around them.
+        std::size_t run_end = t + 1;
+        while (run_end < num_targets && targets[run_end]->body == targets[t]->body) ++run_end;
+        if (run_end - t > 2 &&
+            PacketMeetsBox(packet, inverse, targets[t]->body_min, targets[t]->body_max) == 0) {
+          t = run_end;
+          continue;
+        }
+        for (; t < run_end; ++t) {
+          const Target& target = *targets[t];
+          if (PacketMeetsBox(packet, inverse, target.aabb_min, target.aabb_max) != 0) {
+            WalkTarget4(target, &packet);
+          }
+        }
       }
       alignas(16) float t_max[4];
       _mm_store_ps(t_max, packet.t_max);

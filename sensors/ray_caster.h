@@ -15,6 +15,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -96,6 +97,11 @@ class RayCaster {
   std::atomic<std::uint64_t> generation_{0};
   std::atomic<bool> stop_{false};
   std::int64_t rays_cast_{0};
+  // The world's objects as the kernels read them, kept for one state of one
+  // world (scene::CollisionWorld::instance() and revision()).
+  struct Targets;
+  std::unique_ptr<Targets> targets_;
+  const Targets& TargetsOf(const scene::CollisionWorld& world);
 };
 
 }  // namespace sandbox::sensors

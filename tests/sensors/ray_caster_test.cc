@@ -5,10 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <random>
 
 #include "assets/generators/sample_terrain.h"
 #include "scene/level.h"
+#include "scene/robot_state.h"
 #include "sensors/face_scanner.h"
 #include "sensors/walk_stack.h"
 #include "tests/scene/obj_text.h"
@@ -141,6 +143,43 @@ TEST_F(RayCasterTest, FiltersAndThreadCountsChangeNothingElse) {
   }
 }
 
+// A caster keeps the world's objects between casts while the world stays as
+// it was: after each change (a movable actor placed, the robot moved and
+// bent, the floating origin moved) it casts what a new caster casts.
+TEST_F(RayCasterTest, OneCasterFollowsEveryChangeOfTheWorld) {
+  scene::CollisionWorld world(*level_);
+  const RayBatch rays = RandomRays(20000, 13);
+  RayCaster kept(2);
+  RayHits before, after, fresh;
+  kept.Cast(world, rays, {}, &before);
+  scene::RobotState robot(level_->robots[0]);
+  Eigen::Isometry3d X_WB = Eigen::Isometry3d::Identity();
+  X_WB.translation() = Vector3d(10, 5, 25);
+  ASSERT_TRUE(robot.SetPose(X_WB));
+  std::vector<double> bones(std::size_t(level_->robots[0].num_values), 0.0);
+  for (int b = 1; b <= 20; ++b) bones[std::size_t(2 * b)] = 0.1;
+  ASSERT_TRUE(robot.SetBones(bones));
+  robot.Update();
+  Eigen::Isometry3d X_WG = Eigen::Isometry3d::Identity();
+  X_WG.translation() = Vector3d(-20, 30, 12);
+  const std::vector<std::function<void()>> changes = {
+      [&] { world.SetActorPose("gate", X_WG); }, [&] { world.UpdateRobot(0, robot); },
+      [&] { world.SetOrigin(Vector3d(500, -300, 20)); }};
+  for (std::size_t c = 0; c < changes.size(); ++c) {
+    changes[c]();
+    kept.Cast(world, rays, {}, &after);
+    RayCaster(2).Cast(world, rays, {}, &fresh);
+    EXPECT_EQ(after.body, fresh.body) << "change " << c;
+    EXPECT_EQ(after.distance_m, fresh.distance_m) << "change " << c;
+    int changed = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      changed += after.body[i] != before.body[i] || after.distance_m[i] != before.distance_m[i];
+    }
+    if (c < 2) EXPECT_GT(changed, 0) << "change " << c << " moved nothing the rays see";
+    before = after;
+  }
+}
+
 }  // namespace
 }  // namespace sandbox::sensors
 
@@ -161,7 +200,8 @@ TEST(WalkStackTest, GrowsPastItsPlaceAndGivesEveryEntryBack) {
 scene::Level Room(const testing::TempDir& dir) {
   dir.Write("room.obj", testing::ObjBox("room", 12, 12, 8, -6, -6, 0) +
                             testing::ObjBox("pillar", 2, 2, 8, 1, 1, 0, 9));
-  return scene::LoadLevel(dir.Write("room.toml", "[[actor]]\nname = \"room\"\nfile = \"room.obj\"\n"));
+  return scene::LoadLevel(
+      dir.Write("room.toml", "[[actor]]\nname = \"room\"\nfile = \"room.obj\"\n"));
 }
 
 // The first hit of a ray on the room's box faces, computed here in double
@@ -209,8 +249,8 @@ TEST(RayRulesTest, GrazingAndOriginRulesHoldInAnAxisAlignedRoom) {
   };
   // At whole metres in the room; on its +x wall (origins on a surface, rays
   // along the wall's plane); on the pillar's corner edge.
-  for (const Case& c : {Case{{0, 0, 2}, 0.25, 6}, Case{{6, 1, 3}, 0.5, 8},
-                        Case{{3, 3, 4}, 0.5, 5}, Case{{-2, 1, 0}, 0.25, 4}}) {
+  for (const Case& c : {Case{{0, 0, 2}, 0.25, 6}, Case{{6, 1, 3}, 0.5, 8}, Case{{3, 3, 4}, 0.5, 5},
+                        Case{{-2, 1, 0}, 0.25, 4}}) {
     SCOPED_TRACE(::testing::PrintToString(c.at.transpose()));
     FaceScannerConfig config;
     config.refresh = Refresh::kFull;
