@@ -11,7 +11,7 @@ set -euo pipefail
 sandbox=$1 fly_wing=$2 probe=$3 level=$4 seconds=${5:-30}
 source "$(dirname "$0")/../bridge/processes.sh"
 out=$(mktemp -d /tmp/sandbox-lan-chain-XXXXXX)
-trap 'rm -rf "$out"' EXIT
+trap 'kill $(jobs -p) 2> /dev/null || true; rm -rf "$out"' EXIT
 probe_url="$LAN_URL&recv_buf_size=4194304"
 
 start_sandbox "$out/sandbox.log" ip netns exec h2 "$sandbox" run "$level" --lcm-url "$LAN_URL"

@@ -11,7 +11,7 @@ set -euo pipefail
 sandbox=$1 fly_wing=$2 log_diff=$3 level=$4 poses=${5:-300}
 source "$(dirname "$0")/../bridge/processes.sh"
 out=$(mktemp -d /tmp/sandbox-lan-split-XXXXXX)
-trap 'rm -rf "$out"' EXIT
+trap 'kill $(jobs -p) 2> /dev/null || true; rm -rf "$out"' EXIT
 lockstep=(run "$level" --lcm-url "$LAN_URL" --lockstep --ticks "$poses" --realtime off)
 
 start_sandbox "$out/scanner.log" ip netns exec h2 "$sandbox" "${lockstep[@]}" \
