@@ -5,8 +5,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <exception>
 #include <filesystem>
 #include <iomanip>
+#include <mutex>
 #include <sstream>
 #include <string>
 
@@ -194,7 +196,7 @@ int SandboxLoop::Run() {
 }
 
 void SandboxLoop::Tick(double wall_s, double drain_budget_s, TickRecord* record) {
-  const std::int64_t rays_before = caster_.rays_cast();
+  const std::int64_t rays_before = caster_.rays_cast() + side_rays_;
   if (hooks_.before_tick) hooks_.before_tick(link_, wall_s);
   std::int64_t now = bridge::NowUtime();
   const double t = ApplyInputs(wall_s, drain_budget_s, &now, record);  // 1-2
@@ -205,7 +207,7 @@ void SandboxLoop::Tick(double wall_s, double drain_budget_s, TickRecord* record)
   if (options_.publish) PublishStatusIfDue(t, now);  // 4
   ReportRecordingFailure();
   if (hooks_.end_of_tick) hooks_.end_of_tick(tick_);
-  record->rays = caster_.rays_cast() - rays_before;
+  record->rays = caster_.rays_cast() + side_rays_ - rays_before;
 }
 
 bool SandboxLoop::TakeViewKeys(double drain_budget_s) {
@@ -271,18 +273,47 @@ double SandboxLoop::ApplyInputs(double wall_s, double drain_budget_s, std::int64
 }
 
 void SandboxLoop::RunDueSensors(double t, std::int64_t now_utime) {
+  due_.clear();
   for (std::size_t s = 0; s < sensors_.size(); ++s) {
     if (!sensor_schedules_[s].Due(t)) continue;
     sensor_schedules_[s].Done(t);
+    due_.push_back(s);
+  }
+  auto run = [this, t](std::size_t s, sensors::RayCaster& caster) {
     sensors::Sensor& sensor = sensors_[s];
     const sensors::MountedSensor& mounted = sensor.mounted();
-    RobotRun& robot = robots_[std::size_t(mounted.robot)];
+    const RobotRun& robot = robots_[std::size_t(mounted.robot)];
     sensors::RayFilter filter;
     filter.ignore_robot = mounted.robot;
-    const sensors::SensorContext at{
-        world_,         caster_, filter, mounted.Pose(*robot.state), robot.state->pose(),
-        &robot.history, t,       tick_};
-    robot.outputs->Publish(sensor.Run(at), {mounted.spec.name, mounted.channel}, tick_,
+    sensor.Run({world_, caster, filter, mounted.Pose(*robot.state), robot.state->pose(),
+                &robot.history, t, tick_});
+  };
+  if (caster_.threads() > 1 && int(due_.size()) > caster_.threads()) {
+    // More sensors than threads: whole sensors over the caster's threads, each casting
+    // on its thread alone (one hand-over a tick instead of one a sensor).
+    // A sensor's exception is rethrown here, on the loop thread.
+    std::exception_ptr failure;
+    std::mutex failure_mutex;
+    caster_.RunParallel(int(due_.size()), [&](int k) {
+      thread_local sensors::RayCaster own_thread(1);
+      const std::int64_t before = own_thread.rays_cast();
+      try {
+        run(due_[std::size_t(k)], own_thread);
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(failure_mutex);
+        if (!failure) failure = std::current_exception();
+      }
+      side_rays_ += own_thread.rays_cast() - before;
+    });
+    if (failure) std::rethrow_exception(failure);
+  } else {
+    for (const std::size_t s : due_) run(s, caster_);
+  }
+  for (const std::size_t s : due_) {  // published in the sensors' order
+    const sensors::Sensor& sensor = sensors_[s];
+    const sensors::MountedSensor& mounted = sensor.mounted();
+    RobotRun& robot = robots_[std::size_t(mounted.robot)];
+    robot.outputs->Publish(sensor.output(), {mounted.spec.name, mounted.channel}, tick_,
                            robot.feed->input(), now_utime);
   }
 }

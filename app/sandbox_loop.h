@@ -3,7 +3,8 @@
 // in the order of ../shared/DESIGN.md, "One tick of the loop"
 // (docs/architecture.md shows where each step lives):
 //   1-2. the inputs drained and applied (bridge::RobotFeed, one per robot);
-//   3.   the sensors that are due run (sensors::Sensor);
+//   3.   the sensors that are due run (sensors::Sensor; several at once over
+//        the caster's threads, each on a one-thread caster);
 //   4.   their outputs, each robot's state and the status heartbeat published
 //        (bridge::RobotOutputs);
 //   5.   the cameras that are due handed to the render thread (CameraDirector,
@@ -17,6 +18,7 @@
 // writer, and takes real-time priority for itself when asked and allowed. The
 // live view's window is run by the caller on the main thread.
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <ostream>
@@ -119,6 +121,8 @@ class SandboxLoop {
   std::unique_ptr<bridge::UnknownRobots> unknown_robots_;  // poses for robots not here
   std::vector<sensors::Sensor> sensors_;
   std::vector<RateSchedule> sensor_schedules_;  // one per sensor
+  std::vector<std::size_t> due_;                // the sensors due this tick
+  std::atomic<std::int64_t> side_rays_{0};      // cast by the sensors' own-thread casters
   CameraDirector cameras_;
   ScanFileWriter scan_files_;
   TickStats stats_;

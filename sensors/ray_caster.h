@@ -80,9 +80,12 @@ class RayCaster {
   // Rays cast since construction (frame statistics).
   std::int64_t rays_cast() const { return rays_cast_; }
 
+  // Runs job(k) for k = 0 .. count-1 over this caster's threads (the
+  // caller's too); returns when all are done. A job must not use this caster
+  // (the loop runs whole sensors so, each on a one-thread caster of its own).
+  void RunParallel(int count, const std::function<void(int)>& job);
+
  private:
-  // Runs job(chunk) for chunk = 0 .. chunks-1 over all threads; returns when done.
-  void RunParallel(int chunks, const std::function<void(int)>& job);
   void WorkerLoop();
 
   // Work hand-out: a job generation counter the workers watch (spinning a

@@ -3,6 +3,7 @@
 // in its current, bent shape and never itself. The reference for every
 // published face is a one-shot scan of a world holding only the other robot's
 // skinned mesh, posed from the same inputs (not the loop's collision pieces).
+// A third robot far away keeps more sensors due than the loop has threads.
 
 #include <gtest/gtest.h>
 
@@ -34,11 +35,11 @@ namespace fs = std::filesystem;
 constexpr int kSteps = 4;
 constexpr int kBoneValues = 45;  // the wing: root, R1-R10, L1-L10 two angles each; E1-E3 one
 
-std::string WingTable(const std::string& name) {
+std::string WingTable(const std::string& name, const std::string& position = "[0, 0, 0]") {
   const std::string file =
       (fs::path(SANDBOX_SOURCE_DIR) / "assets/robots/generated/flying_wing.gltf").string();
-  return "[[robot]]\nname = \"" + name + "\"\nfile = \"" + file +
-         "\"\n"
+  return "[[robot]]\nname = \"" + name + "\"\nfile = \"" + file + "\"\nposition = " + position +
+         "\n"
          "bones = [\"root\", \"R1\", \"R2\", \"R3\", \"R4\", \"R5\", \"R6\", \"R7\", \"R8\", "
          "\"R9\", \"R10\", \"L1\", \"L2\", \"L3\", \"L4\", \"L5\", \"L6\", \"L7\", \"L8\", "
          "\"L9\", \"L10\", \"E1\", \"E2\", \"E3\"]\n"
@@ -185,7 +186,8 @@ void Compare(const sandbox_msgs::scan_face_t& message, const scene::CollisionWor
 TEST(ManyRobotsTest, EachRobotsScannerSeesTheOtherBentAndNeverItself) {
   sandbox::testing::TempDir dir;
   const fs::path manifest =
-      dir.Write("course.toml", "[level]\nname = \"course\"\n" + WingTable("A") + WingTable("B"));
+      dir.Write("course.toml", "[level]\nname = \"course\"\n" + WingTable("A") + WingTable("B") +
+                                   WingTable("C", "[500, 500, 60]"));
   const std::string course = (dir.path() / "course.lcmlog").string();
   const std::string record = (dir.path() / "out.lcmlog").string();
   WriteCourse(course);
@@ -197,7 +199,9 @@ TEST(ManyRobotsTest, EachRobotsScannerSeesTheOtherBentAndNeverItself) {
       << run.out;
 
   const scene::Level level = scene::LoadLevel(manifest);
-  ASSERT_EQ(level.robots.size(), 2u);
+  // C, far away and never moved, makes three sensors due each tick: the loop
+  // runs them at once on its two threads (sandbox_loop.cc).
+  ASSERT_EQ(level.robots.size(), 3u);
   sensors::FaceScannerConfig config;
   config.resolution_m = 0.5;
   config.half_extent_m = 20.0;
@@ -222,7 +226,9 @@ TEST(ManyRobotsTest, EachRobotsScannerSeesTheOtherBentAndNeverItself) {
   Comparison against_bent[2], against_straight[2];
   lcm::LogFile log(record, "r");
   ASSERT_TRUE(log.good());
+  int c_faces = 0;
   while (const lcm::LogEvent* event = log.readNextEvent()) {
+    c_faces += event->channel == "C/SCAN_FACE";
     const int r = event->channel == "A/SCAN_FACE" ? 0 : event->channel == "B/SCAN_FACE" ? 1 : -1;
     if (r < 0) continue;
     sandbox_msgs::scan_face_t face;
@@ -232,6 +238,7 @@ TEST(ManyRobotsTest, EachRobotsScannerSeesTheOtherBentAndNeverItself) {
     Compare(face, *bent_world[{r, k}], scanner, &against_bent[r]);
     Compare(face, *straight_world[{r, k}], scanner, &against_straight[r]);
   }
+  EXPECT_EQ(c_faces, 6 * 2 * kSteps);  // a full scan each tick
   for (int r = 0; r < 2; ++r) {
     SCOPED_TRACE(r == 0 ? "A's scanner" : "B's scanner");
     EXPECT_EQ(against_bent[r].faces, 6 * kSteps);

@@ -175,7 +175,9 @@ TEST_F(RayCasterTest, OneCasterFollowsEveryChangeOfTheWorld) {
     for (std::size_t i = 0; i < rays.size(); ++i) {
       changed += after.body[i] != before.body[i] || after.distance_m[i] != before.distance_m[i];
     }
-    if (c < 2) EXPECT_GT(changed, 0) << "change " << c << " moved nothing the rays see";
+    if (c < 2) {
+      EXPECT_GT(changed, 0) << "change " << c << " moved nothing the rays see";
+    }
     before = after;
   }
 }
