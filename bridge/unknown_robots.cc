@@ -16,10 +16,12 @@ void Deliver(const lcm::ReceiveBuffer*, const std::string& channel, UnknownRobot
 UnknownRobots::UnknownRobots(LcmLink& link, const std::vector<std::string>& prefixes,
                              RejectLog* log)
     : link_(link), log_(log) {
+  std::string robots;
   for (const std::string& prefix : prefixes) {
     known_.insert(prefix + "/POSE");
-    robots_ += (robots_.empty() ? "" : ", ") + prefix;
+    robots += (robots.empty() ? "" : ", ") + prefix;
   }
+  reason_ = "a pose for a robot this level does not have; its robots are " + robots;
   // LCM matches the whole channel name against the expression.
   lcm::Subscription* subscription = link_.impl().lcm.subscribeFunction(".*/POSE", &Deliver, this);
   if (subscription == nullptr) throw std::runtime_error("UnknownRobots: cannot subscribe");
@@ -38,8 +40,7 @@ void UnknownRobots::OnPose(const std::string& channel) {
   const std::string key = counted_apart ? channel : "(other channels)";
   ++poses_[key];
   if (log_ != nullptr) {
-    log_->Note(Printable(key, 64),
-               "a pose for a robot this level does not have; its robots are " + robots_);
+    log_->Note(Printable(key, 64), reason_);
   }
 }
 

@@ -38,7 +38,7 @@ class UnknownRobots {
  private:
   LcmLink& link_;
   std::set<std::string> known_;  // "<PREFIX>/POSE" of each robot
-  std::string robots_;           // the prefixes, for the message
+  std::string reason_;           // the logged reason, naming the robots there are
   RejectLog* log_;
   void* subscription_{nullptr};
   std::map<std::string, std::int64_t> poses_;
