@@ -62,6 +62,7 @@ int CameraDirector::Direct(const Shot& shot, FramePipeline* frames, bool write, 
       job.actor_poses.push_back(shot.world->actor_pose(int(a)));
     }
     job.robot_pose = state.pose();
+    job.terrain = shot.terrain;
     if (run.camera->overlay != (shown && controls_.overlay))
       AddOverlay(run, shot, &job);  // 'o' flips
     frames->Submit(std::move(job));

@@ -35,6 +35,7 @@ class CameraDirector {
     std::vector<const bridge::RobotFeed*> feeds;  // steering and camera choice
     const scene::CollisionWorld* world{nullptr};
     const std::vector<sensors::Sensor>* sensors{nullptr};  // face scans for overlays
+    std::shared_ptr<const scene::TileList> terrain;        // the terrain tiles to draw
   };
   // Moves every camera and submits the due ones to `frames` (null: none):
   // all of them when `write`, the live view's when `live`. Returns the jobs submitted.

@@ -132,6 +132,7 @@ void FramePipeline::RenderLoop() {
     std::vector<const scene::RobotState*> robots;
     for (const scene::RobotState& state : job.robots) robots.push_back(&state);
     try {
+      renderer->SetTerrain(job.terrain);
       renderer->Render(job.view, job.actor_poses, robots, {}, &item.frame, &job.overlay);
     } catch (const std::exception& e) {
       Fail("camera " + job.camera + ": " + e.what());

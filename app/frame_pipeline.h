@@ -60,6 +60,7 @@ struct RenderJob {
   std::vector<Eigen::Isometry3d> actor_poses;
   Eigen::Isometry3d robot_pose{Eigen::Isometry3d::Identity()};  // for the index
   render::Overlay overlay;                                      // empty: none
+  std::shared_ptr<const scene::TileList> terrain;               // null: none
   bool write{true};                                             // to the output folder
   bool show{false};  // to FramePipelineConfig::show (the live view)
 };

@@ -103,8 +103,7 @@ int RunPose(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     return 2;
   }
   try {
-    const LoadedLevel loaded =
-        LoadCheckedLevel(
+    const LoadedLevel loaded = LoadCheckedLevel(
         level_file, {},
         parsed->flags.count("--isolate") > 0 ? Isolation::kAlways : Isolation::kSceneFiles);
     const scene::Level& level = loaded.level;

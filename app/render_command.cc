@@ -131,10 +131,19 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
     } else {
       view.X_WC = X_at;
     }
+    if (level.terrain) view.far_m = 1.0e6;  // to the horizon
     view.ValidateOrThrow();
     const auto start = std::chrono::steady_clock::now();
     std::unique_ptr<render::Renderer> renderer = render::MakeRenderer();
     renderer->SetLevel(level, OpenCvTextureDecoder(level.limits));
+    if (level.terrain) {  // the tiles around the camera, all of them in before the picture
+      scene::TerrainStreamer terrain(level);
+      terrain.Update({view.X_WC.translation()}, 0.0, nullptr, scene::TerrainStreamer::Wait::kAll);
+      for (const std::string& message : terrain.TakeMessages()) {
+        err << "sandbox render: " << message << "\n";
+      }
+      renderer->SetTerrain(terrain.drawn());
+    }
     for (const std::string& warning : renderer->warnings())
       err << "sandbox render: warning: " << warning << "\n";
     render::Frame frame;

@@ -36,8 +36,8 @@ void ParseFrames(const std::string& text, FramePipelineConfig* config) {
 }  // namespace
 
 const std::set<std::string> kRunValueOptions = {
-    "--rate", "--duration", "--lcm-url", "--replay",      "--record",
-    "--out",  "--frames",   "--depth",   "--scans-every", "--realtime", "--ticks"};
+    "--rate",   "--duration", "--lcm-url",     "--replay",   "--record", "--out",
+    "--frames", "--depth",    "--scans-every", "--realtime", "--ticks"};
 const std::set<std::string> kRunFlags = {"--lockstep", "--view", "--isolate", "--no-sensors",
                                          "--frames-only"};
 
@@ -102,8 +102,9 @@ RunOptions ParseRunOptions(const ParsedArgs& args) {
     const bool writes_frames = !options.out_dir.empty() && (!options.frames.image_format.empty() ||
                                                             !options.frames.video_format.empty());
     if (!writes_frames && !options.view) {
-      throw UsageError("--frames-only renders the cameras: it needs --out DIR (with --frames "
-                       "other than none) or --view");
+      throw UsageError(
+          "--frames-only renders the cameras: it needs --out DIR (with --frames "
+          "other than none) or --view");
     }
     if (!options.record_file.empty() || options.scans_every_s > 0.0) {
       throw UsageError("--frames-only publishes and scans nothing: no --record or --scans-every");

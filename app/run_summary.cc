@@ -54,6 +54,19 @@ bool ReportRun(const RunRecord& run, std::ostream& out, std::ostream& err) {
     out << "  floating origin: moved " << run.origin_moves << " times, longest "
         << run.longest_origin_move_ms << " ms, now at (" << run.origin.transpose() << ")\n";
   }
+  if (run.terrain) {
+    const scene::TerrainStreamer::Figures& f = *run.terrain;
+    out << "  terrain: " << f.built << " tiles built (" << f.fine_built << " fine), " << f.dropped
+        << " dropped, " << f.failed << " failed; build longest " << f.longest_build_ms
+        << " ms, swap longest " << f.longest_swap_ms << " ms; peak " << f.peak_resident_tiles
+        << " tiles, " << (f.peak_resident_bytes >> 20) << " MB";
+    if (options.lockstep) {
+      out << "; waited " << f.waits << " times, longest " << f.longest_wait_ms << " ms";
+    } else {
+      out << "; late " << f.late << " times";
+    }
+    out << "\n";
+  }
   if (!options.out_dir.empty()) {
     // Files that cannot be finished (a full disk) are reported; the run's results stand.
     const std::filesystem::path dir = options.out_dir;

@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -40,6 +41,7 @@ struct RunRecord {
   std::vector<const bridge::RobotFeed*> feeds;
   std::vector<std::int64_t> published;  // messages each robot published, as feeds
   const bridge::UnknownRobots* unknown_robots{nullptr};
+  std::optional<scene::TerrainStreamer::Figures> terrain;  // a level with [[terrain]]
 };
 
 // A replay's progress bar, on one line of `err`: read, ticks, ticks/s, time left.

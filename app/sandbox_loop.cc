@@ -65,6 +65,7 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
       cameras_(level_, loaded_.cameras),
       stats_(PrepareOutDir(options)) {
   if (!options_.record_file.empty()) link_.RecordTo(options_.record_file);
+  if (level_.terrain) terrain_ = std::make_unique<scene::TerrainStreamer>(level_);
   robots_.resize(level_.robots.size());
   for (std::size_t r = 0; r < level_.robots.size(); ++r) {
     RobotRun& robot = robots_[r];
@@ -200,8 +201,9 @@ void SandboxLoop::Tick(double wall_s, double drain_budget_s, TickRecord* record)
   if (hooks_.before_tick) hooks_.before_tick(link_, wall_s);
   std::int64_t now = bridge::NowUtime();
   const double t = ApplyInputs(wall_s, drain_budget_s, &now, record);  // 1-2
-  if (options_.sensors) RunDueSensors(t, now);                         // 3, and 4: their outputs
-  if (options_.publish) PublishStates(now);                            // 4
+  if (terrain_) StreamTerrain(t);
+  if (options_.sensors) RunDueSensors(t, now);  // 3, and 4: their outputs
+  if (options_.publish) PublishStates(now);     // 4
   WriteDueScans(t);
   DirectCameras(t, record);                          // 5
   if (options_.publish) PublishStatusIfDue(t, now);  // 4
@@ -270,6 +272,17 @@ double SandboxLoop::ApplyInputs(double wall_s, double drain_budget_s, std::int64
                        : wall_s;
   for (RobotRun& robot : robots_) robot.history.Add(t, robot.state->pose());
   return t;
+}
+
+void SandboxLoop::StreamTerrain(double t) {
+  robot_positions_.clear();
+  for (const RobotRun& robot : robots_)
+    robot_positions_.push_back(robot.state->pose().translation());
+  terrain_->Update(
+      robot_positions_, t, &world_,
+      options_.lockstep ? scene::TerrainStreamer::Wait::kAll : scene::TerrainStreamer::Wait::kNone);
+  for (const std::string& message : terrain_->TakeMessages())
+    err_ << "sandbox: " << message << "\n";
 }
 
 void SandboxLoop::RunDueSensors(double t, std::int64_t now_utime) {
@@ -357,6 +370,7 @@ void SandboxLoop::DirectCameras(double t, TickRecord* record) {
   }
   shot_.t_s = t;
   shot_.tick = tick_;
+  if (terrain_) shot_.terrain = terrain_->drawn();
   record->frames += cameras_.Direct(shot_, frames_.get(), write_frames_, live_view_ != nullptr);
 }
 
@@ -414,6 +428,7 @@ bool SandboxLoop::Report(double elapsed_s) {
     run.published.push_back(robot.outputs->published());
   }
   run.unknown_robots = unknown_robots_.get();
+  if (terrain_) run.terrain = terrain_->figures();
   return ReportRun(run, out_, err_);
 }
 

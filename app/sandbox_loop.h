@@ -42,6 +42,7 @@
 #include "scene/collision_world.h"
 #include "scene/level.h"
 #include "scene/robot_state.h"
+#include "scene/terrain_streamer.h"
 #include "sensors/pose_history.h"
 #include "sensors/ray_caster.h"
 #include "sensors/sensor.h"
@@ -93,6 +94,8 @@ class SandboxLoop {
   void Tick(double wall_s, double drain_budget_s, TickRecord* record);
   double ApplyInputs(double wall_s, double drain_budget_s, std::int64_t* now_utime,
                      TickRecord* record);
+  // Terrain tiles near the robots in, far ones out (lock-step: waits for them).
+  void StreamTerrain(double t);
   void RunDueSensors(double t, std::int64_t now_utime);
   void PublishStates(std::int64_t now_utime);
   void WriteDueScans(double t);
@@ -113,6 +116,8 @@ class SandboxLoop {
   const LoadedLevel loaded_;
   const scene::Level& level_{loaded_.level};
   scene::CollisionWorld world_;
+  std::unique_ptr<scene::TerrainStreamer> terrain_;  // when the level has [[terrain]]
+  std::vector<Eigen::Vector3d> robot_positions_;
   std::unique_ptr<bridge::LogReader> log_;
   bridge::LcmLink link_;
   sensors::RayCaster caster_;

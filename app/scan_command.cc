@@ -113,8 +113,7 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     const double res = resolution.empty() ? 1.0 : Positive(resolution, "--resolution");
     const double extent = half_extent.empty() ? 25.0 : Positive(half_extent, "--half-extent");
 
-    const LoadedLevel loaded =
-        LoadCheckedLevel(
+    const LoadedLevel loaded = LoadCheckedLevel(
         level_file, {},
         parsed->flags.count("--isolate") > 0 ? Isolation::kAlways : Isolation::kSceneFiles);
     const scene::Level& level = loaded.level;

@@ -33,7 +33,8 @@ struct Translation {
   // A pose given in this convention as the world pose X_WB of a robot body.
   // `position` is (x, y, z) in the convention, or (lat_deg, lon_deg, alt_m)
   // for kGeodetic; `q` is the body's attitude (w, x, y, z) in the convention's
-  // frame (local NED for kGeodetic).
+  // frame (local NED for kGeodetic). Geodetic points go through
+  // scene/geodetic.h, as the terrain loader's do.
   Eigen::Isometry3d ToWorld(const Eigen::Vector3d& position, const Eigen::Quaterniond& q) const;
   // The inverse: a world pose as the convention's position and attitude.
   void FromWorld(const Eigen::Isometry3d& X_WB, Eigen::Vector3d* position,
@@ -42,9 +43,5 @@ struct Translation {
 
 // Aerospace attitude: R = Rz(yaw) Ry(pitch) Rx(roll) of body FRD in NED, radians.
 Eigen::Quaterniond NedAttitude(double roll_rad, double pitch_rad, double yaw_rad);
-
-// WGS84 geodetic to earth-centred earth-fixed metres, and back.
-Eigen::Vector3d GeodeticToEcef(double latitude_deg, double longitude_deg, double altitude_m);
-Eigen::Vector3d EcefToGeodetic(const Eigen::Vector3d& p_ecef);  // (lat_deg, lon_deg, alt_m)
 
 }  // namespace sandbox::bridge

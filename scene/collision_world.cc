@@ -36,6 +36,7 @@ CollisionWorld::CollisionWorld(const Level& level) : impl_(std::make_unique<Impl
   Impl& w = *impl_;
   w.broadphase.m_deferedcollide = true;  // no overlap search when objects are added
   w.num_actors = static_cast<int>(level.actors.size());
+  w.terrain_actor = level.terrain_actor;
   w.objects_of_body.resize(level.actors.size() + level.robots.size());
   for (std::size_t a = 0; a < level.actors.size(); ++a) {
     const Actor& actor = level.actors[a];
@@ -165,6 +166,40 @@ void CollisionWorld::SetOrigin(const Eigen::Vector3d& p_WO) {
   for (std::size_t b = 0; b < impl_->X_W.size(); ++b) impl_->Place(static_cast<int>(b), p_WO_);
   ++revision_;
 }
+
+std::shared_ptr<CollisionWorld::PreparedTile> CollisionWorld::PrepareTile(
+    std::shared_ptr<const TerrainTile> tile) {
+  auto prepared = std::make_shared<PreparedTile>();
+  const Eigen::Isometry3d X_AT(Eigen::Translation3d(tile->origin_W));
+  prepared->objects = Impl::MakeObjects(-1, {{&tile->positions, &tile->indices}}, X_AT);
+  for (MeshObject& object : prepared->objects) object.tile = tile->id.key() + 1;
+  prepared->tile = std::move(tile);
+  return prepared;
+}
+
+void CollisionWorld::AddTile(std::shared_ptr<PreparedTile> tile) {
+  Impl& w = *impl_;
+  if (w.terrain_actor < 0)
+    throw std::logic_error("CollisionWorld::AddTile(): the level has no terrain");
+  const std::uint64_t key = tile->tile->id.key();
+  RemoveTile(key);
+  for (MeshObject& object : tile->objects) {
+    object.object->setUserIndex(w.terrain_actor);
+    w.Add(std::move(object), static_cast<int>(kWorldStatic));
+  }
+  w.tiles[key + 1] = tile->tile;
+  w.Place(w.terrain_actor, p_WO_);
+  ++revision_;
+}
+
+bool CollisionWorld::RemoveTile(std::uint64_t key) {
+  if (!impl_->RemoveTile(key + 1)) return false;
+  impl_->tiles.erase(key + 1);
+  ++revision_;
+  return true;
+}
+
+int CollisionWorld::num_tiles() const { return static_cast<int>(impl_->tiles.size()); }
 
 int CollisionWorld::num_collision_objects() const {
   return static_cast<int>(impl_->objects.size());

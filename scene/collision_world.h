@@ -24,6 +24,8 @@
 
 namespace sandbox::scene {
 
+struct TerrainTile;
+
 // Collision channels; a ray's mask selects which it sees.
 enum CollisionGroup : std::uint32_t {
   kWorldStatic = 1u << 0,
@@ -78,6 +80,17 @@ class CollisionWorld {
   // Moves the floating origin to `p_WO` (world coordinates kept in double).
   void SetOrigin(const Eigen::Vector3d& p_WO);
   const Eigen::Vector3d& origin() const { return p_WO_; }
+
+  // Terrain tiles (scene/terrain_streamer.h): a tile's objects are made by
+  // PrepareTile on any thread (building their BVH takes milliseconds), then
+  // added between ticks by AddTile (microseconds). They belong to the level's
+  // terrain actor (Level::terrain_actor): rays report it. AddTile throws
+  // std::logic_error when the level has no terrain.
+  struct PreparedTile;
+  static std::shared_ptr<PreparedTile> PrepareTile(std::shared_ptr<const TerrainTile> tile);
+  void AddTile(std::shared_ptr<PreparedTile> tile);
+  bool RemoveTile(std::uint64_t key);  // false when no such tile is in
+  int num_tiles() const;
 
   int num_collision_objects() const;
   int num_parts() const;  // Bullet mesh parts over all shapes

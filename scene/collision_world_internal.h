@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "scene/collision_world.h"
+#include "scene/terrain_tile.h"
 
 namespace sandbox::scene {
 
@@ -45,6 +46,14 @@ struct MeshObject {
   std::unique_ptr<btBvhTriangleMeshShape> shape;
   std::unique_ptr<btCollisionObject> object;
   Eigen::Isometry3d X_BO{Eigen::Isometry3d::Identity()};  // in its body's frame
+  std::uint64_t tile{0};  // a terrain tile's key (TileId::key() + 1), 0 for the rest
+};
+
+// A terrain tile's objects, built off the loop thread; the tile's arrays are
+// what Bullet reads.
+struct CollisionWorld::PreparedTile {
+  std::shared_ptr<const TerrainTile> tile;
+  std::vector<MeshObject> objects;
 };
 
 // A rigid piece of a robot's collision body: the triangles that mostly follow
@@ -73,6 +82,8 @@ struct CollisionWorld::Impl {
   std::vector<bool> movable;                      // actors only
   int num_actors{0};
   int num_parts{0};
+  int terrain_actor{-1};  // the body of the terrain tiles (Level::terrain_actor)
+  std::map<std::uint64_t, std::shared_ptr<const TerrainTile>> tiles;  // by key + 1
   // Robots: their models and rigid pieces (Bullet reads the pieces' arrays).
   std::vector<const RobotModel*> robot_models;
   std::vector<std::vector<std::unique_ptr<RobotPiece>>> robot_pieces;
@@ -86,6 +97,46 @@ struct CollisionWorld::Impl {
   std::vector<int> AddBody(int body, const std::vector<MeshArrays>& meshes, int group,
                            const Eigen::Isometry3d& X_BO = Eigen::Isometry3d::Identity()) {
     std::vector<int> added;
+    for (MeshObject& object : MakeObjects(body, meshes, X_BO)) {
+      added.push_back(Add(std::move(object), group));
+    }
+    return added;
+  }
+
+  // Adds an object made by MakeObjects; returns its index in `objects`.
+  int Add(MeshObject object, int group) {
+    world.addCollisionObject(object.object.get(), group, static_cast<int>(kAllGroups));
+    num_parts += object.mesh_interface->getNumSubParts();
+    const int body = object.object->getUserIndex();
+    objects_of_body[static_cast<std::size_t>(body)].push_back(static_cast<int>(objects.size()));
+    objects.push_back(std::move(object));
+    return static_cast<int>(objects.size()) - 1;
+  }
+
+  // Removes the objects of terrain tile `tile` (MeshObject::tile); false when none.
+  bool RemoveTile(std::uint64_t tile) {
+    bool removed = false;
+    for (std::size_t i = objects.size(); i-- > 0;) {
+      if (objects[i].tile != tile) continue;
+      world.removeCollisionObject(objects[i].object.get());
+      num_parts -= objects[i].mesh_interface->getNumSubParts();
+      objects.erase(objects.begin() + std::ptrdiff_t(i));
+      removed = true;
+    }
+    if (!removed) return false;
+    for (std::vector<int>& list : objects_of_body) list.clear();
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+      objects_of_body[static_cast<std::size_t>(objects[i].object->getUserIndex())].push_back(
+          static_cast<int>(i));
+    }
+    return true;
+  }
+
+  // The objects over `meshes` (split to Bullet's limits), their BVHs built, not
+  // yet in the world: any thread may make them.
+  static std::vector<MeshObject> MakeObjects(int body, const std::vector<MeshArrays>& meshes,
+                                             const Eigen::Isometry3d& X_BO) {
+    std::vector<MeshObject> made;
     std::vector<btIndexedMesh> parts;
     for (const MeshArrays& mesh : meshes) {
       const std::size_t triangles = mesh.indices->size() / 3;
@@ -113,13 +164,9 @@ struct CollisionWorld::Impl {
       object.object->setCollisionShape(object.shape.get());
       object.object->setUserIndex(body);
       object.X_BO = X_BO;
-      world.addCollisionObject(object.object.get(), group, static_cast<int>(kAllGroups));
-      num_parts += static_cast<int>(end - first);
-      objects_of_body[static_cast<std::size_t>(body)].push_back(static_cast<int>(objects.size()));
-      added.push_back(static_cast<int>(objects.size()));
-      objects.push_back(std::move(object));
+      made.push_back(std::move(object));
     }
-    return added;
+    return made;
   }
 
   void Place(int body, const Eigen::Vector3d& p_WO) {

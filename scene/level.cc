@@ -8,6 +8,7 @@
 #include "scene/files.h"
 #include "scene/heightmap.h"
 #include "scene/manifest.h"
+#include "scene/terrain_source.h"
 
 namespace sandbox::scene {
 namespace {
@@ -131,6 +132,33 @@ Level LoadManifest(const fs::path& file, const LoadOptions& options) {
     level.actors.push_back(std::move(actor));
     CheckTriangles(spec.file, level);
   }
+  if (manifest.terrain) {
+    // The rasters are opened and checked here; their tiles are read while running.
+    const TerrainSpec& spec = *manifest.terrain;
+    for (const fs::path& raster : spec.elevation) Reading(options, raster);
+    if (level.FindActor(spec.name) >= 0) {
+      throw LevelError(file.string() + ":" + std::to_string(spec.line) + ": terrain '" + spec.name +
+                       "': an [[actor]] has that name too");
+    }
+    const TerrainSource source(spec);
+    for (const std::string& problem : source.problems()) level.warnings.push_back(problem);
+    Actor actor;
+    actor.name = spec.name;
+    actor.source = spec.elevation.front().string();
+    level.terrain_actor = static_cast<int>(level.actors.size());
+    level.actors.push_back(std::move(actor));
+    level.terrain = spec;
+    if (manifest.horizon) {
+      level.horizon.emplace();
+      level.horizon->hole_W = source.InnerFootprint_W();
+    }
+  }
+  if (manifest.horizon) {
+    if (!level.horizon) level.horizon.emplace();
+    level.horizon->height_m = manifest.horizon->height_m;
+    level.horizon->rgb = manifest.horizon->rgb;
+    level.horizon->visibility_m = manifest.horizon->visibility_m;
+  }
   for (const RobotSpec& spec : manifest.robots) {
     Reading(options, spec.file);
     level.robots.push_back(LoadRobotModel(spec, file, &level));
@@ -201,6 +229,16 @@ Level LoadLevel(const fs::path& file, const LoadOptions& options) {
       LowerExtension(file) == ".toml" ? LoadManifest(file, options) : LoadSceneFile(file, options);
   CheckTriangles(file, level);
   for (Actor& actor : level.actors) ComputeBounds(&actor);
+  if (level.horizon && level.horizon->hole_W.isEmpty() && !level.bounds_W().isEmpty()) {
+    // Without rasters, the level's own ground is what its static actors cover.
+    Eigen::AlignedBox2d hole;
+    for (const Actor& actor : level.actors) {
+      if (!actor.movable && !actor.bounds_W.isEmpty()) {
+        hole.extend(actor.bounds_W.min().head<2>()).extend(actor.bounds_W.max().head<2>());
+      }
+    }
+    level.horizon->hole_W = hole;
+  }
   return level;
 }
 

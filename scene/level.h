@@ -18,6 +18,7 @@
 #include "scene/mesh.h"
 #include "scene/placement.h"
 #include "scene/robot_model.h"
+#include "scene/terrain_tile.h"
 
 namespace sandbox::scene {
 
@@ -34,6 +35,15 @@ struct Actor {
   std::size_t num_vertices() const;
 };
 
+// The ground beyond the level, drawn by cameras out to the horizon with the
+// Earth's curvature ([horizon] of a manifest), so that the world has no edge.
+struct Horizon {
+  double height_m{0.0};  // at the world origin; it falls away with distance
+  Eigen::Vector3f rgb{0.42f, 0.47f, 0.33f};
+  double visibility_m{0.0};  // the haze hides everything by this distance; 0: the renderer's
+  Eigen::AlignedBox2d hole_W;  // the level's own ground (x, y), left open
+};
+
 struct Level {
   std::filesystem::path file;
   std::string name;
@@ -41,6 +51,9 @@ struct Level {
   std::vector<Material> materials;
   std::vector<EmbeddedTexture> textures;
   std::vector<RobotModel> robots;     // declared by [[robot]] tables of a manifest
+  std::optional<TerrainSpec> terrain;  // elevation rasters streamed in tiles ([[terrain]])
+  int terrain_actor{-1};               // the actor terrain tiles belong to (no meshes of its own)
+  std::optional<Horizon> horizon;
   std::vector<std::string> warnings;  // problems that were handled, e.g. dropped faces
   LoadLimits limits;                  // what it was loaded within (textures are decoded later)
 

@@ -378,6 +378,74 @@ RobotSpec ParseRobot(const fs::path& file, const toml::table& table, int index) 
   return robot;
 }
 
+// One or more file names: a string or an array of strings.
+std::vector<fs::path> ParseFiles(const fs::path& file, TableReader& read, const std::string& key) {
+  std::vector<fs::path> files;
+  const toml::node* node = read.Find(key);
+  if (node == nullptr) return files;
+  if (node->is_string()) return {AssetPath(file, *node->value<std::string>())};
+  const toml::array* array = node->as_array();
+  if (array == nullptr) read.Fail(node, "'" + key + "' must be a file name or an array of them");
+  for (const toml::node& item : *array) {
+    if (!item.is_string()) read.Fail(&item, "'" + key + "' must hold file names (strings)");
+    files.push_back(AssetPath(file, *item.value<std::string>()));
+  }
+  return files;
+}
+
+TerrainSpec ParseTerrain(const fs::path& file, const toml::table& table, int index) {
+  TerrainSpec terrain;
+  terrain.line = static_cast<int>(table.source().begin.line);
+  terrain.name = ParseName(file, table, "terrain", index);
+  TableReader read(file, table, "terrain '" + terrain.name + "': ");
+  read.Find("name");
+  terrain.elevation = ParseFiles(file, read, "elevation");
+  if (terrain.elevation.empty()) {
+    read.Fail(nullptr, "'elevation' is required: the elevation raster(s), e.g. a GeoTIFF");
+  }
+  terrain.imagery = ParseFiles(file, read, "imagery");
+  const auto anchor = read.Numbers("anchor", 3);
+  if (!anchor) {
+    read.Fail(nullptr,
+              "'anchor' is required: [latitude_deg, longitude_deg, height_m] of the world origin");
+  }
+  if (std::abs((*anchor)[0]) > 90.0 || std::abs((*anchor)[1]) > 180.0) {
+    read.Fail(read.Find("anchor"), "'anchor' latitude must be within +-90 and longitude +-180");
+  }
+  terrain.anchor = {(*anchor)[0], (*anchor)[1], (*anchor)[2]};
+  auto whole = [&](const char* key, int low, int high, int* value) {
+    if (const auto set = read.Number(key)) {
+      if (*set < low || *set > high || *set != std::floor(*set)) {
+        read.Fail(read.Find(key), std::string("'") + key + "' must be a whole number from " +
+                                      std::to_string(low) + " to " + std::to_string(high));
+      }
+      *value = int(*set);
+    }
+  };
+  whole("tile_samples", 2, 4096, &terrain.tile_samples);
+  whole("coarse_factor", 1, 64, &terrain.coarse_factor);
+  whole("texture_px", 2, 4096, &terrain.texture_px);
+  if (terrain.tile_samples % terrain.coarse_factor != 0) {
+    read.Fail(read.Find("coarse_factor"), "'tile_samples' must be a multiple of 'coarse_factor'");
+  }
+  auto positive = [&](const char* key, double* value, bool zero_ok) {
+    if (const auto set = read.Number(key)) {
+      if (*set < 0.0 || (*set == 0.0 && !zero_ok)) {
+        read.Fail(read.Find(key), std::string("'") + key + "' must be positive");
+      }
+      *value = *set;
+    }
+  };
+  positive("collision_radius_m", &terrain.collision_radius_m, false);
+  positive("view_radius_m", &terrain.view_radius_m, false);
+  positive("prefetch_s", &terrain.prefetch_s, true);
+  if (terrain.view_radius_m < terrain.collision_radius_m) {
+    read.Fail(read.Find("view_radius_m"), "'view_radius_m' must not be below 'collision_radius_m'");
+  }
+  read.RejectUnknownKeys();
+  return terrain;
+}
+
 // Every table of the array `key` ([[key]]), parsed by `parse`, with unique names.
 template <typename Spec, typename Parse>
 std::vector<Spec> ParseTables(const fs::path& file, TableReader& top, const std::string& key,
@@ -459,10 +527,39 @@ LevelManifest ParseManifestText(std::string_view text, const fs::path& file) {
 
   manifest.actors = ParseTables<ActorSpec>(file, top, "actor", ParseActor);
   manifest.robots = ParseTables<RobotSpec>(file, top, "robot", ParseRobot);
+  const std::vector<TerrainSpec> terrains =
+      ParseTables<TerrainSpec>(file, top, "terrain", ParseTerrain);
+  if (terrains.size() > 1) {
+    TableReader(file, root, "")
+        .Fail(top.Find("terrain"),
+              "one [[terrain]] table per level (list several rasters in its "
+              "'elevation' instead)");
+  }
+  if (!terrains.empty()) manifest.terrain = terrains.front();
+  if (const toml::node* horizon = top.Find("horizon")) {
+    if (!horizon->is_table()) top.Fail(horizon, "'horizon' must be a table: [horizon]");
+    TableReader read(file, *horizon->as_table(), "[horizon]: ");
+    HorizonSpec spec;
+    if (const auto height = read.Number("height_m")) spec.height_m = *height;
+    if (const auto rgb = read.Numbers("rgb", 3)) {
+      if ((rgb->array() < 0.0).any() || (rgb->array() > 1.0).any()) {
+        read.Fail(read.Find("rgb"), "'rgb' values must be within 0 and 1");
+      }
+      spec.rgb = rgb->cast<float>();
+    }
+    if (const auto visibility = read.Number("visibility_m")) {
+      if (*visibility <= 0.0)
+        read.Fail(read.Find("visibility_m"), "'visibility_m' must be positive");
+      spec.visibility_m = *visibility;
+    }
+    read.RejectUnknownKeys();
+    manifest.horizon = spec;
+  }
   top.RejectUnknownKeys();
-  if (manifest.actors.empty() && manifest.robots.empty()) {
-    throw LevelError(file.string() +
-                     ": the manifest places nothing (add [[actor]] or [[robot]] tables)");
+  if (manifest.actors.empty() && manifest.robots.empty() && !manifest.terrain) {
+    throw LevelError(
+        file.string() +
+        ": the manifest places nothing (add [[actor]], [[robot]] or [[terrain]] tables)");
   }
   return manifest;
 }

@@ -12,6 +12,7 @@
 #include "scene/load_limits.h"
 #include "scene/placement.h"
 #include "scene/robot_model.h"
+#include "scene/terrain_tile.h"
 
 namespace sandbox::scene {
 
@@ -27,12 +28,21 @@ struct ActorSpec {
   int line{0};  // where the table starts, for messages
 };
 
+// The [horizon] table: the ground beyond the level, drawn to the horizon.
+struct HorizonSpec {
+  double height_m{0.0};
+  Eigen::Vector3f rgb{0.42f, 0.47f, 0.33f};
+  double visibility_m{0.0};  // 0: the renderer's own haze distance
+};
+
 struct LevelManifest {
   std::filesystem::path file;
   std::string name;
   LoadLimits limits;  // the defaults, or what [level] sets
   std::vector<ActorSpec> actors;
   std::vector<RobotSpec> robots;
+  std::optional<TerrainSpec> terrain;  // [[terrain]] (at most one)
+  std::optional<HorizonSpec> horizon;  // [horizon]
 };
 
 // The largest manifest read (a manifest is a few KB; this is no LoadLimits key).

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <set>
 #include <stdexcept>
 #include <tuple>
 
@@ -79,6 +80,34 @@ const char* kOverlayFragmentShader = R"(#version 450 core
 in vec3 mark_rgb;
 out vec4 color;
 void main() { color = vec4(mark_rgb, 1.0); }
+)";
+
+// The sky: a full-screen triangle behind everything, light at the horizon
+// (the haze colour, so distant ground fades into it), deeper overhead, with the sun's disc.
+const char* kSkyVertexShader = R"(#version 450 core
+out vec2 ndc;
+void main() {
+  ndc = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);
+  gl_Position = vec4(ndc, 0.0, 1.0);
+}
+)";
+
+const char* kSkyFragmentShader = R"(#version 450 core
+in vec2 ndc;
+uniform mat4 clip_to_world;  // directions: clip to camera-centred world
+uniform vec3 horizon;
+uniform vec3 zenith;
+uniform vec3 sun;
+out vec4 color;
+void main() {
+  vec4 far_point = clip_to_world * vec4(ndc, 0.5, 1.0);
+  vec3 d = normalize(far_point.xyz / far_point.w);
+  float up = clamp(d.z, 0.0, 1.0);
+  vec3 c = mix(horizon, zenith, pow(up, 0.6));
+  float s = dot(d, sun);
+  c = mix(c, vec3(1.0, 0.98, 0.9), smoothstep(0.99985, 0.99995, s));
+  color = vec4(c, 1.0);
+}
 )";
 
 GLuint Compile(GLenum type, const char* source) {
@@ -211,6 +240,12 @@ class OsMesaRenderer : public Renderer {
     program_ = Link(kVertexShader, kFragmentShader);
     overlay_program_ = Link(kOverlayVertexShader, kOverlayFragmentShader);
     overlay_view_proj_ = glGetUniformLocation(overlay_program_, "view_proj");
+    // GL 4.5 calls libOSMesa does not export are found through it.
+    clip_control_ = reinterpret_cast<PFNGLCLIPCONTROLPROC>(OSMesaGetProcAddress("glClipControl"));
+    if (clip_control_ == nullptr) throw std::runtime_error("Renderer: no glClipControl");
+    sky_program_ = Link(kSkyVertexShader, kSkyFragmentShader);
+    const char* sky_names[] = {"clip_to_world", "horizon", "zenith", "sun"};
+    for (int i = 0; i < 4; ++i) sky_uniforms_[i] = glGetUniformLocation(sky_program_, sky_names[i]);
     glGenVertexArrays(1, &overlay_vao_);
     glGenBuffers(2, overlay_buffers_);
     auto location = [&](const char* name) { return glGetUniformLocation(program_, name); };
@@ -224,6 +259,7 @@ class OsMesaRenderer : public Renderer {
   void SetLevel(const scene::Level& level, const TextureDecoder& decoder) override {
     level_ = &level;
     MergeStatic(level);
+    BuildHorizon(level);
     for (std::size_t a = 0; a < level.actors.size(); ++a) {
       if (!level.actors[a].movable) continue;  // merged above
       for (const scene::Mesh& mesh : level.actors[a].meshes) {
@@ -277,12 +313,14 @@ class OsMesaRenderer : public Renderer {
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
     glViewport(0, 0, view.width, view.height);
     glClearColor(settings.sky_rgb.x(), settings.sky_rgb.y(), settings.sky_rgb.z(), 1.f);
+    clip_control_(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+    glClearDepth(0.0);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glDepthFunc(GL_GREATER);
     glEnable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
     glEnable(GL_BLEND);
     glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-    glUseProgram(program_);
 
     // Camera-centred world: rotation only in the view; positions relative to the camera.
     const Eigen::Vector3d camera = view.X_WC.translation();
@@ -292,19 +330,30 @@ class OsMesaRenderer : public Renderer {
     view_rotation.topLeftCorner<3, 3>() = R_EyeCam * view.X_WC.linear().transpose();
     const double f = 1.0 / std::tan(0.5 * view.fov_y_rad),
                  aspect = double(view.width) / view.height;
+    // Reversed depth: 1 at near, 0 at far (with a float buffer, even precision over the range).
     const double n = view.near_m, fa = view.far_m;
     Eigen::Matrix4d projection = Eigen::Matrix4d::Zero();
     projection(0, 0) = f / aspect;
     projection(1, 1) = f;
-    projection(2, 2) = (fa + n) / (n - fa);
-    projection(2, 3) = 2.0 * fa * n / (n - fa);
+    projection(2, 2) = n / (fa - n);
+    projection(2, 3) = fa * n / (fa - n);
     projection(3, 2) = -1.0;
-    const Eigen::Matrix4f view_proj = (projection * view_rotation).cast<float>();
-    glUniformMatrix4fv(uniforms_.view_proj, 1, GL_FALSE, view_proj.data());
+    const Eigen::Matrix4d view_proj_d = projection * view_rotation;
+    const Eigen::Matrix4f view_proj = view_proj_d.cast<float>();
     const Eigen::Vector3f sun = settings.sun_direction_W.normalized();
+    DrawSky(view_proj_d.inverse().cast<float>(), settings.sky_rgb, sun);
+    glUseProgram(program_);
+    glUniformMatrix4fv(uniforms_.view_proj, 1, GL_FALSE, view_proj.data());
     glUniform3f(uniforms_.sun, sun.x(), sun.y(), sun.z());
     glUniform3f(uniforms_.sky, settings.sky_rgb.x(), settings.sky_rgb.y(), settings.sky_rgb.z());
-    glUniform2f(uniforms_.fog, settings.fog_start_m, settings.fog_end_m);
+    // The haze: the level's visibility when it gives one.
+    const bool default_fog = settings.fog_end_m == RenderSettings{}.fog_end_m;
+    const double visibility = level_->horizon ? level_->horizon->visibility_m : 0.0;
+    if (default_fog && visibility > 0.0) {
+      glUniform2f(uniforms_.fog, float(0.1 * visibility), float(visibility));
+    } else {
+      glUniform2f(uniforms_.fog, settings.fog_start_m, settings.fog_end_m);
+    }
     glUniform1i(uniforms_.base_texture, 0);
     glUniform1i(uniforms_.lightmap, 1);
 
@@ -313,6 +362,12 @@ class OsMesaRenderer : public Renderer {
     const Eigen::Matrix4f static_model =
         Relative(Eigen::Affine3d(Eigen::Translation3d(origin_)), camera);
     const Eigen::Matrix4f static_clip = view_proj * static_model;
+    if (horizon_.index_count > 0) {
+      const Eigen::Vector3f& rgb = level_->horizon->rgb;
+      DrawWith(horizon_, static_model, Eigen::Vector4f(rgb.x(), rgb.y(), rgb.z(), 1.f), 0);
+      glDrawElements(GL_TRIANGLES, horizon_.index_count, GL_UNSIGNED_INT, nullptr);
+    }
+    DrawTerrain(view_proj, camera);
     for (const bool translucent : {false, true}) {
       for (const auto& [bounds, mesh] : static_meshes_) {
         if (IsTranslucent(mesh.material) != translucent || !InFrustum(static_clip, bounds))
@@ -370,12 +425,14 @@ class OsMesaRenderer : public Renderer {
               pixels_[4 * (src + std::size_t(x)) + std::size_t(c)];
         const double d = depth_[src + std::size_t(x)];
         frame->depth_m[dst + std::size_t(x)] =
-            d >= 1.0 ? std::numeric_limits<float>::infinity()
-                     : float(2.0 * n * fa / (fa + n - (2.0 * d - 1.0) * (fa - n)));
+            d <= 0.0 ? std::numeric_limits<float>::infinity() : float(n * fa / (d * (fa - n) + n));
       }
     }
   }
 
+  void SetTerrain(std::shared_ptr<const scene::TileList> tiles) override {
+    terrain_ = std::move(tiles);
+  }
   const std::vector<std::string>& warnings() const override { return warnings_; }
   std::string description() const override { return description_; }
 
@@ -452,6 +509,170 @@ class OsMesaRenderer : public Renderer {
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wrap);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wrap);
     return id;
+  }
+
+  // A mesh with its own colour and texture (0: none), all of it.
+  void DrawWith(const GpuMesh& mesh, const Eigen::Matrix4f& model, const Eigen::Vector4f& color,
+                GLuint texture) {
+    glUniformMatrix4fv(uniforms_.model, 1, GL_FALSE, model.data());
+    glUniform4f(uniforms_.base_color, color.x(), color.y(), color.z(), color.w());
+    glUniform1i(uniforms_.has_texture, texture != 0 && mesh.uvs != 0);
+    glUniform1i(uniforms_.has_lightmap, 0);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, texture);
+    glBindVertexArray(mesh.vao);
+  }
+
+  void DrawSky(const Eigen::Matrix4f& clip_to_world, const Eigen::Vector3f& horizon,
+               const Eigen::Vector3f& sun) {
+    glUseProgram(sky_program_);
+    glUniformMatrix4fv(sky_uniforms_[0], 1, GL_FALSE, clip_to_world.data());
+    glUniform3f(sky_uniforms_[1], horizon.x(), horizon.y(), horizon.z());
+    const Eigen::Vector3f zenith = 0.55f * horizon + Eigen::Vector3f(0.02f, 0.08f, 0.25f);
+    glUniform3f(sky_uniforms_[2], zenith.x(), zenith.y(), zenith.z());
+    glUniform3f(sky_uniforms_[3], sun.x(), sun.y(), sun.z());
+    glDepthMask(GL_FALSE);
+    glDisable(GL_DEPTH_TEST);
+    glBindVertexArray(overlay_vao_);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glEnable(GL_DEPTH_TEST);
+    glDepthMask(GL_TRUE);
+  }
+
+  // Terrain tiles: uploaded when first seen, freed when gone; a coarse tile
+  // leaves out the blocks a fine tile covers.
+  void DrawTerrain(const Eigen::Matrix4f& view_proj, const Eigen::Vector3d& camera) {
+    std::map<const scene::TerrainTile*, TileGpu> kept;
+    std::set<std::uint64_t> fine;
+    if (terrain_) {
+      for (const auto& tile : *terrain_) {
+        if (tile->id.lod == 0) fine.insert(tile->id.key());
+      }
+    }
+    const int factor = level_->terrain ? level_->terrain->coarse_factor : 1;
+    const Eigen::Vector4f plain(level_->horizon ? level_->horizon->rgb.x() : 0.45f,
+                                level_->horizon ? level_->horizon->rgb.y() : 0.5f,
+                                level_->horizon ? level_->horizon->rgb.z() : 0.35f, 1.f);
+    for (const auto& tile : terrain_ ? *terrain_ : scene::TileList{}) {
+      auto found = tile_gpu_.find(tile.get());
+      TileGpu gpu;
+      if (found != tile_gpu_.end()) {
+        gpu = found->second;
+        tile_gpu_.erase(found);
+      } else {
+        gpu = UploadTile(*tile);
+      }
+      kept[tile.get()] = gpu;
+      if (tile->indices.empty() || tile->bounds_W.isEmpty()) continue;
+      const Eigen::AlignedBox3f box((tile->bounds_W.min() - camera).cast<float>(),
+                                    (tile->bounds_W.max() - camera).cast<float>());
+      if (!InFrustum(view_proj, box)) continue;
+      const Eigen::Matrix4f model =
+          Relative(Eigen::Affine3d(Eigen::Translation3d(tile->origin_W)), camera);
+      DrawWith(gpu.mesh, model, gpu.texture ? Eigen::Vector4f(1.f, 1.f, 1.f, 1.f) : plain,
+               gpu.texture);
+      // Index ranges: the surface (coarse: without the blocks fine tiles cover), the skirts.
+      std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges;
+      if (tile->id.lod == 0) {
+        ranges.push_back({0, std::uint32_t(tile->indices.size())});
+      } else {
+        for (int k = 0; k + 1 < int(tile->block_first.size()); ++k) {
+          const scene::TileId under{0, tile->id.file, tile->id.tx * factor + k % factor,
+                                    tile->id.ty * factor + k / factor};
+          if (fine.count(under.key())) continue;
+          const std::uint32_t a = tile->block_first[std::size_t(k)],
+                              b = tile->block_first[std::size_t(k) + 1];
+          if (!ranges.empty() && ranges.back().second == a) {
+            ranges.back().second = b;
+          } else if (b > a) {
+            ranges.push_back({a, b});
+          }
+        }
+      }
+      ranges.push_back({std::uint32_t(tile->indices.size()),
+                        std::uint32_t(tile->indices.size() + tile->skirt_indices.size())});
+      for (const auto& [a, b] : ranges) {
+        if (b <= a) continue;
+        glDrawElements(GL_TRIANGLES, GLsizei(b - a), GL_UNSIGNED_INT,
+                       reinterpret_cast<const void*>(std::uintptr_t(a) * 4));
+      }
+    }
+    for (auto& [tile, gpu] : tile_gpu_) Free(gpu);
+    tile_gpu_.swap(kept);
+  }
+
+  struct TileGpu {
+    GpuMesh mesh;
+    GLuint texture{0};
+  };
+
+  TileGpu UploadTile(const scene::TerrainTile& tile) {
+    std::vector<std::uint32_t> indices = tile.indices;
+    indices.insert(indices.end(), tile.skirt_indices.begin(), tile.skirt_indices.end());
+    TileGpu gpu;
+    gpu.mesh = Upload(tile.positions, tile.normals, tile.uvs, {}, indices, -1, GL_STATIC_DRAW);
+    if (!tile.texture_rgba.empty()) {
+      gpu.texture = UploadTexture({tile.texture_width, tile.texture_height, tile.texture_rgba},
+                                  GL_CLAMP_TO_EDGE);
+    }
+    return gpu;
+  }
+
+  static void Free(const TileGpu& gpu) {
+    const GpuMesh& m = gpu.mesh;
+    const GLuint buffers[] = {m.positions, m.normals, m.uvs, m.lightmap_uvs, m.indices};
+    for (const GLuint buffer : buffers) {
+      if (buffer != 0) glDeleteBuffers(1, &buffer);
+    }
+    glDeleteVertexArrays(1, &m.vao);
+    if (gpu.texture != 0) glDeleteTextures(1, &gpu.texture);
+  }
+
+  // The ground beyond the level: a grid around the level's hole, its cells
+  // growing with distance out to 1000 km, falling away with the Earth's curvature.
+  void BuildHorizon(const scene::Level& level) {
+    if (!level.horizon || level.horizon->hole_W.isEmpty()) return;
+    const scene::Horizon& h = *level.horizon;
+    constexpr double kExtent_m = 1.0e6;
+    auto axis = [&](double lo, double hi) {
+      std::vector<double> out;
+      for (double d = 500.0 * (1.5 - 1.0), k = 1.5; lo - d > -kExtent_m;
+           k *= 1.5, d = 500.0 * (k - 1.0)) {
+        out.insert(out.begin(), lo - d);
+      }
+      out.insert(out.begin(), -kExtent_m);
+      for (int i = 0; i <= 8; ++i) out.push_back(lo + (hi - lo) * i / 8.0);
+      for (double d = 500.0 * (1.5 - 1.0), k = 1.5; hi + d < kExtent_m;
+           k *= 1.5, d = 500.0 * (k - 1.0)) {
+        out.push_back(hi + d);
+      }
+      out.push_back(kExtent_m);
+      return out;
+    };
+    const std::vector<double> xs = axis(h.hole_W.min().x(), h.hole_W.max().x());
+    const std::vector<double> ys = axis(h.hole_W.min().y(), h.hole_W.max().y());
+    std::vector<Eigen::Vector3f> positions, normals;
+    std::vector<std::uint32_t> indices;
+    for (const double y : ys) {
+      for (const double x : xs) {
+        const double drop = (x * x + y * y) / (2.0 * scene::kEarthRadius_m);
+        positions.push_back((Eigen::Vector3d(x, y, h.height_m - drop) - origin_).cast<float>());
+        normals.push_back(
+            Eigen::Vector3d(-x / scene::kEarthRadius_m, -y / scene::kEarthRadius_m, 1.0)
+                .normalized()
+                .cast<float>());
+      }
+    }
+    const std::uint32_t nx = std::uint32_t(xs.size());
+    for (std::uint32_t j = 0; j + 1 < ys.size(); ++j) {
+      for (std::uint32_t i = 0; i + 1 < nx; ++i) {
+        const Eigen::Vector2d centre(0.5 * (xs[i] + xs[i + 1]), 0.5 * (ys[j] + ys[j + 1]));
+        if (h.hole_W.contains(centre)) continue;
+        const std::uint32_t a = j * nx + i, b = a + 1, c = a + nx, d = c + 1;
+        for (const std::uint32_t v : {a, b, d, a, d, c}) indices.push_back(v);
+      }
+    }
+    horizon_ = Upload(positions, normals, {}, {}, indices, -1, GL_STATIC_DRAW);
   }
 
   void Draw(const GpuMesh& mesh, const Eigen::Matrix4f& model) {
@@ -551,6 +772,12 @@ class OsMesaRenderer : public Renderer {
   std::vector<std::pair<Eigen::AlignedBox3f, GpuMesh>> static_meshes_;
   std::vector<std::pair<int, GpuMesh>> actor_meshes_;  // movable actors'
   std::map<const scene::RobotModel*, std::vector<GpuMesh>> robot_meshes_;
+  std::shared_ptr<const scene::TileList> terrain_;
+  std::map<const scene::TerrainTile*, TileGpu> tile_gpu_;
+  GpuMesh horizon_;
+  GLuint sky_program_{0};
+  PFNGLCLIPCONTROLPROC clip_control_{nullptr};
+  GLint sky_uniforms_[4]{-1, -1, -1, -1};
   std::map<int, GLuint> textures_;   // by material
   std::map<int, GLuint> lightmaps_;  // by material
   std::vector<std::string> warnings_;

@@ -1,7 +1,10 @@
 #pragma once
 // Offscreen rendering of the world (OSMesa, OpenGL 4.5 core, llvmpipe): level
-// meshes with their base colours and textures, the robots skinned as posed,
-// a directional sun, sky colour and distance fog; colour and depth read back.
+// meshes with their base colours and textures, terrain tiles with their
+// imagery, the robots skinned as posed, a directional sun, a sky with a
+// horizon gradient, the ground beyond the level out to the horizon and
+// distance haze; colour and depth read back. Depth is reversed (1 near, 0
+// far, in a float buffer): precise from 0.1 m to hundreds of kilometres.
 // GL stays inside renderer.cc; nothing else sees a GL header (the types it
 // takes and gives are in view.h).
 //
@@ -17,6 +20,7 @@
 
 #include "scene/level.h"
 #include "scene/robot_state.h"
+#include "scene/terrain_streamer.h"
 #include "sensors/render/view.h"
 
 namespace sandbox::render {
@@ -52,6 +56,9 @@ class Renderer {
                       const std::vector<const scene::RobotState*>& robots,
                       const RenderSettings& settings, Frame* frame,
                       const Overlay* overlay = nullptr) = 0;
+  // Terrain tiles to draw from the next Render on (scene/terrain_streamer.h):
+  // uploaded when first seen, freed when no longer given.
+  virtual void SetTerrain(std::shared_ptr<const scene::TileList> tiles) = 0;
   virtual const std::vector<std::string>& warnings() const = 0;
   virtual std::string description() const = 0;  // "OpenGL 4.5 (Core Profile) Mesa ... llvmpipe"
 };

@@ -6,6 +6,8 @@
 
 #include <cmath>
 
+#include "scene/geodetic.h"
+
 namespace sandbox::bridge {
 namespace {
 
@@ -75,10 +77,11 @@ TEST(TranslationTest, GeodeticLocalTangentPlane) {
   EXPECT_NEAR(geo.ToWorld(Vector3d(47.0, 8.0, 600.0), NedAttitude(0, 0, 0)).translation().z(),
               100.0, 1e-6);
   // Round trip through ECEF.
-  const Vector3d back = EcefToGeodetic(GeodeticToEcef(47.123, 8.456, 1234.5));
-  EXPECT_NEAR(back.x(), 47.123, 1e-9);
-  EXPECT_NEAR(back.y(), 8.456, 1e-9);
-  EXPECT_NEAR(back.z(), 1234.5, 1e-4);
+  const scene::GeodeticPoint back =
+      scene::EcefToGeodetic(scene::GeodeticToEcef({47.123, 8.456, 1234.5}));
+  EXPECT_NEAR(back.latitude_deg, 47.123, 1e-9);
+  EXPECT_NEAR(back.longitude_deg, 8.456, 1e-9);
+  EXPECT_NEAR(back.height_m, 1234.5, 1e-4);
   Vector3d p;
   Quaterniond q;
   geo.FromWorld(north, &p, &q);

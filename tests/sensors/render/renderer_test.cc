@@ -63,8 +63,18 @@ TEST_F(RendererTest, SkyAboveTerrainBelow) {
   Frame frame;
   const RenderSettings settings;
   renderer_->Render(view, {}, {}, settings, &frame);
+  // The sky's gradient: the haze colour at the horizon, deeper with elevation
+  // (renderer.cc: zenith = 0.55 horizon + (0.02, 0.08, 0.25), weight sin(elevation)^0.6);
+  // the top row's centre looks up by atan(tan(fov / 2) * (1 - 2.5 / 240)).
   const std::uint8_t* top = Pixel(frame, 320, 2);
-  for (int c = 0; c < 3; ++c) EXPECT_NEAR(top[c], std::lround(255 * settings.sky_rgb[c]), 1) << c;
+  const double elevation = std::atan(std::tan(0.5 * view.fov_y_rad) * (1.0 - 2.5 / 240.0));
+  const double w = std::pow(std::sin(elevation), 0.6);
+  const Eigen::Vector3d horizon = settings.sky_rgb.cast<double>();
+  const Eigen::Vector3d zenith = 0.55 * horizon + Eigen::Vector3d(0.02, 0.08, 0.25);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(top[c], 255 * ((1 - w) * horizon[c] + w * zenith[c]), 1.5) << c;
+  }
+  EXPECT_LT(top[0], 255 * horizon[0] - 20);  // deeper than the horizon
   const std::uint8_t* bottom = Pixel(frame, 320, 470);
   EXPECT_GT(bottom[1], bottom[0]);  // the terrain's green
   EXPECT_GT(bottom[1], bottom[2]);
@@ -277,11 +287,6 @@ TEST(RendererTextureTest, CesiumManShowsItsEmbeddedTextureColours) {
   // Where the man is drawn (not sky), lighting scales a colour but keeps its
   // chromaticity: textured pixels take the texture's, many of them; the plain
   // render has the one base colour.
-  const RenderSettings sky;
-  auto is_sky = [&](const std::uint8_t* p) {
-    return std::abs(p[0] - 255 * sky.sky_rgb.x()) < 3 &&
-           std::abs(p[1] - 255 * sky.sky_rgb.y()) < 3 && std::abs(p[2] - 255 * sky.sky_rgb.z()) < 3;
-  };
   auto near_texture = [&](int bin) {
     for (int dr = -1; dr <= 1; ++dr) {
       for (int dg = -1; dg <= 1; ++dg) {
@@ -296,7 +301,10 @@ TEST(RendererTextureTest, CesiumManShowsItsEmbeddedTextureColours) {
     for (int column = 0; column < view.width; ++column) {
       const std::uint8_t* t = Pixel(textured, column, row);
       const std::uint8_t* p = Pixel(plain, column, row);
-      if (is_sky(t)) continue;
+      if (std::isinf(
+              textured.depth_m[std::size_t(row) * std::size_t(view.width) + std::size_t(column)])) {
+        continue;  // sky
+      }
       const int bin = ChromaBin(t[0], t[1], t[2]);
       if (bin < 0) continue;
       ++drawn;
@@ -400,10 +408,9 @@ TEST(RendererWingTest, BendingMovesTheSilhouetteToTheAnalyticTip) {
   }
   const Vector3d tip = X * Vector3d(-0.15, -0.6, 0.0);  // half an element inside the tip
   const Eigen::Vector2d px = Project(view, tip);
-  const RenderSettings sky;
   auto is_sky = [&](const Frame& frame) {
-    const std::uint8_t* p = Pixel(frame, int(px.x()), int(px.y()));
-    return std::abs(p[0] - 255 * sky.sky_rgb[0]) < 3 && std::abs(p[2] - 255 * sky.sky_rgb[2]) < 3;
+    return std::isinf(
+        frame.depth_m[std::size_t(px.y()) * std::size_t(frame.width) + std::size_t(px.x())]);
   };
   EXPECT_FALSE(is_sky(frame_bent)) << px.transpose();     // the bent tip is drawn there
   EXPECT_TRUE(is_sky(frame_straight)) << px.transpose();  // the straight wing is not

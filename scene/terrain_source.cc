@@ -1,0 +1,431 @@
+#include "scene/terrain_source.h"
+
+#include <cpl_conv.h>
+#include <cpl_error.h>
+#include <gdal.h>
+#include <ogr_srs_api.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <stdexcept>
+
+#include "scene/level.h"
+
+namespace sandbox::scene {
+namespace {
+
+// GDAL's own messages go to its last-error slot instead of stderr while one lives.
+struct QuietGdal {
+  QuietGdal() {
+    static std::once_flag registered;
+    std::call_once(registered, [] { GDALAllRegister(); });
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    CPLErrorReset();
+  }
+  ~QuietGdal() { CPLPopErrorHandler(); }
+  static std::string Last(const std::string& otherwise) {
+    const char* message = CPLGetLastErrorMsg();
+    return message != nullptr && *message != '\0' ? std::string(message) : otherwise;
+  }
+};
+
+}  // namespace
+
+struct TerrainSource::Raster {
+  std::filesystem::path path;
+  GDALDatasetH dataset{nullptr};
+  double gt[6]{0, 1, 0, 0, 0, 1};  // sample (col, row) corner -> raster coordinates
+  double inverse[6]{0, 1, 0, 0, 0, 1};
+  int cols{0}, rows{0}, bands{0};
+  bool has_nodata{false};
+  double nodata{0.0};
+  OGRSpatialReferenceH crs{nullptr}, wgs84{nullptr};
+  OGRCoordinateTransformationH to_lonlat{nullptr}, from_lonlat{nullptr};
+  Eigen::Vector2d metres_per_sample{1.0, 1.0};
+
+  ~Raster() {
+    if (to_lonlat) OCTDestroyCoordinateTransformation(to_lonlat);
+    if (from_lonlat) OCTDestroyCoordinateTransformation(from_lonlat);
+    if (crs) OSRDestroySpatialReference(crs);
+    if (wgs84) OSRDestroySpatialReference(wgs84);
+    if (dataset) GDALClose(dataset);
+  }
+
+  // Raster coordinates of the centre of sample (col, row).
+  Eigen::Vector2d Geo(double col, double row) const {
+    return {gt[0] + (col + 0.5) * gt[1] + (row + 0.5) * gt[2],
+            gt[3] + (col + 0.5) * gt[4] + (row + 0.5) * gt[5]};
+  }
+
+  // Opens `file`; "" or why it cannot serve.
+  std::string Open(const std::filesystem::path& file) {
+    path = file;
+    dataset = GDALOpen(file.c_str(), GA_ReadOnly);
+    if (dataset == nullptr) return QuietGdal::Last("GDAL cannot read it");
+    cols = GDALGetRasterXSize(dataset);
+    rows = GDALGetRasterYSize(dataset);
+    bands = GDALGetRasterCount(dataset);
+    if (bands < 1 || cols < 2 || rows < 2) return "no raster of at least 2 x 2 samples in it";
+    if (GDALGetGeoTransform(dataset, gt) != CE_None) {
+      return "it has no georeferencing (no geotransform): a world file or GeoTIFF tags are needed";
+    }
+    if (!GDALInvGeoTransform(gt, inverse)) return "its geotransform cannot be inverted";
+    const OGRSpatialReferenceH own = GDALGetSpatialRef(dataset);
+    if (own == nullptr) {
+      return "it has no georeferencing (no coordinate system): a GeoTIFF with its CRS, or a .prj, "
+             "is needed";
+    }
+    crs = OSRClone(own);
+    wgs84 = OSRNewSpatialReference(nullptr);
+    OSRSetWellKnownGeogCS(wgs84, "WGS84");
+    OSRSetAxisMappingStrategy(crs, OAMS_TRADITIONAL_GIS_ORDER);  // x = longitude / easting
+    OSRSetAxisMappingStrategy(wgs84, OAMS_TRADITIONAL_GIS_ORDER);
+    to_lonlat = OCTNewCoordinateTransformation(crs, wgs84);
+    from_lonlat = OCTNewCoordinateTransformation(wgs84, crs);
+    if (!to_lonlat || !from_lonlat) {
+      return "its coordinate system cannot be transformed to WGS84 (" +
+             QuietGdal::Last("no transformation") + ")";
+    }
+    int has = 0;
+    nodata = GDALGetRasterNoDataValue(GDALGetRasterBand(dataset, 1), &has);
+    has_nodata = has != 0;
+    return "";
+  }
+
+  // Longitude and latitude (degrees) of raster coordinates, in place; false per failed point.
+  void ToLonLat(std::vector<double>* x, std::vector<double>* y, std::vector<int>* ok) const {
+    ok->assign(x->size(), 0);
+    if (x->empty()) return;
+    OCTTransformEx(to_lonlat, int(x->size()), x->data(), y->data(), nullptr, ok->data());
+  }
+};
+
+TerrainSource::TerrainSource(const TerrainSpec& spec) : spec_(spec), plane_(spec.anchor) {
+  if (spec.tile_samples < 2 || spec.coarse_factor < 1 || spec.tile_samples % spec.coarse_factor) {
+    throw LevelError("[[terrain]] '" + spec.name + "': tile_samples (" +
+                     std::to_string(spec.tile_samples) +
+                     ") must be at least 2 and a multiple of coarse_factor (" +
+                     std::to_string(spec.coarse_factor) + ")");
+  }
+  const QuietGdal quiet;
+  for (const std::filesystem::path& file : spec.elevation) {
+    auto raster = std::make_unique<Raster>();
+    const std::string problem = raster->Open(file);
+    if (!problem.empty()) {
+      problems_.push_back(file.string() + ": " + problem + "; this raster is left out");
+      elevation_.push_back(nullptr);
+      continue;
+    }
+    // The spacing in metres, from neighbouring samples at the raster's centre.
+    const double c = 0.5 * raster->cols, r = 0.5 * raster->rows;
+    const Eigen::Vector3d p = SampleToWorldOf(*raster, c, r),
+                          px = SampleToWorldOf(*raster, c + 1, r),
+                          py = SampleToWorldOf(*raster, c, r + 1);
+    raster->metres_per_sample = {(px - p).norm(), (py - p).norm()};
+    elevation_.push_back(std::move(raster));
+  }
+  for (const std::filesystem::path& file : spec.imagery) {
+    auto raster = std::make_unique<Raster>();
+    const std::string problem = raster->Open(file);
+    if (!problem.empty()) {
+      problems_.push_back(file.string() + ": " + problem + "; the terrain is drawn without it");
+      continue;
+    }
+    imagery_.push_back(std::move(raster));
+  }
+}
+
+TerrainSource::~TerrainSource() = default;
+
+int TerrainSource::num_usable() const {
+  return int(std::count_if(elevation_.begin(), elevation_.end(),
+                           [](const auto& raster) { return raster != nullptr; }));
+}
+
+Eigen::Vector3d TerrainSource::SampleToWorldOf(const Raster& raster, double col, double row,
+                                               double height_m) const {
+  const Eigen::Vector2d geo = raster.Geo(col, row);
+  std::vector<double> x{geo.x()}, y{geo.y()};
+  std::vector<int> ok;
+  raster.ToLonLat(&x, &y, &ok);
+  return plane_.ToWorld({y[0], x[0], height_m});
+}
+
+Eigen::Vector3d TerrainSource::SampleToWorld(int file, int col, int row, double height_m) const {
+  const Raster* raster = elevation_.at(std::size_t(file)).get();
+  if (raster == nullptr) throw std::invalid_argument("TerrainSource: raster left out");
+  return SampleToWorldOf(*raster, col, row, height_m);
+}
+
+Eigen::Vector2d TerrainSource::ToSample(const Raster& raster, const Eigen::Vector3d& p_W) const {
+  const GeodeticPoint point = plane_.ToGeodetic(p_W);
+  double x = point.longitude_deg, y = point.latitude_deg;
+  int ok = 0;
+  OCTTransformEx(raster.from_lonlat, 1, &x, &y, nullptr, &ok);
+  if (!ok) return {std::numeric_limits<double>::quiet_NaN(), 0.0};
+  const double* g = raster.inverse;
+  return {g[0] + x * g[1] + y * g[2] - 0.5, g[3] + x * g[4] + y * g[5] - 0.5};
+}
+
+namespace {
+
+int TileSpan(const TerrainSpec& spec, int lod) {
+  return spec.tile_samples * (lod == 0 ? 1 : spec.coarse_factor);
+}
+
+// Tiles along one side: each has at least one cell.
+int TileCount(int samples, int span) { return (samples - 2) / span + 1; }
+
+}  // namespace
+
+void TerrainSource::TilesNear(const Eigen::Vector3d& p_W, int lod, double radius_m,
+                              std::vector<TileId>* out) const {
+  for (std::size_t f = 0; f < elevation_.size(); ++f) {
+    const Raster* raster = elevation_[f].get();
+    if (raster == nullptr) continue;
+    const Eigen::Vector2d s = ToSample(*raster, p_W);
+    if (!std::isfinite(s.x())) continue;
+    const int span = TileSpan(spec_, lod);
+    const double rx = radius_m / raster->metres_per_sample.x(),
+                 ry = radius_m / raster->metres_per_sample.y();
+    const int nx = TileCount(raster->cols, span), ny = TileCount(raster->rows, span);
+    const int x0 = std::max(0, int(std::floor((s.x() - rx) / span))),
+              x1 = std::min(nx - 1, int(std::floor((s.x() + rx) / span)));
+    const int y0 = std::max(0, int(std::floor((s.y() - ry) / span))),
+              y1 = std::min(ny - 1, int(std::floor((s.y() + ry) / span)));
+    for (int ty = y0; ty <= y1; ++ty) {
+      for (int tx = x0; tx <= x1; ++tx) {
+        const TileId id{lod, int(f), tx, ty};
+        if (DistanceTo(id, p_W) <= radius_m) out->push_back(id);
+      }
+    }
+  }
+}
+
+double TerrainSource::DistanceTo(const TileId& id, const Eigen::Vector3d& p_W) const {
+  const Raster* raster = elevation_.at(std::size_t(id.file)).get();
+  if (raster == nullptr) return std::numeric_limits<double>::infinity();
+  const Eigen::Vector2d s = ToSample(*raster, p_W);
+  if (!std::isfinite(s.x())) return std::numeric_limits<double>::infinity();
+  const int span = TileSpan(spec_, id.lod);
+  auto outside = [](double v, double lo, double hi) { return std::max({0.0, lo - v, v - hi}); };
+  const double dx = outside(s.x(), id.tx * span, std::min((id.tx + 1) * span, raster->cols - 1));
+  const double dy = outside(s.y(), id.ty * span, std::min((id.ty + 1) * span, raster->rows - 1));
+  return std::hypot(dx * raster->metres_per_sample.x(), dy * raster->metres_per_sample.y());
+}
+
+bool TerrainSource::Covers(const Eigen::Vector3d& p_W) const {
+  for (const auto& raster : elevation_) {
+    if (raster == nullptr) continue;
+    const Eigen::Vector2d s = ToSample(*raster, p_W);
+    if (s.x() >= 0.0 && s.y() >= 0.0 && s.x() <= raster->cols - 1 && s.y() <= raster->rows - 1) {
+      return true;
+    }
+  }
+  return false;
+}
+
+Eigen::AlignedBox2d TerrainSource::InnerFootprint_W() const {
+  Eigen::AlignedBox2d box;
+  for (const auto& raster : elevation_) {
+    if (raster == nullptr) continue;
+    const int inset = std::min({spec_.tile_samples, raster->cols / 4, raster->rows / 4});
+    const double c0 = inset, c1 = raster->cols - 1 - inset, r0 = inset,
+                 r1 = raster->rows - 1 - inset;
+    const Eigen::Vector3d nw = SampleToWorldOf(*raster, c0, r0),
+                          ne = SampleToWorldOf(*raster, c1, r0),
+                          sw = SampleToWorldOf(*raster, c0, r1),
+                          se = SampleToWorldOf(*raster, c1, r1);
+    // The box inside the four corners.
+    const Eigen::AlignedBox2d inner(
+        Eigen::Vector2d(std::max(nw.x(), sw.x()), std::max(sw.y(), se.y())),
+        Eigen::Vector2d(std::min(ne.x(), se.x()), std::min(nw.y(), ne.y())));
+    box.extend(inner);
+  }
+  return box;
+}
+
+double TerrainSource::fine_tile_m() const {
+  for (const auto& raster : elevation_) {
+    if (raster != nullptr) return raster->metres_per_sample.maxCoeff() * spec_.tile_samples;
+  }
+  return 0.0;
+}
+
+std::vector<int> TerrainSource::SampleSpan(int first, int last, int step) const {
+  std::vector<int> span;
+  for (int i = first; i <= last; i += step) span.push_back(i);
+  if (span.back() != last) span.push_back(last);
+  return span;
+}
+
+TerrainTile TerrainSource::Build(const TileId& id) const {
+  const auto start = std::chrono::steady_clock::now();
+  const Raster* raster = elevation_.at(std::size_t(id.file)).get();
+  if (raster == nullptr) throw std::runtime_error("TerrainSource::Build(): raster left out");
+  const QuietGdal quiet;
+  TerrainTile tile;
+  tile.id = id;
+  const int span = TileSpan(spec_, id.lod), step = id.lod == 0 ? 1 : spec_.coarse_factor;
+  const int c0 = id.tx * span, c1 = std::min(c0 + span, raster->cols - 1);
+  const int r0 = id.ty * span, r1 = std::min(r0 + span, raster->rows - 1);
+  if (c1 <= c0 || r1 <= r0) return tile;
+  const int w = c1 - c0 + 1, h = r1 - r0 + 1;
+  std::vector<float> heights(std::size_t(w) * std::size_t(h));
+  if (GDALRasterIO(GDALGetRasterBand(raster->dataset, 1), GF_Read, c0, r0, w, h, heights.data(), w,
+                   h, GDT_Float32, 0, 0) != CE_None) {
+    throw std::runtime_error(raster->path.string() + ": cannot read samples " + std::to_string(c0) +
+                             ".." + std::to_string(c1) + " x " + std::to_string(r0) + ".." +
+                             std::to_string(r1) + " (" + QuietGdal::Last("read error") + ")");
+  }
+  const std::vector<int> cols = SampleSpan(c0, c1, step), rows = SampleSpan(r0, r1, step);
+  const int nx = int(cols.size()), ny = int(rows.size());
+  const std::size_t n = std::size_t(nx) * std::size_t(ny);
+  // Raster coordinates -> longitude, latitude -> the world, in double.
+  std::vector<double> x(n), y(n);
+  std::vector<float> height(n);
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < nx; ++i) {
+      const std::size_t v = std::size_t(j) * std::size_t(nx) + std::size_t(i);
+      const Eigen::Vector2d geo = raster->Geo(cols[std::size_t(i)], rows[std::size_t(j)]);
+      x[v] = geo.x(), y[v] = geo.y();
+      height[v] = heights[std::size_t(rows[std::size_t(j)] - r0) * std::size_t(w) +
+                          std::size_t(cols[std::size_t(i)] - c0)];
+    }
+  }
+  std::vector<int> ok;
+  raster->ToLonLat(&x, &y, &ok);
+  std::vector<Eigen::Vector3d> p_W(n);
+  std::vector<char> valid(n);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int valid_count = 0;
+  for (std::size_t v = 0; v < n; ++v) {
+    valid[v] = ok[v] && std::isfinite(height[v]) &&
+               !(raster->has_nodata && double(height[v]) == raster->nodata);
+    p_W[v] = plane_.ToWorld({y[v], x[v], valid[v] ? double(height[v]) : 0.0});
+    if (valid[v]) sum += p_W[v], ++valid_count;
+  }
+  if (valid_count == 0) return tile;
+  tile.origin_W = (sum / valid_count).array().round().matrix();  // whole metres
+  tile.positions.resize(n);
+  tile.normals.resize(n);
+  for (std::size_t v = 0; v < n; ++v) {
+    tile.positions[v] = (p_W[v] - tile.origin_W).cast<float>();
+    if (valid[v]) tile.bounds_W.extend(p_W[v]);
+  }
+  auto at = [nx](int i, int j) { return std::size_t(j) * std::size_t(nx) + std::size_t(i); };
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < nx; ++i) {
+      const Eigen::Vector3d east =
+          p_W[at(std::min(i + 1, nx - 1), j)] - p_W[at(std::max(i - 1, 0), j)];
+      const Eigen::Vector3d north =
+          p_W[at(i, std::max(j - 1, 0))] - p_W[at(i, std::min(j + 1, ny - 1))];
+      Eigen::Vector3d normal = east.cross(north);
+      if (normal.z() < 0.0) normal = -normal;
+      tile.normals[at(i, j)] = normal.normalized().cast<float>();
+    }
+  }
+  // Two triangles a cell, counter-clockwise from above; coarse tiles grouped by fine tile.
+  const int blocks = id.lod == 0 ? 1 : spec_.coarse_factor;
+  std::vector<std::vector<std::uint32_t>> by_block(std::size_t(blocks * blocks));
+  for (int j = 0; j + 1 < ny; ++j) {
+    for (int i = 0; i + 1 < nx; ++i) {
+      const std::size_t a = at(i, j), b = at(i + 1, j), c = at(i, j + 1), d = at(i + 1, j + 1);
+      if (!valid[a] || !valid[b] || !valid[c] || !valid[d]) continue;
+      const int bx = std::min(blocks - 1, (cols[std::size_t(i)] - c0) / spec_.tile_samples);
+      const int by = std::min(blocks - 1, (rows[std::size_t(j)] - r0) / spec_.tile_samples);
+      std::vector<std::uint32_t>& out = by_block[std::size_t(by * blocks + bx)];
+      for (const std::size_t v : {c, d, b, c, b, a}) out.push_back(std::uint32_t(v));
+    }
+  }
+  for (const std::vector<std::uint32_t>& block : by_block) {
+    if (id.lod != 0) tile.block_first.push_back(std::uint32_t(tile.indices.size()));
+    tile.indices.insert(tile.indices.end(), block.begin(), block.end());
+  }
+  if (id.lod != 0) tile.block_first.push_back(std::uint32_t(tile.indices.size()));
+
+  // Imagery: the first raster under the tile's centre, read over the tile into one texture.
+  for (const auto& image : imagery_) {
+    std::vector<double> ix(n), iy(n);
+    std::vector<int> iok(n, 0);
+    for (std::size_t v = 0; v < n; ++v) ix[v] = x[v], iy[v] = y[v];
+    OCTTransformEx(image->from_lonlat, int(n), ix.data(), iy.data(), nullptr, iok.data());
+    Eigen::AlignedBox2d window;
+    std::vector<Eigen::Vector2d> pixel(n);
+    for (std::size_t v = 0; v < n; ++v) {
+      const double* g = image->inverse;
+      pixel[v] = {g[0] + ix[v] * g[1] + iy[v] * g[2], g[3] + ix[v] * g[4] + iy[v] * g[5]};
+      if (iok[v] && valid[v]) window.extend(pixel[v]);
+    }
+    if (window.isEmpty()) continue;
+    const double x0 = std::max(0.0, std::floor(window.min().x())),
+                 x1 = std::min(double(image->cols), std::ceil(window.max().x()));
+    const double y0 = std::max(0.0, std::floor(window.min().y())),
+                 y1 = std::min(double(image->rows), std::ceil(window.max().y()));
+    const Eigen::Vector2d centre = pixel[at(nx / 2, ny / 2)];
+    if (x1 - x0 < 1.0 || y1 - y0 < 1.0 || centre.x() < 0 || centre.y() < 0 ||
+        centre.x() > image->cols || centre.y() > image->rows) {
+      continue;
+    }
+    const int size = spec_.texture_px;
+    std::vector<std::uint8_t> rgb(std::size_t(size) * std::size_t(size) * 3);
+    GDALRasterIOExtraArg extra;
+    INIT_RASTERIO_EXTRA_ARG(extra);
+    extra.eResampleAlg = GRIORA_Bilinear;
+    int band_map[3] = {1, std::min(2, image->bands), std::min(3, image->bands)};
+    if (GDALDatasetRasterIOEx(image->dataset, GF_Read, int(x0), int(y0), int(x1 - x0), int(y1 - y0),
+                              rgb.data(), size, size, GDT_Byte, 3, band_map, 3, 3 * size, 1,
+                              &extra) != CE_None) {
+      throw std::runtime_error(image->path.string() + ": cannot read imagery (" +
+                               QuietGdal::Last("read error") + ")");
+    }
+    tile.texture_width = tile.texture_height = size;
+    tile.texture_rgba.resize(std::size_t(size) * std::size_t(size) * 4);
+    for (std::size_t t = 0; t < std::size_t(size) * std::size_t(size); ++t) {
+      for (int k = 0; k < 3; ++k)
+        tile.texture_rgba[4 * t + std::size_t(k)] = rgb[3 * t + std::size_t(k)];
+      tile.texture_rgba[4 * t + 3] = 255;
+    }
+    tile.uvs.resize(n);
+    for (std::size_t v = 0; v < n; ++v) {
+      tile.uvs[v] =
+          Eigen::Vector2d((pixel[v].x() - x0) / (x1 - x0), (pixel[v].y() - y0) / (y1 - y0))
+              .cast<float>();
+    }
+    break;
+  }
+
+  // Skirts: walls hanging from the edges, so that no crack between a fine and a
+  // coarse tile lets the sky through.
+  const double depth_m = std::max(20.0, 2.0 * step * raster->metres_per_sample.maxCoeff());
+  auto wall = [&](std::size_t u, std::size_t v) {
+    if (!valid[u] || !valid[v]) return;
+    const std::uint32_t first = std::uint32_t(tile.positions.size());
+    for (const std::size_t k : {u, v}) {
+      tile.positions.push_back(tile.positions[k] - Eigen::Vector3f(0.f, 0.f, float(depth_m)));
+      tile.normals.push_back(tile.normals[k]);
+      if (!tile.uvs.empty()) tile.uvs.push_back(tile.uvs[k]);
+    }
+    for (const std::uint32_t k :
+         {std::uint32_t(u), std::uint32_t(v), first + 1, std::uint32_t(u), first + 1, first}) {
+      tile.skirt_indices.push_back(k);
+    }
+  };
+  for (int i = 0; i + 1 < nx; ++i)
+    wall(at(i, 0), at(i + 1, 0)), wall(at(i, ny - 1), at(i + 1, ny - 1));
+  for (int j = 0; j + 1 < ny; ++j)
+    wall(at(0, j), at(0, j + 1)), wall(at(nx - 1, j), at(nx - 1, j + 1));
+  tile.build_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return tile;
+}
+
+std::size_t TerrainTile::bytes() const {
+  return positions.size() * 12 + normals.size() * 12 + uvs.size() * 8 +
+         (indices.size() + skirt_indices.size() + block_first.size()) * 4 + texture_rgba.size();
+}
+
+}  // namespace sandbox::scene

@@ -1,0 +1,72 @@
+#pragma once
+// The rasters of a [[terrain]] table, read with GDAL: where a world point lies
+// in them, which tiles are near it, and the tiles themselves, reprojected to
+// the world frame (the tangent plane at the anchor, scene/geodetic.h), each
+// relative to its own origin. Heights are taken as metres above the WGS84
+// ellipsoid, as the bridge's geodetic poses are.
+//
+// Threads: a TerrainSource belongs to the thread that made it (GDAL datasets
+// are not shared between threads); the streamer's worker has its own.
+
+#include <Eigen/Geometry>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "scene/terrain_tile.h"
+
+namespace sandbox::scene {
+
+class TerrainSource {
+ public:
+  // Opens every raster of `spec`. One GDAL cannot read, or without
+  // georeferencing, is left out and said in problems() ("FILE: why"); the
+  // others still serve. Throws LevelError for settings that cannot work
+  // (tile_samples not a multiple of coarse_factor, radii not positive).
+  explicit TerrainSource(const TerrainSpec& spec);
+  ~TerrainSource();
+  TerrainSource(const TerrainSource&) = delete;
+  TerrainSource& operator=(const TerrainSource&) = delete;
+
+  const TerrainSpec& spec() const { return spec_; }
+  const std::vector<std::string>& problems() const { return problems_; }
+  int num_usable() const;  // elevation rasters that serve
+
+  // The tiles of detail `lod` whose footprint comes within `radius_m`
+  // (horizontally) of `p_W`, appended to `out`.
+  void TilesNear(const Eigen::Vector3d& p_W, int lod, double radius_m,
+                 std::vector<TileId>* out) const;
+  // Horizontal distance from `p_W` to a tile's footprint (0 inside).
+  double DistanceTo(const TileId& id, const Eigen::Vector3d& p_W) const;
+  // True when `p_W` lies over some elevation raster.
+  bool Covers(const Eigen::Vector3d& p_W) const;
+  // The rasters' footprint in the world (x, y), without the outermost tile
+  // of samples: the ground beyond it is the horizon's (renderer).
+  Eigen::AlignedBox2d InnerFootprint_W() const;
+  // A fine tile's side in metres (about: the raster's sample spacing times tile_samples).
+  double fine_tile_m() const;
+
+  // Builds one tile: its surface, its skirts, its imagery. Throws
+  // std::runtime_error naming the file when the raster cannot be read there.
+  TerrainTile Build(const TileId& id) const;
+
+  // The world point of raster sample (col, row) of elevation raster `file`
+  // at its height; tests compare it against their own reading of the file.
+  Eigen::Vector3d SampleToWorld(int file, int col, int row, double height_m) const;
+
+ private:
+  struct Raster;
+  std::vector<int> SampleSpan(int first, int last, int step) const;
+  // Sample coordinates (col, row; NaN when it cannot be transformed) of a world point.
+  Eigen::Vector2d ToSample(const Raster& raster, const Eigen::Vector3d& p_W) const;
+  Eigen::Vector3d SampleToWorldOf(const Raster& raster, double col, double row,
+                                  double height_m = 0.0) const;
+
+  TerrainSpec spec_;
+  LocalTangentPlane plane_;
+  std::vector<std::unique_ptr<Raster>> elevation_;  // null where the file is left out
+  std::vector<std::unique_ptr<Raster>> imagery_;
+  std::vector<std::string> problems_;
+};
+
+}  // namespace sandbox::scene
