@@ -4,6 +4,8 @@
 #include <iomanip>
 #include <sstream>
 
+#include "app/process_stats.h"
+
 namespace sandbox::app {
 
 std::string PaceName(const RunOptions& options) {
@@ -65,7 +67,7 @@ bool ReportRun(const RunRecord& run, std::ostream& out, std::ostream& err) {
     } else {
       out << "; late " << f.late << " times";
     }
-    out << "\n";
+    out << "; process peak resident " << PeakResidentMiB() << " MiB\n";
   }
   if (!options.out_dir.empty()) {
     // Files that cannot be finished (a full disk) are reported; the run's results stand.

@@ -49,6 +49,28 @@ void ExampleFlight(double t, std::int64_t seq, std::int64_t utime, sandbox_msgs:
   for (int e = 0; e < 3; ++e) bones->values[std::size_t(42 + e)] = 0.2 * std::sin(2.0 * t + e);
 }
 
+void HighlandsFlight(double t, std::int64_t seq, std::int64_t utime,
+                     sandbox_msgs::robot_pose_t* pose, sandbox_msgs::bone_values_t* bones) {
+  constexpr double kScale_m = 12000.0, kCeiling_m = 20000.0;
+  const double x = kHighlandsSpeed_mps * std::max(0.0, t);
+  const double climb = std::exp(-x / kScale_m);
+  *pose = {};
+  pose->utime = utime;
+  pose->seq = seq;
+  pose->position[0] = x;
+  pose->position[1] = 0.0;
+  pose->position[2] = 2.0 + kCeiling_m * (1.0 - climb);
+  const double pitch = -std::atan(kCeiling_m / kScale_m * climb);  // nose up: negative about y
+  SetRpy(0.0, pitch, 0.0, pose->orientation);
+  *bones = {};
+  bones->utime = utime;
+  bones->seq = seq;
+  bones->num_values = 45;
+  bones->values.assign(45, 0.0);
+  const double bend = 0.02 + 0.04 * climb + 0.01 * std::sin(0.7 * t);
+  for (int b = 1; b <= 20; ++b) bones->values[std::size_t(2 * b)] = b <= 10 ? bend : -bend;
+}
+
 void WingmanFlight(int side, double t, std::int64_t seq, std::int64_t utime,
                    sandbox_msgs::robot_pose_t* pose, sandbox_msgs::bone_values_t* bones) {
   const double lag_s = 1.2, radius = kRadius_m + 12.0 * side;

@@ -35,6 +35,7 @@ RobotBridgeConfig RobotBridgeConfig::FromModel(const scene::RobotModel& model) {
                 "'geodetic_origin' must be [latitude_deg, longitude_deg, altitude_m]");
     }
     config.pose.origin = {origin[0], origin[1], origin[2]};
+    config.geodetic_origin_given = true;
   }
   config.stale_after_s = read.Number("stale_after_s", config.stale_after_s);
   if (!(config.stale_after_s > 0.0)) read.Fail("stale_after_s", "'stale_after_s' must be positive");
@@ -104,6 +105,21 @@ std::vector<RobotBridgeConfig> RobotBridgeConfigs(const scene::Level& level) {
   for (const scene::RobotModel& model : level.robots) {
     RobotBridgeConfig config = RobotBridgeConfig::FromModel(model);
     const scene::SettingsReader read(model.bridge);
+    if (level.terrain && config.pose.convention == Convention::kGeodetic) {
+      // Geodetic poses land on the terrain where its rasters say: one anchor for both.
+      const scene::GeodeticPoint& anchor = level.terrain->anchor;
+      const GeodeticOrigin terrain{anchor.latitude_deg, anchor.longitude_deg, anchor.height_m};
+      if (!config.geodetic_origin_given) {
+        config.pose.origin = terrain;
+      } else if (config.pose.origin.latitude_deg != terrain.latitude_deg ||
+                 config.pose.origin.longitude_deg != terrain.longitude_deg ||
+                 config.pose.origin.altitude_m != terrain.altitude_m) {
+        read.Fail("geodetic_origin",
+                  "'geodetic_origin' differs from the [[terrain]] anchor; leave it out (the "
+                  "anchor is taken) or make them equal, or poses will not land where the "
+                  "rasters say");
+      }
+    }
     if (const auto [it, fresh] = prefixes.emplace(config.channel_prefix, model.name); !fresh) {
       read.Fail("channel_prefix", "robot '" + model.name + "' would use the channel prefix '" +
                                       config.channel_prefix + "' of robot '" + it->second +

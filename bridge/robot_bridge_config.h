@@ -29,6 +29,7 @@ namespace sandbox::bridge {
 struct RobotBridgeConfig {
   std::string channel_prefix;
   Translation pose;
+  bool geodetic_origin_given{false};  // else, on a level with [[terrain]], its anchor
   double stale_after_s{0.5};
   bool state_in_pose_convention{false};
   std::string bind_address{"127.0.0.1"};

@@ -121,11 +121,11 @@ namespace {
 std::size_t ExpectedDoubles(const RobotBridgeConfig& config, int num_bone_values) {
   std::size_t expected = 0;
   for (const std::string& item : config.udp_doubles_layout) {
-    expected += item == "position"                  ? 3
-                : item == "quaternion"              ? 4
-                : item == "rpy"                     ? 3
-                : item == "time" || item == "seq"   ? 1
-                                                    : std::size_t(num_bone_values);
+    expected += item == "position"                ? 3
+                : item == "quaternion"            ? 4
+                : item == "rpy"                   ? 3
+                : item == "time" || item == "seq" ? 1
+                                                  : std::size_t(num_bone_values);
   }
   return expected;
 }

@@ -67,7 +67,9 @@ class NetFdmInput {
   bool Apply(scene::RobotState* state);
   // The applied packet's time: its cur_time (whole seconds since 1970) in
   // microseconds, -1 when it is 0. The format has no counter (seq -1).
-  PacketTag last_tag() const { return {-1, last_.cur_time > 0 ? 1'000'000LL * last_.cur_time : -1}; }
+  PacketTag last_tag() const {
+    return {-1, last_.cur_time > 0 ? 1'000'000LL * last_.cur_time : -1};
+  }
   const UdpLatest& socket() const { return socket_; }
   void set_log(RejectLog* log) { socket_.set_log(log); }
   const NetFdm& last_good() const { return last_; }

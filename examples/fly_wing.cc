@@ -7,7 +7,12 @@
 //
 //   fly_wing [--slot wing|left|right] [--rate HZ] [--duration S] [--poses N]
 //            [--lcm-url URL] [--robot NAME] [--log FILE] [--phase S]
+//            [--flight circle|highlands] [--write-log FILE]
 //
+// --write-log: publishes nothing; writes the flight to FILE as fast as it can,
+// stamped in flight time (a pose every 1/rate s), for `sandbox run --replay`.
+// --flight highlands: the wing over assets/highlands instead, climbing from the
+// airfield to 20 km while it crosses 100 km eastwards at 300 m/s.
 // --phase: fly S seconds ahead on the circle (robots spread along it).
 // --log: also writes every message it publishes to an LCM log (`sandbox run
 // --replay FILE` then runs the same inputs again).
@@ -29,7 +34,8 @@
 int main(int argc, char** argv) {
   double rate_hz = 100.0, duration_s = 10.0, phase_s = 0.0;
   long long poses = -1;
-  std::string url, robot, slot = "wing", log_file;
+  std::string url, robot, slot = "wing", log_file, flight = "circle";
+  bool offline = false;  // --write-log: the log only, in flight time, at once
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--rate"))
       rate_hz = std::atof(argv[i + 1]);
@@ -45,6 +51,10 @@ int main(int argc, char** argv) {
       slot = argv[i + 1];
     else if (!std::strcmp(argv[i], "--log"))
       log_file = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--write-log"))
+      log_file = argv[i + 1], offline = true;
+    else if (!std::strcmp(argv[i], "--flight"))
+      flight = argv[i + 1];
     else if (!std::strcmp(argv[i], "--phase"))
       phase_s = std::atof(argv[i + 1]);
     else {
@@ -53,14 +63,16 @@ int main(int argc, char** argv) {
     }
   }
   const int side = slot == "left" ? -1 : slot == "right" ? 1 : 0;
-  if (argc < 0 || argc % 2 == 0 || (side == 0 && slot != "wing") || !(rate_hz > 0.0)) {
+  if (argc < 0 || argc % 2 == 0 || (side == 0 && slot != "wing") || !(rate_hz > 0.0) ||
+      (flight != "circle" && flight != "highlands")) {
     std::fprintf(stderr,
                  "usage: fly_wing [--slot wing|left|right] [--rate HZ] [--duration S] [--poses N]\n"
-                 "                [--lcm-url URL] [--robot NAME] [--log FILE] [--phase S]\n");
+                 "                [--lcm-url URL] [--robot NAME] [--log FILE] [--phase S]\n"
+                 "                [--flight circle|highlands] [--write-log FILE]\n");
     return 2;
   }
   if (robot.empty()) robot = side < 0 ? "QUAD1" : side > 0 ? "QUAD2" : "ELAHA";
-  lcm::LCM lcm(url);
+  lcm::LCM lcm(offline ? "memq://" : url);
   if (!lcm.good()) {
     std::fprintf(stderr, "fly_wing: cannot open LCM URL '%s'\n", url.c_str());
     return 1;
@@ -75,7 +87,7 @@ int main(int argc, char** argv) {
   }
   auto publish = [&](const std::string& channel, std::vector<std::uint8_t>* bytes,
                      std::int64_t utime) {
-    lcm.publish(channel, bytes->data(), unsigned(bytes->size()));
+    if (!offline) lcm.publish(channel, bytes->data(), unsigned(bytes->size()));
     if (!log) return;
     lcm::LogEvent event{};
     event.timestamp = utime;
@@ -90,15 +102,24 @@ int main(int argc, char** argv) {
   auto next = start;
   std::int64_t seq = 0;
   for (;;) {
-    const double t = std::chrono::duration<double>(Clock::now() - start).count();
+    const double t = offline ? double(seq) / rate_hz
+                             : std::chrono::duration<double>(Clock::now() - start).count();
     if (t >= duration_s || seq == poses) break;
-    const std::int64_t utime = std::chrono::duration_cast<std::chrono::microseconds>(
-                                   std::chrono::system_clock::now().time_since_epoch())
-                                   .count();
+    static const std::int64_t start_utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                                                std::chrono::system_clock::now().time_since_epoch())
+                                                .count();
+    const std::int64_t utime = offline ? start_utime + std::int64_t(std::llround(t * 1e6))
+                                       : std::chrono::duration_cast<std::chrono::microseconds>(
+                                             std::chrono::system_clock::now().time_since_epoch())
+                                             .count();
     sandbox_msgs::robot_pose_t pose;
     sandbox_msgs::bone_values_t bones;
     if (side == 0) {  // the flight itself
-      sandbox::bridge::ExampleFlight(t + phase_s, seq, utime, &pose, &bones);
+      if (flight == "highlands") {
+        sandbox::bridge::HighlandsFlight(t + phase_s, seq, utime, &pose, &bones);
+      } else {
+        sandbox::bridge::ExampleFlight(t + phase_s, seq, utime, &pose, &bones);
+      }
     } else {
       sandbox::bridge::WingmanFlight(side, t + phase_s, seq, utime, &pose, &bones);
     }
@@ -111,6 +132,7 @@ int main(int argc, char** argv) {
     pose.encode(bytes.data(), 0, int(bytes.size()));
     publish(robot + "/POSE", &bytes, utime);
     ++seq;
+    if (offline) continue;
     next += std::chrono::duration_cast<Clock::duration>(period);
     std::this_thread::sleep_until(next);
   }

@@ -40,7 +40,7 @@ struct Actor {
 struct Horizon {
   double height_m{0.0};  // at the world origin; it falls away with distance
   Eigen::Vector3f rgb{0.42f, 0.47f, 0.33f};
-  double visibility_m{0.0};  // the haze hides everything by this distance; 0: the renderer's
+  double visibility_m{0.0};    // the haze hides everything by this distance; 0: the renderer's
   Eigen::AlignedBox2d hole_W;  // the level's own ground (x, y), left open
 };
 
@@ -50,7 +50,7 @@ struct Level {
   std::vector<Actor> actors;
   std::vector<Material> materials;
   std::vector<EmbeddedTexture> textures;
-  std::vector<RobotModel> robots;     // declared by [[robot]] tables of a manifest
+  std::vector<RobotModel> robots;      // declared by [[robot]] tables of a manifest
   std::optional<TerrainSpec> terrain;  // elevation rasters streamed in tiles ([[terrain]])
   int terrain_actor{-1};               // the actor terrain tiles belong to (no meshes of its own)
   std::optional<Horizon> horizon;

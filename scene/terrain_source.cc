@@ -21,7 +21,10 @@ namespace {
 struct QuietGdal {
   QuietGdal() {
     static std::once_flag registered;
-    std::call_once(registered, [] { GDALAllRegister(); });
+    std::call_once(registered, [] {
+      GDALAllRegister();
+      GDALSetCacheMax64(std::int64_t{64} << 20);  // its block cache (default: 5% of the memory)
+    });
     CPLPushErrorHandler(CPLQuietErrorHandler);
     CPLErrorReset();
   }
