@@ -58,10 +58,11 @@ bool ReportRun(const RunRecord& run, std::ostream& out, std::ostream& err) {
   }
   if (run.terrain) {
     const scene::TerrainStreamer::Figures& f = *run.terrain;
-    out << "  terrain: " << f.built << " tiles built (" << f.fine_built << " fine), " << f.dropped
-        << " dropped, " << f.failed << " failed; build longest " << f.longest_build_ms
-        << " ms, swap longest " << f.longest_swap_ms << " ms; peak " << f.peak_resident_tiles
-        << " tiles, " << (f.peak_resident_bytes >> 20) << " MB";
+    out << "  terrain: " << f.built << " tiles built (" << f.fine_built << " fine, " << f.from_cache
+        << " from the cache), " << f.dropped << " dropped, " << f.failed << " failed; build total "
+        << f.total_build_ms / 1e3 << " s, longest " << f.longest_build_ms << " ms, swap longest "
+        << f.longest_swap_ms << " ms; peak " << f.peak_resident_tiles << " tiles, "
+        << (f.peak_resident_bytes >> 20) << " MB";
     if (options.lockstep) {
       out << "; waited " << f.waits << " times, longest " << f.longest_wait_ms << " ms";
     } else {

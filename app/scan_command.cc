@@ -12,6 +12,7 @@
 #include "app/loaded_level.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
+#include "scene/terrain_streamer.h"
 #include "sensors/face_scanner.h"
 #include "sensors/ground_scanner.h"
 #include "sensors/lidar.h"
@@ -118,6 +119,13 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
         parsed->flags.count("--isolate") > 0 ? Isolation::kAlways : Isolation::kSceneFiles);
     const scene::Level& level = loaded.level;
     scene::CollisionWorld world(level);
+    if (level.terrain) {  // the fine tiles around the sensor, in before the scan
+      scene::TerrainStreamer terrain(level);
+      terrain.Update({X_WS.translation()}, 0.0, &world, scene::TerrainStreamer::Wait::kFine);
+      for (const std::string& message : terrain.TakeMessages()) {
+        err << "sandbox scan: " << message << "\n";
+      }
+    }
     // The floating origin at the sensor (whole metres), as the loop keeps it near the robot.
     world.SetOrigin(X_WS.translation().array().round().matrix());
     sensors::RayCaster caster;

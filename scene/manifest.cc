@@ -442,6 +442,7 @@ TerrainSpec ParseTerrain(const fs::path& file, const toml::table& table, int ind
   if (terrain.view_radius_m < terrain.collision_radius_m) {
     read.Fail(read.Find("view_radius_m"), "'view_radius_m' must not be below 'collision_radius_m'");
   }
+  if (const auto cache = read.String("cache")) terrain.cache = AssetPath(file, *cache);
   read.RejectUnknownKeys();
   return terrain;
 }

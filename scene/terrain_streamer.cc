@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <set>
 #include <sstream>
 
+#include "scene/terrain_cache.h"
 #include "scene/terrain_source.h"
 
 namespace sandbox::scene {
@@ -68,6 +70,8 @@ void TerrainStreamer::Work() {
   if (source) {
     for (const std::string& problem : source->problems()) say(problem);
   }
+  TerrainCache cache(spec);
+  if (!cache.problem().empty()) say(cache.problem());
   const double fine_m = source ? source->fine_tile_m() : 0.0;
   const double coarse_m = fine_m * spec.coarse_factor;
   struct Resident {
@@ -163,10 +167,20 @@ void TerrainStreamer::Work() {
         }
         Event event;
         event.key = id.key();
+        bool cached = false;
+        double ms = 0.0;
         try {
-          auto tile = std::make_shared<TerrainTile>(source->Build(id));
+          const auto start = Clock::now();
+          std::optional<TerrainTile> kept = cache.Load(id);
+          cached = kept.has_value();
+          auto tile = std::make_shared<TerrainTile>(cached ? std::move(*kept) : source->Build(id));
+          if (!cached && cache.enabled()) {
+            cache.Store(*tile);
+            if (!cache.enabled()) say(cache.problem());
+          }
           if (id.lod == 0 && !tile->indices.empty())
             event.collision = CollisionWorld::PrepareTile(tile);
+          ms = MsSince(start);
           event.tile = std::move(tile);
         } catch (const std::exception& error) {
           failed.insert(id.key());
@@ -182,8 +196,9 @@ void TerrainStreamer::Work() {
         Figures& f = s.figures;
         ++f.built;
         if (id.lod == 0) ++f.fine_built;
-        f.total_build_ms += event.tile->build_ms;
-        f.longest_build_ms = std::max(f.longest_build_ms, event.tile->build_ms);
+        if (cached) ++f.from_cache;
+        f.total_build_ms += ms;
+        f.longest_build_ms = std::max(f.longest_build_ms, ms);
         s.events.push_back(std::move(event));
       }
       if (interrupted) break;

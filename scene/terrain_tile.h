@@ -27,6 +27,7 @@ struct TerrainSpec {
   double view_radius_m{60000.0};                 // coarse tiles (cameras only) within this
   double prefetch_s{10.0};                       // also around where each robot will be this soon
   int texture_px{256};                           // a tile's imagery texture, a side
+  std::filesystem::path cache;  // built tiles kept here (terrain_cache.h); empty: none
   int line{0};
 };
 
@@ -60,7 +61,7 @@ struct TerrainTile {
   int texture_width{0}, texture_height{0};
   std::vector<std::uint8_t> texture_rgba;  // row 0 at v = 0
   Eigen::AlignedBox3d bounds_W;
-  double build_ms{0.0};  // reading, reprojecting and meshing
+  double build_ms{0.0};  // reading, reprojecting and meshing (as when it was built)
 
   std::size_t bytes() const;
 };

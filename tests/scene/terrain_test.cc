@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <set>
 
 #include "assets/generators/highlands_terrain.h"
@@ -353,6 +354,57 @@ TEST(TerrainTest, BadRastersAreLeftOutWithTheirReasonAndTheRestServes) {
   messages = terrain.TakeMessages();
   ASSERT_EQ(messages.size(), 1u);
   EXPECT_NE(messages[0].find("robot 0 at (-30000, 0) m is beyond every elevation raster"),
+            std::string::npos)
+      << messages[0];
+}
+
+TEST(TerrainTest, TheTileCacheGivesBackTheSameTilesAndAFolderThatCannotBeMadeIsSaidOnce) {
+  testing::TempDir dir;
+  const Level level = LoadLevel(dir.Write("level.toml", TerrainToml("", "cache = \"tiles\"\n")));
+  auto tiles_at = [&](const Level& with, const Vector3d& p, TerrainStreamer::Figures* figures,
+                      std::vector<std::string>* messages) {
+    CollisionWorld world(with);
+    TerrainStreamer terrain(with);
+    terrain.Update({p}, 0.0, &world, TerrainStreamer::Wait::kAll);
+    *figures = terrain.figures();
+    *messages = terrain.TakeMessages();
+    return terrain.drawn();
+  };
+  TerrainStreamer::Figures first, second;
+  std::vector<std::string> messages;
+  const auto built = tiles_at(level, Vector3d(20000, 5000, 0), &first, &messages);
+  EXPECT_TRUE(messages.empty());
+  EXPECT_EQ(first.from_cache, 0);
+  ASSERT_GT(first.built, 4);
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path() / "tiles"),
+                          std::filesystem::directory_iterator{}),
+            first.built);
+  const auto read = tiles_at(level, Vector3d(20000, 5000, 0), &second, &messages);
+  EXPECT_EQ(second.from_cache, second.built);
+  ASSERT_EQ(read->size(), built->size());
+  for (std::size_t t = 0; t < read->size(); ++t) {
+    const TerrainTile &a = *(*built)[t], &b = *(*read)[t];
+    EXPECT_EQ(a.id.key(), b.id.key());
+    EXPECT_EQ(a.origin_W, b.origin_W);
+    EXPECT_EQ(a.positions, b.positions);
+    EXPECT_EQ(a.indices, b.indices);
+    EXPECT_EQ(a.skirt_indices, b.skirt_indices);
+    EXPECT_EQ(a.block_first, b.block_first);
+  }
+  // A damaged file is built again, not read.
+  const auto first_file = *std::filesystem::directory_iterator(dir.path() / "tiles");
+  std::filesystem::resize_file(first_file.path(), 100);
+  tiles_at(level, Vector3d(20000, 5000, 0), &second, &messages);
+  EXPECT_EQ(second.from_cache, second.built - 1);
+  // A cache "folder" that is a file: said once, tiles built all the same.
+  dir.Write("taken", "a file\n");
+  const Level blocked =
+      LoadLevel(dir.Write("blocked.toml", TerrainToml("", "cache = \"taken/tiles\"\n")));
+  const auto without = tiles_at(blocked, Vector3d(20000, 5000, 0), &second, &messages);
+  EXPECT_EQ(without->size(), built->size());
+  ASSERT_EQ(messages.size(), 1u);
+  EXPECT_NE(messages[0].find("terrain cache " + (dir.path() / "taken/tiles").string() +
+                             " cannot be made"),
             std::string::npos)
       << messages[0];
 }
