@@ -17,6 +17,7 @@
 #include "app/process_stats.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
+#include "scene/terrain_source.h"
 #include "sensors/sensor.h"
 
 namespace sandbox::app {
@@ -144,6 +145,21 @@ void PrintText(const Level& level, const std::vector<sensors::MountedSensor>& se
     for (const sensors::MountedSensor& sensor : sensors) {
       if (level.robots[static_cast<std::size_t>(sensor.robot)].name != r.name) continue;
       out << "  sensor " << sensor.spec.name << ": " << sensor.Describe() << "\n";
+    }
+  }
+  if (level.terrain) {
+    const scene::TerrainSpec& t = *level.terrain;
+    const scene::TerrainSource source(t);
+    const Eigen::AlignedBox2d ground = source.InnerFootprint_W();
+    out << "terrain " << t.name << ": " << source.num_usable() << " of " << t.elevation.size()
+        << " elevation rasters, " << t.imagery.size() << " imagery; anchor " << std::setprecision(6)
+        << t.anchor.latitude_deg << ", " << t.anchor.longitude_deg << ", " << std::setprecision(2)
+        << t.anchor.height_m << " m; fine tiles of " << source.fine_tile_m() << " m within "
+        << t.collision_radius_m << " m, coarse within " << t.view_radius_m
+        << " m (streamed while running)\n";
+    if (!ground.isEmpty()) {
+      out << "  ground from (" << ground.min().x() << ", " << ground.min().y() << ") to ("
+          << ground.max().x() << ", " << ground.max().y() << ") m, inside the outermost tiles\n";
     }
   }
   const Eigen::AlignedBox3d bounds = level.bounds_W();
