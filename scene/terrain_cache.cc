@@ -80,9 +80,13 @@ fs::path TerrainCache::FileOf(const TileId& id) const {
 
 std::optional<TerrainTile> TerrainCache::Load(const TileId& id) const {
   if (!enabled()) return std::nullopt;
-  std::ifstream file(FileOf(id), std::ios::binary);
-  if (!file) return std::nullopt;
-  const std::string in((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  const fs::path path = FileOf(id);
+  std::error_code error;
+  const std::uintmax_t bytes = fs::file_size(path, error);
+  if (error) return std::nullopt;
+  std::ifstream file(path, std::ios::binary);
+  std::string in(bytes, '\0');
+  if (!file.read(in.data(), std::streamsize(bytes))) return std::nullopt;
   std::size_t at = sizeof(kMagic);
   TerrainTile tile;
   std::vector<std::uint64_t> key;
