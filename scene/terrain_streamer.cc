@@ -126,9 +126,13 @@ void TerrainStreamer::Work() {
     }
     fine.insert(fine.end(), near_now.begin(), near_now.end());
     for (std::vector<TileId>* list : {&fine, &coarse}) {
-      std::sort(list->begin(), list->end(),
-                [&](const TileId& a, const TileId& b) { return nearest(a) < nearest(b); });
+      std::sort(list->begin(), list->end());
       list->erase(std::unique(list->begin(), list->end()), list->end());
+      std::vector<std::pair<double, TileId>> by_distance;
+      for (const TileId& id : *list) by_distance.push_back({nearest(id), id});
+      std::sort(by_distance.begin(), by_distance.end(),
+                [](const auto& a, const auto& b) { return a.first < b.first; });
+      for (std::size_t i = 0; i < by_distance.size(); ++i) (*list)[i] = by_distance[i].second;
     }
     const bool late =
         handled > 1 && std::any_of(near_now.begin(), near_now.end(), [&](const TileId& id) {
