@@ -33,7 +33,7 @@ template <typename T>
 void Put(std::string* out, const std::vector<T>& values) {
   const std::uint64_t n = values.size();
   out->append(reinterpret_cast<const char*>(&n), sizeof(n));
-  out->append(reinterpret_cast<const char*>(values.data()), n * sizeof(T));
+  if (n > 0) out->append(reinterpret_cast<const char*>(values.data()), n * sizeof(T));
 }
 
 template <typename T>
@@ -44,7 +44,7 @@ bool Take(const std::string& in, std::size_t* at, std::vector<T>* values) {
   *at += sizeof(n);
   if (n > (in.size() - *at) / sizeof(T)) return false;
   values->resize(n);
-  std::memcpy(static_cast<void*>(values->data()), in.data() + *at, n * sizeof(T));
+  if (n > 0) std::memcpy(static_cast<void*>(values->data()), in.data() + *at, n * sizeof(T));
   *at += n * sizeof(T);
   return true;
 }
