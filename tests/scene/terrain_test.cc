@@ -46,20 +46,26 @@ std::string TerrainToml(const std::string& extra = "", const std::string& terrai
 struct RasterProbe {
   GDALDatasetH dataset{nullptr};
   double gt[6]{};
+  OGRSpatialReferenceH crs{nullptr}, wgs84{nullptr};
   OGRCoordinateTransformationH to_lonlat{nullptr};
   RasterProbe() {
     GDALAllRegister();
     dataset = GDALOpen(Generated("elevation.tif").c_str(), GA_ReadOnly);
     EXPECT_NE(dataset, nullptr);
     GDALGetGeoTransform(dataset, gt);
-    OGRSpatialReferenceH crs = OSRClone(GDALGetSpatialRef(dataset));
-    OGRSpatialReferenceH wgs84 = OSRNewSpatialReference(nullptr);
+    crs = OSRClone(GDALGetSpatialRef(dataset));
+    wgs84 = OSRNewSpatialReference(nullptr);
     OSRSetWellKnownGeogCS(wgs84, "WGS84");
     OSRSetAxisMappingStrategy(crs, OAMS_TRADITIONAL_GIS_ORDER);
     OSRSetAxisMappingStrategy(wgs84, OAMS_TRADITIONAL_GIS_ORDER);
     to_lonlat = OCTNewCoordinateTransformation(crs, wgs84);
   }
-  ~RasterProbe() { GDALClose(dataset); }
+  ~RasterProbe() {
+    OCTDestroyCoordinateTransformation(to_lonlat);
+    OSRDestroySpatialReference(crs);
+    OSRDestroySpatialReference(wgs84);
+    GDALClose(dataset);
+  }
   double Height(int col, int row) const {
     float h = 0.f;
     EXPECT_EQ(GDALRasterIO(GDALGetRasterBand(dataset, 1), GF_Read, col, row, 1, 1, &h, 1, 1,
