@@ -1,5 +1,6 @@
 #include "scene/asset_import.h"
 
+#include <assimp/GltfMaterial.h>
 #include <assimp/config.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
@@ -199,22 +200,43 @@ Material ConvertMaterial(const aiScene& scene, const aiMaterial& in, const fs::p
       out.lightmap_texture_embedded = std::atoi(lightmap.C_Str() + 1);
     }
   }
-  aiString texture;
-  if (in.GetTexture(aiTextureType_BASE_COLOR, 0, &texture) == AI_SUCCESS ||
-      in.GetTexture(aiTextureType_DIFFUSE, 0, &texture) == AI_SUCCESS) {
+  // glTF's alpha mode and metallic-roughness factors.
+  aiString alpha_mode;
+  if (in.Get(AI_MATKEY_GLTF_ALPHAMODE, alpha_mode) == AI_SUCCESS) {
+    out.linear_color = true;  // only glTF materials have an alpha mode
+    const std::string mode = alpha_mode.C_Str();
+    out.alpha_mode = mode == "MASK"    ? AlphaMode::kMask
+                     : mode == "BLEND" ? AlphaMode::kBlend
+                                       : AlphaMode::kOpaque;
+    if (out.alpha_mode == AlphaMode::kOpaque) out.base_color.w() = 1.0f;
+  }
+  in.Get(AI_MATKEY_GLTF_ALPHACUTOFF, out.alpha_cutoff);
+  in.Get(AI_MATKEY_METALLIC_FACTOR, out.metallic);
+  in.Get(AI_MATKEY_ROUGHNESS_FACTOR, out.roughness);
+  // A texture: embedded ("*N" or by name) or a file beside the asset.
+  auto texture_of = [&](aiTextureType type, std::string* path_out, int* embedded_out) {
+    aiString texture;
+    if (in.GetTexture(type, 0, &texture) != AI_SUCCESS) return false;
     const char* path = texture.C_Str();
     if (path[0] == '*') {
-      out.base_color_texture_embedded = std::atoi(path + 1);
+      *embedded_out = std::atoi(path + 1);
     } else if (scene.GetEmbeddedTexture(path) != nullptr) {
       for (unsigned t = 0; t < scene.mNumTextures; ++t) {
         if (scene.mTextures[t] == scene.GetEmbeddedTexture(path)) {
-          out.base_color_texture_embedded = static_cast<int>(t);
+          *embedded_out = static_cast<int>(t);
         }
       }
     } else {
-      out.base_color_texture_path = (folder / path).lexically_normal().string();
+      *path_out = (folder / path).lexically_normal().string();
     }
+    return true;
+  };
+  if (!texture_of(aiTextureType_BASE_COLOR, &out.base_color_texture_path,
+                  &out.base_color_texture_embedded)) {
+    texture_of(aiTextureType_DIFFUSE, &out.base_color_texture_path,
+               &out.base_color_texture_embedded);
   }
+  texture_of(aiTextureType_NORMALS, &out.normal_texture_path, &out.normal_texture_embedded);
   return out;
 }
 
@@ -272,6 +294,13 @@ Mesh ConvertMesh(const aiMesh& in, std::size_t* non_triangles) {
     out.lightmap_uvs.resize(in.mNumVertices);
     for (unsigned v = 0; v < in.mNumVertices; ++v) {
       out.lightmap_uvs[v] = {in.mTextureCoords[1][v].x, in.mTextureCoords[1][v].y};
+    }
+  }
+  if (in.HasVertexColors(0)) {
+    out.colors.resize(in.mNumVertices);
+    for (unsigned v = 0; v < in.mNumVertices; ++v) {
+      const aiColor4D& c = in.mColors[0][v];
+      out.colors[v] = {c.r, c.g, c.b, c.a};
     }
   }
   out.indices.reserve(std::size_t{in.mNumFaces} * 3);

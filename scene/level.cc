@@ -121,6 +121,7 @@ Level LoadManifest(const fs::path& file, const LoadOptions& options) {
     actor.source = spec.file.string();
     actor.collision = spec.collision;
     actor.movable = spec.movable;
+    actor.surface = spec.surface;
     actor.X_WA = spec.placement.pose();
     for (const ImportedNode& node : asset.nodes) {
       const Eigen::Affine3d X_AN = Eigen::Scaling(spec.placement.scale) * node.X_RN;
@@ -178,6 +179,7 @@ int AppendMaterials(std::vector<Material> materials, std::vector<EmbeddedTexture
       material.base_color_texture_embedded += texture_base;
     }
     if (material.lightmap_texture_embedded >= 0) material.lightmap_texture_embedded += texture_base;
+    if (material.normal_texture_embedded >= 0) material.normal_texture_embedded += texture_base;
     level->materials.push_back(std::move(material));
   }
   for (EmbeddedTexture& texture : textures) level->textures.push_back(std::move(texture));

@@ -27,7 +27,9 @@ struct Actor {
   std::string source;                                     // the file (and node path) it came from
   Eigen::Isometry3d X_WA{Eigen::Isometry3d::Identity()};  // pose at load time
   bool collision{true};                                   // false: drawn but invisible to rays
-  bool movable{false};           // true: may be placed from outside at run time
+  bool movable{false};  // true: may be placed from outside at run time
+  // How cameras shade it, over its materials' own (heightmaps: terrain).
+  std::optional<Surface> surface;
   std::vector<Mesh> meshes;      // in frame A
   Eigen::AlignedBox3d bounds_W;  // exact bounds of the meshes at X_WA; empty without meshes
 

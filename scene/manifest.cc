@@ -202,6 +202,19 @@ ActorSpec ParseActor(const fs::path& file, const toml::table& table, int index) 
   actor.placement = ParsePlacement(read);
   actor.collision = read.Bool("collision").value_or(true);
   actor.movable = read.Bool("movable").value_or(false);
+  if (const auto surface = read.String("surface")) {
+    const std::pair<const char*, Surface> kSurfaces[] = {
+        {"plain", Surface::kPlain}, {"terrain", Surface::kTerrain}, {"water", Surface::kWater}};
+    for (const auto& [name, value] : kSurfaces) {
+      if (*surface == name) actor.surface = value;
+    }
+    if (!actor.surface) {
+      read.Fail(read.Find("surface"),
+                "'surface' must be \"plain\", \"terrain\" or \"water\", got '" + *surface + "'");
+    }
+  } else if (actor.is_heightmap) {
+    actor.surface = Surface::kTerrain;
+  }
   read.RejectUnknownKeys();
   return actor;
 }

@@ -25,7 +25,8 @@ struct ActorSpec {
   Placement placement;
   bool collision{true};
   bool movable{false};
-  int line{0};  // where the table starts, for messages
+  std::optional<Surface> surface;  // `surface = "plain" | "terrain" | "water"`
+  int line{0};                     // where the table starts, for messages
 };
 
 // The [horizon] table: the ground beyond the level, drawn to the horizon.
