@@ -28,6 +28,37 @@ CameraKind ParseCameraKind(const scene::SensorSpec& spec) {
                           scene::ChoiceList(types) + ", got '" + spec.type + "'");
 }
 
+// quality, shadows, msaa, haze, anisotropy, images: the camera's look.
+void ReadLook(const scene::SensorSpec& spec, scene::SettingsReader* read, RenderSettings* look) {
+  try {
+    *look = RenderSettings::Preset(ParseQuality(read->Text("quality", "high")));
+  } catch (const std::invalid_argument& error) {
+    throw scene::LevelError(spec.settings.Where("quality") + error.what());
+  }
+  look->shadows = read->Flag("shadows", look->shadows);
+  look->haze = read->Flag("haze", look->haze);
+  look->msaa_samples = read->Whole("msaa", look->msaa_samples);
+  if (look->msaa_samples != 0 && look->msaa_samples != 1 && look->msaa_samples != 4) {
+    read->Fail("msaa", "'msaa' must be 0 (off) or 4 samples");
+  }
+  look->anisotropy = read->Whole("anisotropy", look->anisotropy);
+  if (look->anisotropy < 1 || look->anisotropy > 16) {
+    read->Fail("anisotropy", "'anisotropy' must be 1 (off) to 16");
+  }
+  look->images = kColorImage;
+  if (read->Has("images")) {
+    look->images = 0;
+    for (const std::string& word : read->Texts("images")) {
+      try {
+        look->images |= ParseImageKind(word);
+      } catch (const std::invalid_argument& error) {
+        read->Fail("images", error.what());
+      }
+    }
+    if (look->images == 0) read->Fail("images", "'images' must name at least one image kind");
+  }
+}
+
 }  // namespace
 
 std::string_view CameraTypeName(CameraKind kind) {
@@ -72,7 +103,9 @@ std::vector<MountedCamera> MakeRobotCameras(const scene::Level& level) {
       camera.chase.rotation_lag_s = read.Number("rotation_lag_s", camera.chase.rotation_lag_s);
       camera.trailing_distance_m = read.Number("distance_m", camera.trailing_distance_m);
       camera.trailing_height_m = read.Number("height_m", camera.trailing_height_m);
-      camera.depth = read.Flag("depth", camera.kind == CameraKind::kPayload);
+      ReadLook(spec, &read, &camera.look);
+      if (read.Flag("depth", camera.kind == CameraKind::kPayload))
+        camera.look.images |= kDepthImage;
       camera.overlay = read.Flag("overlay", false);
       camera.overlay_stub_m = read.Number("overlay_stub_m", 0.0);
       if (!(camera.overlay_stub_m >= 0.0 && camera.overlay_stub_m <= 100.0)) {

@@ -11,6 +11,7 @@
 #include "scene/robot_model.h"
 #include "scene/robot_state.h"
 #include "sensors/render/cameras.h"
+#include "sensors/render/renderer.h"
 #include "sensors/render/view.h"
 
 namespace sandbox::render {
@@ -34,7 +35,9 @@ struct MountedCamera {
   ChaseConfig chase;
   double trailing_distance_m{25.0};
   double trailing_height_m{8.0};
-  bool depth{false};           // payload cameras: also a depth image
+  // The look (quality preset and switches) and the images it makes
+  // (`images = [...]`; `depth = true` adds depth; payload cameras: colour and depth).
+  RenderSettings look;
   bool overlay{false};         // the debug overlay (scanner samples, bone frames, actor bounds)
   double overlay_stub_m{0.0};  // scanner samples as points (0) or stubs this long
 

@@ -5,6 +5,7 @@
 #include <GL/glext.h>
 #include <GL/osmesa.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -12,103 +13,34 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "sensors/render/detail_textures.h"
+#include "sensors/render/segmentation.h"
+#include "sensors/render/shaders.h"
+#include "sensors/render/shadow_cascades.h"
+
 namespace sandbox::render {
+
+Quality ParseQuality(const std::string& word) {
+  if (word == "plain") return Quality::kPlain;
+  if (word == "fast") return Quality::kFast;
+  if (word == "high") return Quality::kHigh;
+  throw std::invalid_argument("quality must be \"fast\" or \"high\" (or \"plain\"), got '" + word +
+                              "'");
+}
+
+RenderSettings RenderSettings::Preset(Quality quality) {
+  RenderSettings settings;
+  settings.shadows = quality == Quality::kHigh;
+  settings.msaa_samples = quality == Quality::kHigh ? 4 : 0;
+  settings.gamma_correct = quality != Quality::kPlain;
+  settings.materials = quality != Quality::kPlain;
+  return settings;
+}
+
 namespace {
 
-const char* kVertexShader = R"(#version 450 core
-layout(location = 0) in vec3 position;
-layout(location = 1) in vec3 normal;
-layout(location = 2) in vec2 uv;
-layout(location = 3) in vec2 lightmap_uv;
-uniform mat4 model;       // object to camera-centred world (world axes, origin at the camera)
-uniform mat4 view_proj;   // camera-centred world to clip
-out vec3 world_normal;
-out vec2 tex_uv;
-out vec2 baked_uv;
-out float distance_m;
-void main() {
-  vec4 p = model * vec4(position, 1.0);
-  world_normal = mat3(model) * normal;
-  tex_uv = uv;
-  baked_uv = lightmap_uv;
-  distance_m = length(p.xyz);
-  gl_Position = view_proj * p;
-}
-)";
-
-const char* kFragmentShader = R"(#version 450 core
-in vec3 world_normal;
-in vec2 tex_uv;
-in vec2 baked_uv;
-in float distance_m;
-uniform vec4 base_color;
-uniform bool has_lightmap;        // baked lighting replaces the sun (Quake 3 maps)
-uniform sampler2D lightmap;
-uniform bool has_texture;
-uniform sampler2D base_texture;
-uniform vec3 sun;
-uniform vec3 sky;
-uniform vec2 fog;  // start, end
-out vec4 color;
-void main() {
-  vec4 albedo = base_color;
-  if (has_texture) albedo *= texture(base_texture, tex_uv);
-  vec3 n = normalize(world_normal);
-  float light = 0.35 + 0.65 * abs(dot(n, sun));  // two-sided: thin surfaces lit from both sides
-  // Quake 3 stores lightmaps at half brightness (its "overbright" bit).
-  vec3 lit = has_lightmap ? albedo.rgb * min(2.0 * texture(lightmap, baked_uv).rgb, vec3(1.0))
-                          : albedo.rgb * light;
-  float f = clamp((distance_m - fog.x) / max(fog.y - fog.x, 1e-3), 0.0, 1.0);
-  color = vec4(mix(lit, sky, f), albedo.a);
-}
-)";
-
-// The overlay: coloured points and lines, pulled 0.2% towards the camera so
-// that marks lying on a surface are not hidden by it.
-const char* kOverlayVertexShader = R"(#version 450 core
-layout(location = 0) in vec3 position;  // camera-centred world
-layout(location = 1) in vec3 rgb;
-uniform mat4 view_proj;
-out vec3 mark_rgb;
-void main() {
-  mark_rgb = rgb;
-  gl_Position = view_proj * vec4(0.998 * position, 1.0);
-}
-)";
-
-const char* kOverlayFragmentShader = R"(#version 450 core
-in vec3 mark_rgb;
-out vec4 color;
-void main() { color = vec4(mark_rgb, 1.0); }
-)";
-
-// The sky: a full-screen triangle behind everything, light at the horizon
-// (the haze colour, so distant ground fades into it), deeper overhead, with the sun's disc.
-const char* kSkyVertexShader = R"(#version 450 core
-out vec2 ndc;
-void main() {
-  ndc = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);
-  gl_Position = vec4(ndc, 0.0, 1.0);
-}
-)";
-
-const char* kSkyFragmentShader = R"(#version 450 core
-in vec2 ndc;
-uniform mat4 clip_to_world;  // directions: clip to camera-centred world
-uniform vec3 horizon;
-uniform vec3 zenith;
-uniform vec3 sun;
-out vec4 color;
-void main() {
-  vec4 far_point = clip_to_world * vec4(ndc, 0.5, 1.0);
-  vec3 d = normalize(far_point.xyz / far_point.w);
-  float up = clamp(d.z, 0.0, 1.0);
-  vec3 c = mix(horizon, zenith, pow(up, 0.6));
-  float s = dot(d, sun);
-  c = mix(c, vec3(1.0, 0.98, 0.9), smoothstep(0.99985, 0.99995, s));
-  color = vec4(c, 1.0);
-}
-)";
+constexpr double kPatternPeriod_m = 6900.0;  // the ground's and water's patterns repeat here
+constexpr int kDetailPx = 256;
 
 GLuint Compile(GLenum type, const char* source) {
   const GLuint shader = glCreateShader(type);
@@ -117,7 +49,7 @@ GLuint Compile(GLenum type, const char* source) {
   GLint ok = 0;
   glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
   if (!ok) {
-    char log[2048];
+    char log[4096];
     glGetShaderInfoLog(shader, sizeof(log), nullptr, log);
     throw std::runtime_error(std::string("Renderer: shader does not compile: ") + log);
   }
@@ -126,75 +58,130 @@ GLuint Compile(GLenum type, const char* source) {
 
 GLuint Link(const char* vertex, const char* fragment) {
   const GLuint program = glCreateProgram();
-  glAttachShader(program, Compile(GL_VERTEX_SHADER, vertex));
-  glAttachShader(program, Compile(GL_FRAGMENT_SHADER, fragment));
+  const GLuint v = Compile(GL_VERTEX_SHADER, vertex), f = Compile(GL_FRAGMENT_SHADER, fragment);
+  glAttachShader(program, v);
+  glAttachShader(program, f);
   glLinkProgram(program);
+  glDeleteShader(v);
+  glDeleteShader(f);
   GLint ok = 0;
   glGetProgramiv(program, GL_LINK_STATUS, &ok);
-  if (!ok) throw std::runtime_error("Renderer: shaders do not link");
+  if (!ok) {
+    char log[4096];
+    glGetProgramInfoLog(program, sizeof(log), nullptr, log);
+    throw std::runtime_error(std::string("Renderer: shaders do not link: ") + log);
+  }
   return program;
 }
 
-// A mesh on the GPU.
+// A mesh on the GPU, with what it is drawn as.
 struct GpuMesh {
-  GLuint vao{0}, positions{0}, normals{0}, uvs{0}, lightmap_uvs{0}, indices{0};
+  GLuint vao{0}, positions{0}, normals{0}, uvs{0}, lightmap_uvs{0}, colors{0}, segments{0},
+      indices{0};
   GLsizei index_count{0};
   int material{-1};
+  int surface{-1};  // a scene::Surface over the material's, -1: the material's
+  std::uint32_t segment_base{0};
+  GLuint triangle_segments{0}, triangle_segment_buffer{0};  // a buffer texture, 0: none
 };
 
-GpuMesh Upload(const std::vector<Eigen::Vector3f>& positions,
-               const std::vector<Eigen::Vector3f>& normals, const std::vector<Eigen::Vector2f>& uvs,
-               const std::vector<Eigen::Vector2f>& lightmap_uvs,
-               const std::vector<std::uint32_t>& indices, int material, GLenum usage) {
+// What a mesh is made of, for Upload.
+struct MeshData {
+  const std::vector<Eigen::Vector3f>* positions{nullptr};
+  const std::vector<Eigen::Vector3f>* normals{nullptr};
+  const std::vector<Eigen::Vector2f>* uvs{nullptr};
+  const std::vector<Eigen::Vector2f>* lightmap_uvs{nullptr};
+  const std::vector<Eigen::Vector4f>* colors{nullptr};
+  const std::vector<std::uint32_t>* vertex_segments{nullptr};
+  const std::vector<std::uint32_t>* indices{nullptr};
+};
+
+GpuMesh Upload(const MeshData& data, int material, GLenum usage) {
   GpuMesh mesh;
   mesh.material = material;
-  mesh.index_count = GLsizei(indices.size());
+  mesh.index_count = GLsizei(data.indices->size());
+  const std::size_t n = data.positions->size();
   glGenVertexArrays(1, &mesh.vao);
   glBindVertexArray(mesh.vao);
-  auto attribute = [&](GLuint* buffer, GLuint location, int size, const void* data,
-                       std::size_t bytes) {
+  auto attribute = [&](GLuint* buffer, GLuint location, int size, const void* bytes,
+                       std::size_t count) {
     glGenBuffers(1, buffer);
     glBindBuffer(GL_ARRAY_BUFFER, *buffer);
-    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(bytes), data, usage);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(count), bytes, usage);
     glEnableVertexAttribArray(location);
     glVertexAttribPointer(location, size, GL_FLOAT, GL_FALSE, 0, nullptr);
   };
-  attribute(&mesh.positions, 0, 3, positions.data(), positions.size() * 12);
-  attribute(&mesh.normals, 1, 3, normals.data(), normals.size() * 12);
-  if (uvs.size() == positions.size()) {
-    attribute(&mesh.uvs, 2, 2, uvs.data(), uvs.size() * 8);
+  attribute(&mesh.positions, 0, 3, data.positions->data(), n * 12);
+  attribute(&mesh.normals, 1, 3, data.normals->data(), data.normals->size() * 12);
+  if (data.uvs != nullptr && data.uvs->size() == n) {
+    attribute(&mesh.uvs, 2, 2, data.uvs->data(), n * 8);
   } else {
-    glDisableVertexAttribArray(2);
     glVertexAttrib2f(2, 0.f, 0.f);
   }
-  if (lightmap_uvs.size() == positions.size()) {
-    attribute(&mesh.lightmap_uvs, 3, 2, lightmap_uvs.data(), lightmap_uvs.size() * 8);
+  if (data.lightmap_uvs != nullptr && data.lightmap_uvs->size() == n) {
+    attribute(&mesh.lightmap_uvs, 3, 2, data.lightmap_uvs->data(), n * 8);
   } else {
-    glDisableVertexAttribArray(3);
     glVertexAttrib2f(3, 0.f, 0.f);
+  }
+  if (data.colors != nullptr && data.colors->size() == n) {
+    attribute(&mesh.colors, 4, 4, data.colors->data(), n * 16);
+  } else {
+    glVertexAttrib4f(4, 1.f, 1.f, 1.f, 1.f);
+  }
+  if (data.vertex_segments != nullptr && data.vertex_segments->size() == n) {
+    glGenBuffers(1, &mesh.segments);
+    glBindBuffer(GL_ARRAY_BUFFER, mesh.segments);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(n * 4), data.vertex_segments->data(), GL_STATIC_DRAW);
+    glEnableVertexAttribArray(5);
+    glVertexAttribIPointer(5, 1, GL_UNSIGNED_INT, 0, nullptr);
+  } else {
+    glVertexAttribI1ui(5, 0);
   }
   glGenBuffers(1, &mesh.indices);
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, mesh.indices);
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * 4), indices.data(),
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(data.indices->size() * 4), data.indices->data(),
                GL_STATIC_DRAW);
   glBindVertexArray(0);
   return mesh;
 }
 
-// Static geometry, merged: one buffer set per material and ground cell, with
-// its bounds for culling. Positions are relative to `origin` (double) so that
-// floats keep their precision in large levels.
+void Free(const GpuMesh& m) {
+  const GLuint buffers[] = {m.positions, m.normals,  m.uvs,     m.lightmap_uvs,
+                            m.colors,    m.segments, m.indices, m.triangle_segment_buffer};
+  for (const GLuint buffer : buffers) {
+    if (buffer != 0) glDeleteBuffers(1, &buffer);
+  }
+  if (m.triangle_segments != 0) glDeleteTextures(1, &m.triangle_segments);
+  glDeleteVertexArrays(1, &m.vao);
+}
+
+// A per-triangle id table for gl_PrimitiveID lookups.
+void SetTriangleSegments(GpuMesh* mesh, const std::vector<std::uint32_t>& ids) {
+  if (ids.empty()) return;
+  glGenBuffers(1, &mesh->triangle_segment_buffer);
+  glBindBuffer(GL_TEXTURE_BUFFER, mesh->triangle_segment_buffer);
+  glBufferData(GL_TEXTURE_BUFFER, GLsizeiptr(ids.size() * 4), ids.data(), GL_STATIC_DRAW);
+  glGenTextures(1, &mesh->triangle_segments);
+  glBindTexture(GL_TEXTURE_BUFFER, mesh->triangle_segments);
+  glTexBuffer(GL_TEXTURE_BUFFER, GL_R32UI, mesh->triangle_segment_buffer);
+}
+
+// Static geometry, merged: one buffer set per material, surface and ground
+// cell, with its bounds for culling. Positions are relative to `origin`
+// (double) so that floats keep their precision in large levels.
 struct StaticChunk {
   std::vector<Eigen::Vector3f> positions, normals;
   std::vector<Eigen::Vector2f> uvs, lightmap_uvs;
-  std::vector<std::uint32_t> indices;
+  std::vector<Eigen::Vector4f> colors;
+  std::vector<std::uint32_t> segments, indices;
   Eigen::AlignedBox3f bounds;
-  bool any_uvs{false}, any_lightmap_uvs{false};
+  bool any_uvs{false}, any_lightmap_uvs{false}, any_colors{false};
 };
 constexpr double kChunkCell_m = 128.0;
 
 // False when the box lies wholly outside one plane of the frustum of clip
-// matrix M (rows of M combined as in Gribb and Hartmann).
+// matrix M (rows of M combined as in Gribb and Hartmann). Orthographic
+// shadow boxes too.
 bool InFrustum(const Eigen::Matrix4f& M, const Eigen::AlignedBox3f& box) {
   for (int plane = 0; plane < 6; ++plane) {
     const Eigen::Vector4f p = M.row(3) + (plane % 2 == 0 ? 1.f : -1.f) * M.row(plane / 2);
@@ -213,6 +200,13 @@ Eigen::Matrix4f Relative(const Eigen::Affine3d& X, const Eigen::Vector3d& camera
   rel.translation() -= camera;
   return rel.matrix().cast<float>();
 }
+
+// The passes a frame is drawn in.
+enum class Pass {
+  kColor,   // colour (and, without multisampling, segment and normal too)
+  kData,    // segment and normal only, one sample at each pixel centre
+  kShadow,  // depth from the sun
+};
 
 class OsMesaRenderer : public Renderer {
  public:
@@ -237,70 +231,90 @@ class OsMesaRenderer : public Renderer {
     }
     description_ = std::string("OpenGL ") + reinterpret_cast<const char*>(glGetString(GL_VERSION)) +
                    ", " + reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-    program_ = Link(kVertexShader, kFragmentShader);
-    overlay_program_ = Link(kOverlayVertexShader, kOverlayFragmentShader);
-    overlay_view_proj_ = glGetUniformLocation(overlay_program_, "view_proj");
     // GL 4.5 calls libOSMesa does not export are found through it.
     clip_control_ = reinterpret_cast<PFNGLCLIPCONTROLPROC>(OSMesaGetProcAddress("glClipControl"));
     if (clip_control_ == nullptr) throw std::runtime_error("Renderer: no glClipControl");
-    sky_program_ = Link(kSkyVertexShader, kSkyFragmentShader);
-    const char* sky_names[] = {"clip_to_world", "horizon", "zenith", "sun"};
-    for (int i = 0; i < 4; ++i) sky_uniforms_[i] = glGetUniformLocation(sky_program_, sky_names[i]);
+    shadow_program_ = Link(shaders::kShadowVertex, shaders::kShadowFragment);
+    overlay_program_ = Link(shaders::kOverlayVertex, shaders::kOverlayFragment);
+    sky_program_ = Link(shaders::kSkyVertex, shaders::kSkyFragment);
     glGenVertexArrays(1, &overlay_vao_);
     glGenBuffers(2, overlay_buffers_);
-    auto location = [&](const char* name) { return glGetUniformLocation(program_, name); };
-    uniforms_ = {location("model"),       location("view_proj"),    location("base_color"),
-                 location("has_texture"), location("base_texture"), location("sun"),
-                 location("sky"),         location("fog"),          location("has_lightmap"),
-                 location("lightmap")};
+    glGetFloatv(GL_MAX_TEXTURE_MAX_ANISOTROPY, &max_anisotropy_);
+    if (glGetError() != GL_NO_ERROR) max_anisotropy_ = 1.f;
+    glGenSamplers(1, &anisotropic_);
+    glSamplerParameteri(anisotropic_, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glSamplerParameteri(anisotropic_, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glUseProgram(shadow_program_);
+    program_key_ = -1;
+    glUniform1i(glGetUniformLocation(shadow_program_, "base_texture"), 0);
+    // The ground's detail textures.
+    const std::vector<std::uint8_t> detail = MakeDetailTextures(kDetailPx);
+    glGenTextures(1, &detail_);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, detail_);
+    glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA8, kDetailPx, kDetailPx, kNumDetailLayers, 0,
+                 GL_RGBA, GL_UNSIGNED_BYTE, detail.data());
+    glGenerateMipmap(GL_TEXTURE_2D_ARRAY);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   }
   ~OsMesaRenderer() override { OSMesaDestroyContext(context_); }
 
   void SetLevel(const scene::Level& level, const TextureDecoder& decoder) override {
     level_ = &level;
+    legend_ = std::make_unique<SegmentationLegend>(level);
+    water_level_ = -1e9f;
+    for (const scene::Actor& actor : level.actors) {
+      if (actor.surface == scene::Surface::kWater && !actor.bounds_W.isEmpty()) {
+        water_level_ = std::max(water_level_, float(actor.bounds_W.max().z()));
+      }
+    }
     MergeStatic(level);
     BuildHorizon(level);
     for (std::size_t a = 0; a < level.actors.size(); ++a) {
       if (!level.actors[a].movable) continue;  // merged above
       for (const scene::Mesh& mesh : level.actors[a].meshes) {
-        actor_meshes_.push_back(
-            {int(a), Upload(mesh.positions_A, mesh.normals_A, mesh.uvs, mesh.lightmap_uvs,
-                            mesh.indices, mesh.material, GL_STATIC_DRAW)});
+        GpuMesh gpu = Upload({&mesh.positions_A, &mesh.normals_A, &mesh.uvs, &mesh.lightmap_uvs,
+                              &mesh.colors, nullptr, &mesh.indices},
+                             mesh.material, GL_STATIC_DRAW);
+        gpu.surface = level.actors[a].surface ? int(*level.actors[a].surface) : -1;
+        gpu.segment_base = legend_->actor(int(a));
+        actor_meshes_.push_back({int(a), gpu});
       }
     }
     // Textures: decoded once, by the decoder the app gives.
     for (std::size_t m = 0; m < level.materials.size(); ++m) {
       const scene::Material& material = level.materials[m];
-      const bool embedded = material.base_color_texture_embedded >= 0 &&
-                            material.base_color_texture_embedded < int(level.textures.size());
-      if (embedded || !material.base_color_texture_path.empty()) {
+      auto load = [&](int embedded_index, const std::string& path, const std::string& what,
+                      const std::string& fallback, GLint wrap, bool srgb,
+                      std::map<int, GLuint>* to) {
+        const bool embedded = embedded_index >= 0 && embedded_index < int(level.textures.size());
+        if (!embedded && path.empty()) return;
         RgbaImage image;
         const scene::EmbeddedTexture* texture =
-            embedded ? &level.textures[std::size_t(material.base_color_texture_embedded)] : nullptr;
-        const std::string problem =
-            decoder ? decoder(texture, material.base_color_texture_path, &image) : "no decoder";
+            embedded ? &level.textures[std::size_t(embedded_index)] : nullptr;
+        const std::string problem = decoder ? decoder(texture, path, &image) : "no decoder";
         if (problem.empty() && image.width > 0 && image.height > 0) {
-          textures_[int(m)] = UploadTexture(image, GL_REPEAT);
+          (*to)[int(m)] = UploadTexture(image, wrap, srgb);
         } else {
-          warnings_.push_back("material '" + material.name + "': texture " +
-                              (embedded ? "(embedded)" : material.base_color_texture_path) +
-                              " cannot be read (" + (problem.empty() ? "empty" : problem) +
-                              "); drawn with its base colour");
+          warnings_.push_back("material '" + material.name + "': " + what + " " +
+                              (embedded ? "(embedded)" : path) + " cannot be read (" +
+                              (problem.empty() ? "empty" : problem) + "); " + fallback);
         }
+      };
+      load(material.base_color_texture_embedded, material.base_color_texture_path, "texture",
+           "drawn with its base colour", GL_REPEAT, true, &textures_);
+      load(material.normal_texture_embedded, material.normal_texture_path, "normal map",
+           "drawn without it", GL_REPEAT, false, &normal_maps_);
+      if (material.lightmap_texture_embedded >= 0) {
+        load(material.lightmap_texture_embedded, "", "lightmap", "lit by the sun instead",
+             GL_CLAMP_TO_EDGE, false, &lightmaps_);
       }
-      if (material.lightmap_texture_embedded >= 0 &&
-          material.lightmap_texture_embedded < int(level.textures.size())) {
-        RgbaImage image;
-        const std::string problem =
-            decoder ? decoder(&level.textures[std::size_t(material.lightmap_texture_embedded)], "",
-                              &image)
-                    : "no decoder";
-        if (problem.empty() && image.width > 0 && image.height > 0) {
-          lightmaps_[int(m)] = UploadTexture(image, GL_CLAMP_TO_EDGE);
-        } else {
-          warnings_.push_back("material '" + material.name + "': its lightmap cannot be read (" +
-                              (problem.empty() ? "empty" : problem) + "); lit by the sun instead");
-        }
+    }
+    // The robots' bone groups, per triangle, for segmentation.
+    for (std::size_t r = 0; r < level.robots.size(); ++r) {
+      std::vector<std::vector<std::uint32_t>>& groups = robot_groups_[&level.robots[r]];
+      for (std::size_t m = 0; m < level.robots[r].meshes.size(); ++m) {
+        groups.push_back(BoneGroupPerTriangle(level.robots[r], int(m)));
       }
     }
   }
@@ -309,21 +323,20 @@ class OsMesaRenderer : public Renderer {
               const std::vector<const scene::RobotState*>& robots, const RenderSettings& settings,
               Frame* frame, const Overlay* overlay) override {
     view.ValidateOrThrow();
-    Resize(view.width, view.height);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
-    glViewport(0, 0, view.width, view.height);
-    glClearColor(settings.sky_rgb.x(), settings.sky_rgb.y(), settings.sky_rgb.z(), 1.f);
+    if (overlay != nullptr && (overlay->point_rgb.size() != overlay->points_W.size() ||
+                               overlay->line_rgb.size() * 2 != overlay->lines_W.size())) {
+      throw std::invalid_argument("Renderer: an overlay needs one colour per point and per line");
+    }
+    const ImageKinds kinds = settings.images;
+    const int samples = settings.msaa_samples > 1 ? std::min(settings.msaa_samples, 8) : 0;
+    Resize(view.width, view.height, samples);
     clip_control_(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-    glClearDepth(0.0);
-    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    glDepthFunc(GL_GREATER);
-    glEnable(GL_DEPTH_TEST);
-    glDisable(GL_CULL_FACE);
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    actor_poses_ = &actor_poses;
+    UploadRobots(robots);
+    UploadTerrain();
 
     // Camera-centred world: rotation only in the view; positions relative to the camera.
-    const Eigen::Vector3d camera = view.X_WC.translation();
+    camera_ = view.X_WC.translation();
     Eigen::Matrix3d R_EyeCam;
     R_EyeCam << 0, -1, 0, 0, 0, 1, -1, 0, 0;  // camera x forward, y left, z up -> GL eye
     Eigen::Matrix4d view_rotation = Eigen::Matrix4d::Identity();
@@ -341,92 +354,140 @@ class OsMesaRenderer : public Renderer {
     const Eigen::Matrix4d view_proj_d = projection * view_rotation;
     const Eigen::Matrix4f view_proj = view_proj_d.cast<float>();
     const Eigen::Vector3f sun = settings.sun_direction_W.normalized();
-    DrawSky(view_proj_d.inverse().cast<float>(), settings.sky_rgb, sun);
-    glUseProgram(program_);
-    glUniformMatrix4fv(uniforms_.view_proj, 1, GL_FALSE, view_proj.data());
-    glUniform3f(uniforms_.sun, sun.x(), sun.y(), sun.z());
-    glUniform3f(uniforms_.sky, settings.sky_rgb.x(), settings.sky_rgb.y(), settings.sky_rgb.z());
-    // The haze: the level's visibility when it gives one.
-    const bool default_fog = settings.fog_end_m == RenderSettings{}.fog_end_m;
-    const double visibility = level_->horizon ? level_->horizon->visibility_m : 0.0;
-    if (default_fog && visibility > 0.0) {
-      glUniform2f(uniforms_.fog, float(0.1 * visibility), float(visibility));
-    } else {
-      glUniform2f(uniforms_.fog, settings.fog_start_m, settings.fog_end_m);
-    }
-    glUniform1i(uniforms_.base_texture, 0);
-    glUniform1i(uniforms_.lightmap, 1);
 
-    // Opaque first, then the translucent (water) on top. Static chunks outside
-    // the view are skipped.
-    const Eigen::Matrix4f static_model =
-        Relative(Eigen::Affine3d(Eigen::Translation3d(origin_)), camera);
-    const Eigen::Matrix4f static_clip = view_proj * static_model;
-    if (horizon_.index_count > 0) {
-      const Eigen::Vector3f& rgb = level_->horizon->rgb;
-      DrawWith(horizon_, static_model, Eigen::Vector4f(rgb.x(), rgb.y(), rgb.z(), 1.f), 0);
-      glDrawElements(GL_TRIANGLES, horizon_.index_count, GL_UNSIGNED_INT, nullptr);
+    // Shadow maps first (they need the scene's upload above).
+    const bool shadows = settings.shadows && kinds & kColorImage && sun.z() > 0.02f;
+    std::vector<ShadowCascade> cascades;
+    if (shadows) {
+      cascades = FitShadowCascades(view, sun.cast<double>(), settings.shadow_distance_m,
+                                   std::clamp(settings.shadow_cascades, 1, 4),
+                                   std::clamp(settings.shadow_map_px, 256, 8192), 1500.0);
+      DrawShadowMaps(cascades, settings.shadow_map_px);
     }
-    DrawTerrain(view_proj, camera);
-    for (const bool translucent : {false, true}) {
-      for (const auto& [bounds, mesh] : static_meshes_) {
-        if (IsTranslucent(mesh.material) != translucent || !InFrustum(static_clip, bounds))
-          continue;
-        Draw(mesh, static_model);
-      }
-      for (const auto& [actor, mesh] : actor_meshes_) {
-        if (IsTranslucent(mesh.material) != translucent) continue;
-        const Eigen::Isometry3d& X_WA = actor_poses.size() == level_->actors.size()
-                                            ? actor_poses[std::size_t(actor)]
-                                            : level_->actors[std::size_t(actor)].X_WA;
-        Draw(mesh, Relative(Eigen::Affine3d(X_WA.matrix()), camera));
+
+    // The look's programs, each with this frame's uniforms.
+    const int look = (settings.gamma_correct ? kGamma : 0) | (settings.materials ? kMaterials : 0) |
+                     (shadows ? kShadows : 0);
+    for (const int pass_look : {look, look | kDataOnly}) {
+      look_ = pass_look;
+      for (int surface = 0; surface < 3; ++surface) {
+        UseSurface(surface);
+        glUniformMatrix4fv(U("view_proj"), 1, GL_FALSE, view_proj.data());
+        SetLookUniforms(view, settings, sun, cascades);
       }
     }
-    // Robots: their posed meshes, uploaded afresh.
-    for (std::size_t r = 0; r < robots.size(); ++r) {
-      const scene::RobotState& state = *robots[r];
-      std::vector<GpuMesh>& meshes = robot_meshes_[&state.model()];
-      const auto& model = state.model();
-      for (std::size_t m = 0; m < model.meshes.size(); ++m) {
-        if (meshes.size() <= m) {
-          meshes.push_back(Upload(state.positions_B(int(m)), state.normals_B(int(m)),
-                                  model.meshes[m].bind.uvs, model.meshes[m].bind.lightmap_uvs,
-                                  model.meshes[m].bind.indices, model.meshes[m].bind.material,
-                                  GL_DYNAMIC_DRAW));
-        } else {
-          glBindBuffer(GL_ARRAY_BUFFER, meshes[m].positions);
-          glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(state.positions_B(int(m)).size() * 12),
-                          state.positions_B(int(m)).data());
-          glBindBuffer(GL_ARRAY_BUFFER, meshes[m].normals);
-          glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(state.normals_B(int(m)).size() * 12),
-                          state.normals_B(int(m)).data());
-        }
-        Draw(meshes[m], Relative(Eigen::Affine3d(state.pose().matrix()), camera));
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);
+    glDisable(GL_CULL_FACE);
+    const GLenum color_only[] = {GL_COLOR_ATTACHMENT0};
+    const GLenum all[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+    const GLenum data_only[] = {GL_NONE, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+    const bool want_data = (kinds & (kSegmentationImage | kNormalsImage)) != 0;
+    const bool want_depth = (kinds & kDepthImage) != 0;
+    const Eigen::Vector3f horizon = settings.sky_rgb;
+
+    // Colour: into the multisampled buffer, or straight into the data buffer
+    // (then with segment and normal in the same pass).
+    if (kinds & kColorImage) {
+      glBindFramebuffer(GL_FRAMEBUFFER, samples > 0 ? msaa_fbo_ : fbo_);
+      glViewport(0, 0, view.width, view.height);
+      ClearTargets(samples == 0, horizon);
+      glDrawBuffers(1, color_only);
+      DrawSky(view_proj_d.inverse().cast<float>(), horizon, sun);
+      if (samples == 0 && want_data) glDrawBuffers(3, all);
+      look_ = look;
+      DrawScene(Pass::kColor, view_proj);
+      if (samples > 0) {
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, msaa_fbo_);
+        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo_);
+        glReadBuffer(GL_COLOR_ATTACHMENT0);
+        glDrawBuffers(1, color_only);
+        glBlitFramebuffer(0, 0, view.width, view.height, 0, 0, view.width, view.height,
+                          GL_COLOR_BUFFER_BIT, GL_NEAREST);
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
       }
     }
+    // Depth, segment and normal at pixel centres, when colour did not give
+    // them (the overlay is hidden by this depth too).
+    const bool marks = overlay != nullptr && !overlay->empty() && (kinds & kColorImage);
+    if ((want_data || want_depth || marks) && (samples > 0 || !(kinds & kColorImage))) {
+      glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+      glViewport(0, 0, view.width, view.height);
+      ClearTargets(true, horizon, /*keep_color=*/true);
+      glDrawBuffers(3, data_only);
+      look_ = look | kDataOnly;
+      DrawScene(Pass::kData, view_proj);
+    }
+
     // Read back, bottom row first in GL (flipped below); depth before the overlay.
     const int w = view.width, h = view.height;
-    pixels_.resize(std::size_t(w) * h * 4);
-    depth_.resize(std::size_t(w) * h);
-    glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, depth_.data());
-    if (overlay != nullptr && !overlay->empty()) DrawOverlay(*overlay, camera, view_proj);
-    glFinish();
-    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, pixels_.data());
+    const std::size_t count = std::size_t(w) * std::size_t(h);
     frame->width = w;
     frame->height = h;
-    frame->rgb.resize(std::size_t(w) * h * 3);
-    frame->depth_m.resize(std::size_t(w) * h);
-    for (int y = 0; y < h; ++y) {
-      const std::size_t src = std::size_t(h - 1 - y) * std::size_t(w),
-                        dst = std::size_t(y) * std::size_t(w);
-      for (int x = 0; x < w; ++x) {
-        for (int c = 0; c < 3; ++c)
-          frame->rgb[3 * (dst + std::size_t(x)) + std::size_t(c)] =
-              pixels_[4 * (src + std::size_t(x)) + std::size_t(c)];
-        const double d = depth_[src + std::size_t(x)];
-        frame->depth_m[dst + std::size_t(x)] =
-            d <= 0.0 ? std::numeric_limits<float>::infinity() : float(n * fa / (d * (fa - n) + n));
+    frame->kinds = kinds;
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
+    if (want_depth) {
+      depth_.resize(count);
+      glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, depth_.data());
+      frame->depth_m.resize(count);
+      for (int y = 0; y < h; ++y) {
+        const float* src = &depth_[std::size_t(h - 1 - y) * std::size_t(w)];
+        float* dst = &frame->depth_m[std::size_t(y) * std::size_t(w)];
+        for (int x = 0; x < w; ++x) {
+          const double d = src[x];
+          dst[x] = d <= 0.0 ? std::numeric_limits<float>::infinity()
+                            : float(n * fa / (d * (fa - n) + n));
+        }
       }
+    } else {
+      frame->depth_m.clear();
+    }
+    if (kinds & kSegmentationImage) {
+      segment_.resize(count);
+      glReadBuffer(GL_COLOR_ATTACHMENT1);
+      glReadPixels(0, 0, w, h, GL_RED_INTEGER, GL_UNSIGNED_INT, segment_.data());
+      frame->segment.resize(count);
+      for (int y = 0; y < h; ++y) {
+        std::copy_n(&segment_[std::size_t(h - 1 - y) * std::size_t(w)], w,
+                    &frame->segment[std::size_t(y) * std::size_t(w)]);
+      }
+    } else {
+      frame->segment.clear();
+    }
+    if (kinds & kNormalsImage) {
+      normal_.resize(3 * count);
+      glReadBuffer(GL_COLOR_ATTACHMENT2);
+      glReadPixels(0, 0, w, h, GL_RGB, GL_FLOAT, normal_.data());
+      frame->normal_C.resize(3 * count);
+      for (int y = 0; y < h; ++y) {
+        std::copy_n(&normal_[3 * std::size_t(h - 1 - y) * std::size_t(w)], 3 * w,
+                    &frame->normal_C[3 * std::size_t(y) * std::size_t(w)]);
+      }
+    } else {
+      frame->normal_C.clear();
+    }
+    if (kinds & kColorImage) {
+      glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+      if (marks) {
+        glDrawBuffers(1, color_only);
+        DrawOverlay(*overlay, view_proj);
+      }
+      glFinish();
+      pixels_.resize(4 * count);
+      glReadBuffer(GL_COLOR_ATTACHMENT0);
+      glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, pixels_.data());
+      frame->rgb.resize(3 * count);
+      for (int y = 0; y < h; ++y) {
+        const std::uint8_t* src = &pixels_[4 * std::size_t(h - 1 - y) * std::size_t(w)];
+        std::uint8_t* dst = &frame->rgb[3 * std::size_t(y) * std::size_t(w)];
+        for (int x = 0; x < w; ++x) {
+          dst[3 * x] = src[4 * x];
+          dst[3 * x + 1] = src[4 * x + 1];
+          dst[3 * x + 2] = src[4 * x + 2];
+        }
+      }
+    } else {
+      frame->rgb.clear();
     }
   }
 
@@ -437,18 +498,368 @@ class OsMesaRenderer : public Renderer {
   std::string description() const override { return description_; }
 
  private:
-  // Static actors' meshes in world coordinates, grouped by material and by
-  // ground cell, uploaded once: few draws, and whole cells culled.
+  // The scene program for a surface (0 plain, 1 terrain, 2 water) and the
+  // look of the pass (look_), made at its first use, in use. Fixed sampler
+  // units: 0 base colour, 1 lightmap, 2 normal map, 3 detail, 4 shadow map,
+  // 5 triangle segments.
+  void UseSurface(int surface) {
+    const int key = std::clamp(surface, 0, 2) | look_;
+    if (key == program_key_) return;
+    program_key_ = key;
+    auto found = programs_.find(key);
+    const bool made = found == programs_.end();
+    if (made) {
+      std::string fragment = "#version 450 core\n";
+      const std::pair<const char*, int> defines[] = {{"SURFACE", key & 3},
+                                                     {"GAMMA", (key & kGamma) != 0},
+                                                     {"MATERIALS", (key & kMaterials) != 0},
+                                                     {"SHADOWS", (key & kShadows) != 0},
+                                                     {"DATA_ONLY", (key & kDataOnly) != 0}};
+      for (const auto& [name, value] : defines) {
+        fragment += "#define " + std::string(name) + " " + std::to_string(value) + "\n";
+      }
+      fragment += shaders::kSceneFragment;
+      found =
+          programs_.emplace(key, SceneProgram{Link(shaders::kSceneVertex, fragment.c_str()), {}})
+              .first;
+    }
+    program_ = &found->second;
+    glUseProgram(program_->id);
+    if (made) {
+      const std::pair<const char*, int> units[] = {{"base_texture", 0},   {"lightmap", 1},
+                                                   {"normal_texture", 2}, {"detail", 3},
+                                                   {"shadow_map", 4},     {"segments", 5}};
+      for (const auto& [name, unit] : units) glUniform1i(U(name), unit);
+    }
+  }
+  // A uniform of the scene program in use.
+  GLint U(const char* name) {
+    auto found = program_->uniforms.find(name);
+    if (found != program_->uniforms.end()) return found->second;
+    return program_->uniforms[name] = glGetUniformLocation(program_->id, name);
+  }
+
+  void ClearTargets(bool data_targets, const Eigen::Vector3f& sky, bool keep_color = false) {
+    glDepthMask(GL_TRUE);
+    glClearDepth(0.0);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    if (!keep_color) {
+      const float color[] = {sky.x(), sky.y(), sky.z(), 1.f};
+      glClearBufferfv(GL_COLOR, 0, color);
+    }
+    if (data_targets) {
+      const GLuint zero_id[] = {0, 0, 0, 0};
+      const float zero[] = {0.f, 0.f, 0.f, 0.f};
+      const GLenum all[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+      glDrawBuffers(3, all);
+      glClearBufferuiv(GL_COLOR, 1, zero_id);
+      glClearBufferfv(GL_COLOR, 2, zero);
+    }
+  }
+
+  void SetLookUniforms(const CameraView& view, const RenderSettings& settings,
+                       const Eigen::Vector3f& sun, const std::vector<ShadowCascade>& cascades) {
+    glUniform3f(U("sun"), sun.x(), sun.y(), sun.z());
+    const Eigen::Vector3f horizon = settings.sky_rgb, zenith = Zenith(horizon);
+    glUniform3f(U("horizon"), horizon.x(), horizon.y(), horizon.z());
+    glUniform3f(U("zenith"), zenith.x(), zenith.y(), zenith.z());
+    // The haze: the level's visibility when it gives one.
+    const bool default_fog = settings.fog_end_m == RenderSettings{}.fog_end_m;
+    const double visibility = level_->horizon ? level_->horizon->visibility_m : 0.0;
+    if (!settings.haze) {
+      glUniform2f(U("fog"), 0.f, 0.f);
+    } else if (default_fog && visibility > 0.0) {
+      glUniform2f(U("fog"), float(0.1 * visibility), float(visibility));
+    } else {
+      glUniform2f(U("fog"), settings.fog_start_m, settings.fog_end_m);
+    }
+    // Anisotropic filtering of material textures (the sampler repeats at the edges).
+    const float anisotropy = std::clamp(float(settings.anisotropy), 1.f, max_anisotropy_);
+    if (anisotropy > 1.f) {
+      glSamplerParameterf(anisotropic_, GL_TEXTURE_MAX_ANISOTROPY, anisotropy);
+      glBindSampler(0, anisotropic_);
+      glBindSampler(2, anisotropic_);
+    } else {
+      glBindSampler(0, 0);
+      glBindSampler(2, 0);
+    }
+    glUniform1f(U("camera_z"), float(camera_.z()));
+    glUniform2f(U("camera_xy"), float(std::fmod(camera_.x(), kPatternPeriod_m)),
+                float(std::fmod(camera_.y(), kPatternPeriod_m)));
+    glUniform1f(U("water_level"), water_level_);
+    glUniform1f(U("snow_line"), 2800.f);
+    const Eigen::Vector3f grass =
+        level_->horizon ? level_->horizon->rgb : Eigen::Vector3f(0.36f, 0.45f, 0.24f);
+    glUniform3f(U("grass_rgb"), grass.x(), grass.y(), grass.z());
+    const Eigen::Vector3f axis = view.X_WC.linear().col(0).cast<float>();
+    glUniform3f(U("view_axis"), axis.x(), axis.y(), axis.z());
+    const Eigen::Matrix3f R_CW = view.X_WC.linear().transpose().cast<float>();
+    glUniformMatrix3fv(U("world_to_camera"), 1, GL_FALSE, R_CW.data());
+    glUniform1i(U("cascades"), int(cascades.size()));
+    for (std::size_t c = 0; c < cascades.size(); ++c) {
+      const std::string i = "[" + std::to_string(c) + "]";
+      const Eigen::Matrix4f M = cascades[c].light_clip.cast<float>();
+      glUniformMatrix4fv(U(("shadow_clip" + i).c_str()), 1, GL_FALSE, M.data());
+      glUniform1f(U(("cascade_far" + i).c_str()), float(cascades[c].far_m));
+      glUniform1f(U(("shadow_texel" + i).c_str()), float(cascades[c].texel_m));
+    }
+    glActiveTexture(GL_TEXTURE3);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, detail_);
+    glActiveTexture(GL_TEXTURE4);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, shadow_map_);
+    glActiveTexture(GL_TEXTURE0);
+  }
+
+  static Eigen::Vector3f Zenith(const Eigen::Vector3f& horizon) {
+    return 0.55f * horizon + Eigen::Vector3f(0.02f, 0.08f, 0.25f);
+  }
+
+  // Everything in the world, in one pass. Opaque first, then the translucent
+  // (water) on top; whatever lies outside the view is skipped.
+  void DrawScene(Pass pass, const Eigen::Matrix4f& view_proj) {
+    pass_ = pass;
+    view_proj_ = view_proj;
+    const Eigen::Matrix4f static_model =
+        Relative(Eigen::Affine3d(Eigen::Translation3d(origin_)), camera_);
+    const Eigen::Matrix4f static_clip = view_proj * static_model;
+    if (horizon_.index_count > 0 && pass != Pass::kShadow) {
+      const Eigen::Vector3f& rgb = level_->horizon->rgb;
+      DrawMesh(horizon_, static_model, Eigen::Vector4f(rgb.x(), rgb.y(), rgb.z(), 1.f), 0);
+    }
+    DrawTerrain();
+    const bool blend = pass == Pass::kColor;
+    for (const bool translucent : {false, true}) {
+      if (translucent && pass == Pass::kShadow) break;
+      if (translucent && blend) {
+        glEnable(GL_BLEND);
+        glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+      }
+      for (const auto& [bounds, mesh] : static_meshes_) {
+        if (IsTranslucent(mesh) != translucent || !InFrustum(static_clip, bounds)) continue;
+        Draw(mesh, static_model);
+      }
+      for (const auto& [actor, mesh] : actor_meshes_) {
+        if (IsTranslucent(mesh) != translucent) continue;
+        const Eigen::Isometry3d& X_WA = actor_poses_->size() == level_->actors.size()
+                                            ? (*actor_poses_)[std::size_t(actor)]
+                                            : level_->actors[std::size_t(actor)].X_WA;
+        Draw(mesh, Relative(Eigen::Affine3d(X_WA.matrix()), camera_));
+      }
+      if (!translucent) {
+        for (const auto& [pose, meshes] : posed_robots_) {
+          for (const GpuMesh* mesh : meshes)
+            Draw(*mesh, Relative(Eigen::Affine3d(pose.matrix()), camera_));
+        }
+      }
+      glDisable(GL_BLEND);
+    }
+  }
+
+  bool IsTranslucent(const GpuMesh& mesh) const {
+    if (mesh.surface == int(scene::Surface::kWater)) return true;
+    if (mesh.material < 0 || mesh.material >= int(level_->materials.size())) return false;
+    const scene::Material& m = level_->materials[std::size_t(mesh.material)];
+    return m.surface == scene::Surface::kWater ||
+           (m.alpha_mode != scene::AlphaMode::kMask && m.base_color.w() < 0.999f);
+  }
+
+  // A mesh with its material.
+  void Draw(const GpuMesh& mesh, const Eigen::Matrix4f& model) {
+    const scene::Material* material =
+        mesh.material >= 0 && mesh.material < int(level_->materials.size())
+            ? &level_->materials[std::size_t(mesh.material)]
+            : nullptr;
+    static const scene::Material kDefault = [] {
+      scene::Material m;
+      m.base_color = {0.8f, 0.8f, 0.8f, 1.f};
+      return m;
+    }();
+    const scene::Material& m = material != nullptr ? *material : kDefault;
+    const auto texture = textures_.find(mesh.material);
+    const GLuint texture_id = texture != textures_.end() ? texture->second : 0;
+    if (pass_ == Pass::kShadow) {
+      const bool masked =
+          m.alpha_mode == scene::AlphaMode::kMask && texture_id != 0 && mesh.uvs != 0;
+      glUniform1i(shadow_uniforms_.masked, masked);
+      glUniform1f(shadow_uniforms_.alpha_cutoff, m.alpha_cutoff);
+      glUniformMatrix4fv(shadow_uniforms_.model, 1, GL_FALSE, model.data());
+      glBindTexture(GL_TEXTURE_2D, masked ? texture_id : 0);
+      glBindVertexArray(mesh.vao);
+      glDrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
+      return;
+    }
+    UseSurface(mesh.surface >= 0 ? mesh.surface : int(m.surface));
+    glUniformMatrix4fv(U("model"), 1, GL_FALSE, model.data());
+    glUniform4f(U("base_color"), m.base_color.x(), m.base_color.y(), m.base_color.z(),
+                m.base_color.w());
+    glUniform1i(U("linear_factor"), m.linear_color);
+    glUniform1i(U("alpha_mode"), int(m.alpha_mode));
+    glUniform1f(U("alpha_cutoff"), m.alpha_cutoff);
+    glUniform2f(U("metal_rough"), m.metallic, m.roughness);
+    BindTexture(GL_TEXTURE0, "has_texture", texture_id, mesh.uvs != 0);
+    const auto lightmap = lightmaps_.find(mesh.material);
+    BindTexture(GL_TEXTURE1, "has_lightmap", lightmap != lightmaps_.end() ? lightmap->second : 0,
+                mesh.lightmap_uvs != 0);
+    const auto normal_map = normal_maps_.find(mesh.material);
+    BindTexture(GL_TEXTURE2, "has_normal_map",
+                normal_map != normal_maps_.end() ? normal_map->second : 0, mesh.uvs != 0);
+    DrawIds(mesh);
+  }
+
+  // The rest of a draw: segment ids, then the triangles.
+  void DrawIds(const GpuMesh& mesh) {
+    glUniform1ui(U("segment_base"), mesh.segment_base);
+    glUniform1i(U("triangle_segments"), mesh.triangle_segments != 0);
+    glActiveTexture(GL_TEXTURE5);
+    glBindTexture(GL_TEXTURE_BUFFER, mesh.triangle_segments);
+    glActiveTexture(GL_TEXTURE0);
+    glBindVertexArray(mesh.vao);
+    glDrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
+  }
+
+  void BindTexture(GLenum unit, const char* flag, GLuint texture, bool usable) {
+    glUniform1i(U(flag), texture != 0 && usable);
+    glActiveTexture(unit);
+    glBindTexture(GL_TEXTURE_2D, texture);
+    glActiveTexture(GL_TEXTURE0);
+  }
+
+  // A mesh in one colour (and texture, 0: none), not a level material: the
+  // horizon and terrain tiles. Draws all of it unless `ranges` are given.
+  void DrawMesh(const GpuMesh& mesh, const Eigen::Matrix4f& model, const Eigen::Vector4f& color,
+                GLuint texture,
+                const std::vector<std::pair<std::uint32_t, std::uint32_t>>* ranges = nullptr) {
+    if (pass_ == Pass::kShadow) {
+      glUniform1i(shadow_uniforms_.masked, 0);
+      glUniformMatrix4fv(shadow_uniforms_.model, 1, GL_FALSE, model.data());
+    } else {
+      UseSurface(mesh.surface >= 0 ? mesh.surface : 0);
+      glUniformMatrix4fv(U("model"), 1, GL_FALSE, model.data());
+      glUniform4f(U("base_color"), color.x(), color.y(), color.z(), color.w());
+      glUniform1i(U("linear_factor"), 0);
+      glUniform1i(U("alpha_mode"), 0);
+      glUniform2f(U("metal_rough"), 0.f, 1.f);
+      BindTexture(GL_TEXTURE0, "has_texture", texture, mesh.uvs != 0);
+      BindTexture(GL_TEXTURE1, "has_lightmap", 0, false);
+      BindTexture(GL_TEXTURE2, "has_normal_map", 0, false);
+      glUniform1ui(U("segment_base"), mesh.segment_base);
+      glUniform1i(U("triangle_segments"), 0);
+    }
+    glBindVertexArray(mesh.vao);
+    if (ranges == nullptr) {
+      glDrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
+      return;
+    }
+    for (const auto& [a, b] : *ranges) {
+      if (b <= a) continue;
+      glDrawElements(GL_TRIANGLES, GLsizei(b - a), GL_UNSIGNED_INT,
+                     reinterpret_cast<const void*>(std::uintptr_t(a) * 4));
+    }
+  }
+
+  // The sun's depth from each cascade's box.
+  void DrawShadowMaps(const std::vector<ShadowCascade>& cascades, int px) {
+    const int layers = int(cascades.size());
+    if (shadow_map_ == 0 || shadow_px_ != px || shadow_layers_ < layers) {
+      if (shadow_map_ != 0) glDeleteTextures(1, &shadow_map_);
+      if (shadow_fbo_ == 0) glGenFramebuffers(1, &shadow_fbo_);
+      glGenTextures(1, &shadow_map_);
+      glBindTexture(GL_TEXTURE_2D_ARRAY, shadow_map_);
+      glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_DEPTH_COMPONENT32F, px, px, layers, 0,
+                   GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
+      glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+      glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+      glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+      shadow_px_ = px;
+      shadow_layers_ = layers;
+    }
+    glUseProgram(shadow_program_);
+    program_key_ = -1;
+    shadow_uniforms_ = {glGetUniformLocation(shadow_program_, "model"),
+                        glGetUniformLocation(shadow_program_, "view_proj"),
+                        glGetUniformLocation(shadow_program_, "masked"),
+                        glGetUniformLocation(shadow_program_, "alpha_cutoff")};
+    glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo_);
+    glDrawBuffer(GL_NONE);
+    glReadBuffer(GL_NONE);
+    glViewport(0, 0, px, px);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(1.5f, 2.f);
+    for (int c = 0; c < layers; ++c) {
+      glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, shadow_map_, 0, c);
+      glClearDepth(1.0);
+      glClear(GL_DEPTH_BUFFER_BIT);
+      const Eigen::Matrix4f clip = cascades[std::size_t(c)].light_clip.cast<float>();
+      glUniformMatrix4fv(shadow_uniforms_.view_proj, 1, GL_FALSE, clip.data());
+      DrawScene(Pass::kShadow, clip);
+    }
+    glDisable(GL_POLYGON_OFFSET_FILL);
+  }
+
+  // Robots: their posed meshes, uploaded once a frame for every pass.
+  void UploadRobots(const std::vector<const scene::RobotState*>& robots) {
+    posed_robots_.clear();
+    for (const scene::RobotState* state : robots) {
+      const scene::RobotModel& model = state->model();
+      std::vector<GpuMesh>& meshes = robot_meshes_[&model];
+      std::vector<const GpuMesh*> drawn;
+      for (std::size_t m = 0; m < model.meshes.size(); ++m) {
+        const scene::Mesh& bind = model.meshes[m].bind;
+        if (meshes.size() <= m) {
+          meshes.push_back(
+              Upload({&state->positions_B(int(m)), &state->normals_B(int(m)), &bind.uvs,
+                      &bind.lightmap_uvs, &bind.colors, nullptr, &bind.indices},
+                     bind.material, GL_DYNAMIC_DRAW));
+          const int r = RobotIndex(model);
+          meshes.back().segment_base = r >= 0 ? legend_->bone(r, 0) : 0xffffu;
+          const auto groups = robot_groups_.find(&model);
+          if (r >= 0 && groups != robot_groups_.end())
+            SetTriangleSegments(&meshes.back(), groups->second[m]);
+        } else {
+          glBindBuffer(GL_ARRAY_BUFFER, meshes[m].positions);
+          glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(state->positions_B(int(m)).size() * 12),
+                          state->positions_B(int(m)).data());
+          glBindBuffer(GL_ARRAY_BUFFER, meshes[m].normals);
+          glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(state->normals_B(int(m)).size() * 12),
+                          state->normals_B(int(m)).data());
+        }
+        drawn.push_back(&meshes[m]);
+      }
+      posed_robots_.emplace_back(state->pose(), std::move(drawn));
+    }
+  }
+
+  int RobotIndex(const scene::RobotModel& model) const {
+    for (std::size_t r = 0; r < level_->robots.size(); ++r) {
+      if (&level_->robots[r] == &model) return int(r);
+    }
+    return -1;
+  }
+
+  // Static actors' meshes in world coordinates, grouped by material, surface
+  // and ground cell, uploaded once: few draws, and whole cells culled.
   void MergeStatic(const scene::Level& level) {
     origin_ = level.bounds_W().isEmpty() ? Eigen::Vector3d(Eigen::Vector3d::Zero())
                                          : Eigen::Vector3d(level.bounds_W().center());
-    std::map<std::tuple<int, long, long>, StaticChunk> chunks;
-    for (const scene::Actor& actor : level.actors) {
+    std::map<std::tuple<int, int, long, long>, StaticChunk> chunks;
+    for (std::size_t a = 0; a < level.actors.size(); ++a) {
+      const scene::Actor& actor = level.actors[a];
       if (actor.movable) continue;
+      const int surface = actor.surface ? int(*actor.surface) : -1;
       const Eigen::Matrix3d R = actor.X_WA.linear();
       for (const scene::Mesh& mesh : actor.meshes) {
         // This mesh's vertices already copied into each chunk.
-        std::map<std::tuple<int, long, long>, std::vector<std::int64_t>> copied;
+        std::map<std::tuple<int, int, long, long>, std::vector<std::int64_t>> copied;
+        const bool has_uvs = mesh.uvs.size() == mesh.positions_A.size();
+        const bool has_lightmap_uvs = mesh.lightmap_uvs.size() == mesh.positions_A.size();
+        const bool has_colors = mesh.colors.size() == mesh.positions_A.size();
         for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
           Eigen::Vector3d p[3];
           for (int k = 0; k < 3; ++k) {
@@ -456,16 +867,15 @@ class OsMesaRenderer : public Renderer {
                    origin_;
           }
           const Eigen::Vector3d c = (p[0] + p[1] + p[2]) / 3.0;
-          const std::tuple<int, long, long> key{mesh.material,
-                                                std::lround(std::floor(c.x() / kChunkCell_m)),
-                                                std::lround(std::floor(c.y() / kChunkCell_m))};
+          const std::tuple<int, int, long, long> key{mesh.material, surface,
+                                                     std::lround(std::floor(c.x() / kChunkCell_m)),
+                                                     std::lround(std::floor(c.y() / kChunkCell_m))};
           StaticChunk& chunk = chunks[key];
           std::vector<std::int64_t>& map = copied[key];
           if (map.empty()) map.assign(mesh.positions_A.size(), -1);
-          const bool has_uvs = mesh.uvs.size() == mesh.positions_A.size();
-          const bool has_lightmap_uvs = mesh.lightmap_uvs.size() == mesh.positions_A.size();
           chunk.any_uvs = chunk.any_uvs || has_uvs;
           chunk.any_lightmap_uvs = chunk.any_lightmap_uvs || has_lightmap_uvs;
+          chunk.any_colors = chunk.any_colors || has_colors;
           for (int k = 0; k < 3; ++k) {
             const std::uint32_t v = mesh.indices[t + std::size_t(k)];
             if (map[v] < 0) {
@@ -475,6 +885,8 @@ class OsMesaRenderer : public Renderer {
               chunk.uvs.push_back(has_uvs ? mesh.uvs[v] : Eigen::Vector2f::Zero());
               chunk.lightmap_uvs.push_back(has_lightmap_uvs ? mesh.lightmap_uvs[v]
                                                             : Eigen::Vector2f::Zero());
+              chunk.colors.push_back(has_colors ? mesh.colors[v] : Eigen::Vector4f::Ones());
+              chunk.segments.push_back(legend_->actor(int(a)));
               chunk.bounds.extend(chunk.positions.back());
             }
             chunk.indices.push_back(std::uint32_t(map[v]));
@@ -485,24 +897,22 @@ class OsMesaRenderer : public Renderer {
     for (auto& [key, chunk] : chunks) {
       if (!chunk.any_uvs) chunk.uvs.clear();
       if (!chunk.any_lightmap_uvs) chunk.lightmap_uvs.clear();
-      static_meshes_.push_back(
-          {chunk.bounds, Upload(chunk.positions, chunk.normals, chunk.uvs, chunk.lightmap_uvs,
-                                chunk.indices, std::get<0>(key), GL_STATIC_DRAW)});
+      if (!chunk.any_colors) chunk.colors.clear();
+      GpuMesh gpu = Upload({&chunk.positions, &chunk.normals, &chunk.uvs, &chunk.lightmap_uvs,
+                            &chunk.colors, &chunk.segments, &chunk.indices},
+                           std::get<0>(key), GL_STATIC_DRAW);
+      gpu.surface = std::get<1>(key);
+      static_meshes_.push_back({chunk.bounds, gpu});
     }
   }
 
-  bool IsTranslucent(int material) const {
-    return material >= 0 && material < int(level_->materials.size()) &&
-           level_->materials[std::size_t(material)].base_color.w() < 0.999f;
-  }
-
-  // An RGBA8 texture with mipmaps.
-  static GLuint UploadTexture(const RgbaImage& image, GLint wrap) {
+  // An RGBA8 texture (sRGB: colours; else data) with mipmaps.
+  GLuint UploadTexture(const RgbaImage& image, GLint wrap, bool srgb) {
     GLuint id = 0;
     glGenTextures(1, &id);
     glBindTexture(GL_TEXTURE_2D, id);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, image.width, image.height, 0, GL_RGBA,
-                 GL_UNSIGNED_BYTE, image.rgba.data());
+    glTexImage2D(GL_TEXTURE_2D, 0, srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, image.width, image.height, 0,
+                 GL_RGBA, GL_UNSIGNED_BYTE, image.rgba.data());
     glGenerateMipmap(GL_TEXTURE_2D);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
@@ -511,26 +921,17 @@ class OsMesaRenderer : public Renderer {
     return id;
   }
 
-  // A mesh with its own colour and texture (0: none), all of it.
-  void DrawWith(const GpuMesh& mesh, const Eigen::Matrix4f& model, const Eigen::Vector4f& color,
-                GLuint texture) {
-    glUniformMatrix4fv(uniforms_.model, 1, GL_FALSE, model.data());
-    glUniform4f(uniforms_.base_color, color.x(), color.y(), color.z(), color.w());
-    glUniform1i(uniforms_.has_texture, texture != 0 && mesh.uvs != 0);
-    glUniform1i(uniforms_.has_lightmap, 0);
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, texture);
-    glBindVertexArray(mesh.vao);
-  }
-
   void DrawSky(const Eigen::Matrix4f& clip_to_world, const Eigen::Vector3f& horizon,
                const Eigen::Vector3f& sun) {
     glUseProgram(sky_program_);
-    glUniformMatrix4fv(sky_uniforms_[0], 1, GL_FALSE, clip_to_world.data());
-    glUniform3f(sky_uniforms_[1], horizon.x(), horizon.y(), horizon.z());
-    const Eigen::Vector3f zenith = 0.55f * horizon + Eigen::Vector3f(0.02f, 0.08f, 0.25f);
-    glUniform3f(sky_uniforms_[2], zenith.x(), zenith.y(), zenith.z());
-    glUniform3f(sky_uniforms_[3], sun.x(), sun.y(), sun.z());
+    program_key_ = -1;
+    glUniformMatrix4fv(glGetUniformLocation(sky_program_, "clip_to_world"), 1, GL_FALSE,
+                       clip_to_world.data());
+    glUniform3f(glGetUniformLocation(sky_program_, "horizon"), horizon.x(), horizon.y(),
+                horizon.z());
+    const Eigen::Vector3f zenith = Zenith(horizon);
+    glUniform3f(glGetUniformLocation(sky_program_, "zenith"), zenith.x(), zenith.y(), zenith.z());
+    glUniform3f(glGetUniformLocation(sky_program_, "sun"), sun.x(), sun.y(), sun.z());
     glDepthMask(GL_FALSE);
     glDisable(GL_DEPTH_TEST);
     glBindVertexArray(overlay_vao_);
@@ -539,40 +940,53 @@ class OsMesaRenderer : public Renderer {
     glDepthMask(GL_TRUE);
   }
 
-  // Terrain tiles: uploaded when first seen, freed when gone; a coarse tile
-  // leaves out the blocks a fine tile covers.
-  void DrawTerrain(const Eigen::Matrix4f& view_proj, const Eigen::Vector3d& camera) {
+  struct TileGpu {
+    GpuMesh mesh;
+    GLuint texture{0};
+  };
+
+  // Terrain tiles: uploaded when first seen, freed when gone.
+  void UploadTerrain() {
     std::map<const scene::TerrainTile*, TileGpu> kept;
-    std::set<std::uint64_t> fine;
-    if (terrain_) {
-      for (const auto& tile : *terrain_) {
-        if (tile->id.lod == 0) fine.insert(tile->id.key());
+    for (const auto& tile : terrain_ ? *terrain_ : scene::TileList{}) {
+      auto found = tile_gpu_.find(tile.get());
+      if (found != tile_gpu_.end()) {
+        kept[tile.get()] = found->second;
+        tile_gpu_.erase(found);
+      } else {
+        kept[tile.get()] = UploadTile(*tile);
       }
+    }
+    for (auto& [tile, gpu] : tile_gpu_) {
+      Free(gpu.mesh);
+      if (gpu.texture != 0) glDeleteTextures(1, &gpu.texture);
+    }
+    tile_gpu_.swap(kept);
+  }
+
+  // Terrain tiles in view; a coarse tile leaves out the blocks a fine tile covers.
+  void DrawTerrain() {
+    if (!terrain_) return;
+    std::set<std::uint64_t> fine;
+    for (const auto& tile : *terrain_) {
+      if (tile->id.lod == 0) fine.insert(tile->id.key());
     }
     const int factor = level_->terrain ? level_->terrain->coarse_factor : 1;
     const Eigen::Vector4f plain(level_->horizon ? level_->horizon->rgb.x() : 0.45f,
                                 level_->horizon ? level_->horizon->rgb.y() : 0.5f,
                                 level_->horizon ? level_->horizon->rgb.z() : 0.35f, 1.f);
-    for (const auto& tile : terrain_ ? *terrain_ : scene::TileList{}) {
-      auto found = tile_gpu_.find(tile.get());
-      TileGpu gpu;
-      if (found != tile_gpu_.end()) {
-        gpu = found->second;
-        tile_gpu_.erase(found);
-      } else {
-        gpu = UploadTile(*tile);
-      }
-      kept[tile.get()] = gpu;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges;
+    for (const auto& tile : *terrain_) {
+      const TileGpu& gpu = tile_gpu_.at(tile.get());
       if (tile->indices.empty() || tile->bounds_W.isEmpty()) continue;
-      const Eigen::AlignedBox3f box((tile->bounds_W.min() - camera).cast<float>(),
-                                    (tile->bounds_W.max() - camera).cast<float>());
-      if (!InFrustum(view_proj, box)) continue;
+      if (pass_ == Pass::kShadow && tile->id.lod != 0) continue;  // far tiles cast no shadow here
+      const Eigen::AlignedBox3f box((tile->bounds_W.min() - camera_).cast<float>(),
+                                    (tile->bounds_W.max() - camera_).cast<float>());
+      if (!InFrustum(view_proj_, box)) continue;
       const Eigen::Matrix4f model =
-          Relative(Eigen::Affine3d(Eigen::Translation3d(tile->origin_W)), camera);
-      DrawWith(gpu.mesh, model, gpu.texture ? Eigen::Vector4f(1.f, 1.f, 1.f, 1.f) : plain,
-               gpu.texture);
+          Relative(Eigen::Affine3d(Eigen::Translation3d(tile->origin_W)), camera_);
       // Index ranges: the surface (coarse: without the blocks fine tiles cover), the skirts.
-      std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges;
+      ranges.clear();
       if (tile->id.lod == 0) {
         ranges.push_back({0, std::uint32_t(tile->indices.size())});
       } else {
@@ -591,41 +1005,25 @@ class OsMesaRenderer : public Renderer {
       }
       ranges.push_back({std::uint32_t(tile->indices.size()),
                         std::uint32_t(tile->indices.size() + tile->skirt_indices.size())});
-      for (const auto& [a, b] : ranges) {
-        if (b <= a) continue;
-        glDrawElements(GL_TRIANGLES, GLsizei(b - a), GL_UNSIGNED_INT,
-                       reinterpret_cast<const void*>(std::uintptr_t(a) * 4));
-      }
+      DrawMesh(gpu.mesh, model, gpu.texture ? Eigen::Vector4f(1.f, 1.f, 1.f, 1.f) : plain,
+               gpu.texture, &ranges);
     }
-    for (auto& [tile, gpu] : tile_gpu_) Free(gpu);
-    tile_gpu_.swap(kept);
   }
-
-  struct TileGpu {
-    GpuMesh mesh;
-    GLuint texture{0};
-  };
 
   TileGpu UploadTile(const scene::TerrainTile& tile) {
     std::vector<std::uint32_t> indices = tile.indices;
     indices.insert(indices.end(), tile.skirt_indices.begin(), tile.skirt_indices.end());
     TileGpu gpu;
-    gpu.mesh = Upload(tile.positions, tile.normals, tile.uvs, {}, indices, -1, GL_STATIC_DRAW);
+    gpu.mesh =
+        Upload({&tile.positions, &tile.normals, &tile.uvs, nullptr, nullptr, nullptr, &indices}, -1,
+               GL_STATIC_DRAW);
+    gpu.mesh.surface = int(scene::Surface::kTerrain);
+    gpu.mesh.segment_base = legend_->actor(level_->terrain_actor);
     if (!tile.texture_rgba.empty()) {
       gpu.texture = UploadTexture({tile.texture_width, tile.texture_height, tile.texture_rgba},
-                                  GL_CLAMP_TO_EDGE);
+                                  GL_CLAMP_TO_EDGE, true);
     }
     return gpu;
-  }
-
-  static void Free(const TileGpu& gpu) {
-    const GpuMesh& m = gpu.mesh;
-    const GLuint buffers[] = {m.positions, m.normals, m.uvs, m.lightmap_uvs, m.indices};
-    for (const GLuint buffer : buffers) {
-      if (buffer != 0) glDeleteBuffers(1, &buffer);
-    }
-    glDeleteVertexArrays(1, &m.vao);
-    if (gpu.texture != 0) glDeleteTextures(1, &gpu.texture);
   }
 
   // The ground beyond the level: a grid around the level's hole, its cells
@@ -672,52 +1070,27 @@ class OsMesaRenderer : public Renderer {
         for (const std::uint32_t v : {a, b, d, a, d, c}) indices.push_back(v);
       }
     }
-    horizon_ = Upload(positions, normals, {}, {}, indices, -1, GL_STATIC_DRAW);
-  }
-
-  void Draw(const GpuMesh& mesh, const Eigen::Matrix4f& model) {
-    glUniformMatrix4fv(uniforms_.model, 1, GL_FALSE, model.data());
-    Eigen::Vector4f color(0.8f, 0.8f, 0.8f, 1.f);
-    if (mesh.material >= 0 && mesh.material < int(level_->materials.size())) {
-      color = level_->materials[std::size_t(mesh.material)].base_color;
-    }
-    glUniform4f(uniforms_.base_color, color.x(), color.y(), color.z(), color.w());
-    const auto texture = textures_.find(mesh.material);
-    glUniform1i(uniforms_.has_texture, texture != textures_.end() && mesh.uvs != 0);
-    if (texture != textures_.end()) {
-      glActiveTexture(GL_TEXTURE0);
-      glBindTexture(GL_TEXTURE_2D, texture->second);
-    }
-    const auto lightmap = lightmaps_.find(mesh.material);
-    glUniform1i(uniforms_.has_lightmap, lightmap != lightmaps_.end() && mesh.lightmap_uvs != 0);
-    if (lightmap != lightmaps_.end()) {
-      glActiveTexture(GL_TEXTURE1);
-      glBindTexture(GL_TEXTURE_2D, lightmap->second);
-      glActiveTexture(GL_TEXTURE0);
-    }
-    glBindVertexArray(mesh.vao);
-    glDrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
+    horizon_ = Upload({&positions, &normals, nullptr, nullptr, nullptr, nullptr, &indices}, -1,
+                      GL_STATIC_DRAW);
+    horizon_.segment_base = legend_->horizon();
   }
 
   // Points and lines with one colour each, relative to the camera.
-  void DrawOverlay(const Overlay& overlay, const Eigen::Vector3d& camera,
-                   const Eigen::Matrix4f& view_proj) {
-    if (overlay.point_rgb.size() != overlay.points_W.size() ||
-        overlay.line_rgb.size() * 2 != overlay.lines_W.size()) {
-      throw std::invalid_argument("Renderer: an overlay needs one colour per point and per line");
-    }
+  void DrawOverlay(const Overlay& overlay, const Eigen::Matrix4f& view_proj) {
     overlay_positions_.clear();
     overlay_colors_.clear();
     for (std::size_t i = 0; i < overlay.points_W.size(); ++i) {
-      overlay_positions_.push_back((overlay.points_W[i] - camera).cast<float>());
+      overlay_positions_.push_back((overlay.points_W[i] - camera_).cast<float>());
       overlay_colors_.push_back(overlay.point_rgb[i]);
     }
     for (std::size_t i = 0; i < overlay.lines_W.size(); ++i) {
-      overlay_positions_.push_back((overlay.lines_W[i] - camera).cast<float>());
+      overlay_positions_.push_back((overlay.lines_W[i] - camera_).cast<float>());
       overlay_colors_.push_back(overlay.line_rgb[i / 2]);
     }
     glUseProgram(overlay_program_);
-    glUniformMatrix4fv(overlay_view_proj_, 1, GL_FALSE, view_proj.data());
+    program_key_ = -1;
+    glUniformMatrix4fv(glGetUniformLocation(overlay_program_, "view_proj"), 1, GL_FALSE,
+                       view_proj.data());
     glBindVertexArray(overlay_vao_);
     const std::pair<GLuint, const std::vector<Eigen::Vector3f>*> attributes[] = {
         {overlay_buffers_[0], &overlay_positions_}, {overlay_buffers_[1], &overlay_colors_}};
@@ -735,54 +1108,92 @@ class OsMesaRenderer : public Renderer {
     glBindVertexArray(0);
   }
 
-  void Resize(int width, int height) {
-    if (width == width_ && height == height_) return;
+  // The data buffer (colour, segment, normal, depth at pixel centres) and,
+  // with multisampling, the multisampled colour buffer.
+  void Resize(int width, int height, int samples) {
+    if (width == width_ && height == height_ && samples == samples_) return;
     if (fbo_ == 0) {
       glGenFramebuffers(1, &fbo_);
-      glGenRenderbuffers(2, buffers_);
+      glGenRenderbuffers(4, buffers_);
+      glGenFramebuffers(1, &msaa_fbo_);
+      glGenRenderbuffers(2, msaa_buffers_);
     }
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
-    glBindRenderbuffer(GL_RENDERBUFFER, buffers_[0]);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, buffers_[0]);
-    glBindRenderbuffer(GL_RENDERBUFFER, buffers_[1]);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, width, height);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, buffers_[1]);
-    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-      throw std::runtime_error("Renderer: framebuffer of " + std::to_string(width) + " x " +
-                               std::to_string(height) + " is incomplete");
+    auto attach = [&](GLuint fbo, GLuint buffer, GLenum format, GLenum attachment, int n) {
+      glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+      glBindRenderbuffer(GL_RENDERBUFFER, buffer);
+      glRenderbufferStorageMultisample(GL_RENDERBUFFER, n, format, width, height);
+      glFramebufferRenderbuffer(GL_FRAMEBUFFER, attachment, GL_RENDERBUFFER, buffer);
+    };
+    auto check = [&](const char* what) {
+      if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+        throw std::runtime_error(std::string("Renderer: ") + what + " framebuffer of " +
+                                 std::to_string(width) + " x " + std::to_string(height) +
+                                 " is incomplete");
+      }
+    };
+    attach(fbo_, buffers_[0], GL_RGBA8, GL_COLOR_ATTACHMENT0, 0);
+    attach(fbo_, buffers_[1], GL_R32UI, GL_COLOR_ATTACHMENT1, 0);
+    attach(fbo_, buffers_[2], GL_RGBA32F, GL_COLOR_ATTACHMENT2, 0);
+    attach(fbo_, buffers_[3], GL_DEPTH_COMPONENT32F, GL_DEPTH_ATTACHMENT, 0);
+    check("the");
+    if (samples > 0) {
+      attach(msaa_fbo_, msaa_buffers_[0], GL_RGBA8, GL_COLOR_ATTACHMENT0, samples);
+      attach(msaa_fbo_, msaa_buffers_[1], GL_DEPTH_COMPONENT32F, GL_DEPTH_ATTACHMENT, samples);
+      check("the multisampled");
     }
-    width_ = width, height_ = height;
+    width_ = width, height_ = height, samples_ = samples;
   }
 
   OSMesaContext context_{nullptr};
   std::vector<std::uint8_t> backing_;
   std::string description_;
-  GLuint program_{0}, fbo_{0}, buffers_[2]{0, 0};
-  GLuint overlay_program_{0}, overlay_vao_{0}, overlay_buffers_[2]{0, 0};
-  GLint overlay_view_proj_{-1};
-  std::vector<Eigen::Vector3f> overlay_positions_, overlay_colors_;
+  PFNGLCLIPCONTROLPROC clip_control_{nullptr};
+  // The scene's programs by surface and look, the one in use and the pass's look.
+  struct SceneProgram {
+    GLuint id{0};
+    std::map<std::string, GLint> uniforms;
+  };
+  static constexpr int kGamma = 4, kMaterials = 8, kShadows = 16, kDataOnly = 32;
+  std::map<int, SceneProgram> programs_;
+  SceneProgram* program_{nullptr};
+  int program_key_{-1};
+  int look_{0};
+  GLuint shadow_program_{0}, overlay_program_{0}, sky_program_{0};
   struct {
-    GLint model, view_proj, base_color, has_texture, base_texture, sun, sky, fog, has_lightmap,
-        lightmap;
-  } uniforms_{};
-  int width_{0}, height_{0};
+    GLint model{-1}, view_proj{-1}, masked{-1}, alpha_cutoff{-1};
+  } shadow_uniforms_;
+  GLuint fbo_{0}, buffers_[4]{0, 0, 0, 0}, msaa_fbo_{0}, msaa_buffers_[2]{0, 0};
+  GLuint shadow_fbo_{0}, shadow_map_{0}, detail_{0};
+  int shadow_px_{0}, shadow_layers_{0};
+  GLuint overlay_vao_{0}, overlay_buffers_[2]{0, 0};
+  GLfloat max_anisotropy_{1.f};
+  GLuint anisotropic_{0};  // a sampler
+  std::vector<Eigen::Vector3f> overlay_positions_, overlay_colors_;
+  int width_{0}, height_{0}, samples_{-1};
   const scene::Level* level_{nullptr};
+  std::unique_ptr<SegmentationLegend> legend_;
+  float water_level_{-1e9f};
   Eigen::Vector3d origin_{Eigen::Vector3d::Zero()};  // of the static chunks
   std::vector<std::pair<Eigen::AlignedBox3f, GpuMesh>> static_meshes_;
   std::vector<std::pair<int, GpuMesh>> actor_meshes_;  // movable actors'
   std::map<const scene::RobotModel*, std::vector<GpuMesh>> robot_meshes_;
+  std::map<const scene::RobotModel*, std::vector<std::vector<std::uint32_t>>> robot_groups_;
   std::shared_ptr<const scene::TileList> terrain_;
   std::map<const scene::TerrainTile*, TileGpu> tile_gpu_;
   GpuMesh horizon_;
-  GLuint sky_program_{0};
-  PFNGLCLIPCONTROLPROC clip_control_{nullptr};
-  GLint sky_uniforms_[4]{-1, -1, -1, -1};
-  std::map<int, GLuint> textures_;   // by material
-  std::map<int, GLuint> lightmaps_;  // by material
+  std::map<int, GLuint> textures_;     // by material
+  std::map<int, GLuint> normal_maps_;  // by material
+  std::map<int, GLuint> lightmaps_;    // by material
   std::vector<std::string> warnings_;
+  // The frame being drawn.
+  Pass pass_{Pass::kColor};
+  Eigen::Matrix4f view_proj_{Eigen::Matrix4f::Identity()};
+  Eigen::Vector3d camera_{Eigen::Vector3d::Zero()};
+  const std::vector<Eigen::Isometry3d>* actor_poses_{nullptr};
+  std::vector<std::pair<Eigen::Isometry3d, std::vector<const GpuMesh*>>> posed_robots_;
   std::vector<std::uint8_t> pixels_;
-  std::vector<float> depth_;
+  std::vector<float> depth_, normal_;
+  std::vector<std::uint32_t> segment_;
 };
 
 }  // namespace

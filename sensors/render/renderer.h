@@ -1,10 +1,13 @@
 #pragma once
 // Offscreen rendering of the world (OSMesa, OpenGL 4.5 core, llvmpipe): level
-// meshes with their base colours and textures, terrain tiles with their
-// imagery, the robots skinned as posed, a directional sun, a sky with a
-// horizon gradient, the ground beyond the level out to the horizon and
-// distance haze; colour and depth read back. Depth is reversed (1 near, 0
-// far, in a float buffer): precise from 0.1 m to hundreds of kilometres.
+// meshes with their materials (base colours, textures, vertex colours,
+// cut-outs, normal maps, highlights), terrain tiles with their imagery, ground
+// shaded by slope and height with detail textures, water with reflections, the
+// robots skinned as posed, a sun with cascaded shadow maps, sky light, a sky
+// with a horizon gradient, the ground beyond the level out to the horizon,
+// distance haze, 4x multisampling; colour, depth, segmentation and normal
+// images read back. Depth is reversed (1 near, 0 far, in a float buffer):
+// precise from 0.1 m to hundreds of kilometres.
 // GL stays inside renderer.cc; nothing else sees a GL header (the types it
 // takes and gives are in view.h).
 //
@@ -36,11 +39,35 @@ struct RgbaImage {
 using TextureDecoder = std::function<std::string(const scene::EmbeddedTexture* embedded,
                                                  const std::string& path, RgbaImage* image)>;
 
+// How much of the look a camera pays for. kPlain is the flat look of before
+// (a reference for benchmarks); kFast adds gamma-correct shading with sky
+// light, the ground's and the water's materials, normal maps and highlights;
+// kHigh adds sun shadows and 4x multisampling.
+enum class Quality { kPlain, kFast, kHigh };
+
+// "plain", "fast", "high"; throws std::invalid_argument naming the word.
+Quality ParseQuality(const std::string& word);
+
 struct RenderSettings {
   Eigen::Vector3f sky_rgb{0.62f, 0.76f, 0.92f};
   Eigen::Vector3f sun_direction_W{0.35f, -0.45f, 0.82f};  // towards the sun
   float fog_start_m{300.0f};
   float fog_end_m{1500.0f};
+  // The look (each switchable; Preset sets them together).
+  bool gamma_correct{true};  // shade in linear light with sky light; write sRGB
+  bool materials{true};      // ground layers, water, normal maps, highlights
+  bool haze{true};
+  bool shadows{true};
+  int msaa_samples{4};  // 0 or 1: none
+  // Anisotropic filtering of material textures (1: trilinear mipmaps only).
+  // Off by default: llvmpipe takes about 9 s to compile each shader variant that uses it.
+  int anisotropy{1};
+  int shadow_map_px{2048};
+  int shadow_cascades{3};
+  double shadow_distance_m{300.0};  // shadows end this far along the optical axis
+  ImageKinds images{kColorImage | kDepthImage};
+
+  static RenderSettings Preset(Quality quality);
 };
 
 class Renderer {
@@ -51,7 +78,7 @@ class Renderer {
   virtual void SetLevel(const scene::Level& level, const TextureDecoder& decoder) = 0;
   // Renders the level (movable actors at `actor_poses`, indexed like
   // Level::actors; empty: load-time poses), `robots` as posed and, when given,
-  // the overlay on top.
+  // the overlay on top (colour only), into the images `settings.images` names.
   virtual void Render(const CameraView& view, const std::vector<Eigen::Isometry3d>& actor_poses,
                       const std::vector<const scene::RobotState*>& robots,
                       const RenderSettings& settings, Frame* frame,

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace sandbox::render {
 
@@ -28,6 +29,30 @@ void CameraView::ValidateOrThrow() const {
   }
   if (!(near_m > 0.0 && far_m > near_m)) throw std::invalid_argument("need 0 < near_m < far_m");
   if (!X_WC.matrix().allFinite()) throw std::invalid_argument("non-finite camera pose");
+}
+
+namespace {
+constexpr std::pair<ImageKind, const char*> kImageKindNames[] = {
+    {kColorImage, "color"},
+    {kDepthImage, "depth"},
+    {kSegmentationImage, "segmentation"},
+    {kNormalsImage, "normals"}};
+}  // namespace
+
+ImageKind ParseImageKind(const std::string& word) {
+  for (const auto& [kind, name] : kImageKindNames) {
+    if (word == name) return kind;
+  }
+  throw std::invalid_argument("unknown image kind '" + word +
+                              "' (color, depth, segmentation or normals)");
+}
+
+std::string ImageKindsText(ImageKinds kinds) {
+  std::string text;
+  for (const auto& [kind, name] : kImageKindNames) {
+    if ((kinds & kind) != 0) text += (text.empty() ? "" : ",") + std::string(name);
+  }
+  return text;
 }
 
 }  // namespace sandbox::render

@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace sandbox::render {
@@ -21,11 +22,29 @@ struct CameraView {
   void ValidateOrThrow() const;
 };
 
+// The images a render makes (a bit set).
+enum ImageKind : unsigned {
+  kColorImage = 1u,
+  kDepthImage = 2u,
+  kSegmentationImage = 4u,  // an id per actor, horizon and robot bone group (segmentation.h)
+  kNormalsImage = 8u,       // unit surface normals in the camera frame
+};
+using ImageKinds = unsigned;
+
+// "color", "depth", "segmentation", "normals" (also "all"), by name; throws
+// std::invalid_argument naming the word and the choices.
+ImageKind ParseImageKind(const std::string& word);
+std::string ImageKindsText(ImageKinds kinds);  // "color,depth"
+
 struct Frame {
   int width{0};
   int height{0};
-  std::vector<std::uint8_t> rgb;  // row 0 at the top
-  std::vector<float> depth_m;     // distance along the optical axis; +inf where sky
+  ImageKinds kinds{0};  // which of the images below are filled; row 0 at the top
+  std::vector<std::uint8_t> rgb;
+  std::vector<float> depth_m;          // distance along the optical axis; +inf where sky
+  std::vector<std::uint32_t> segment;  // 0 where sky
+  std::vector<float>
+      normal_C;  // x, y, z a pixel, camera frame (x forward, y left, z up); 0 where sky
 };
 
 // Debug marks drawn over the scene, hidden behind nearer surfaces: points and

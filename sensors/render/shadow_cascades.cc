@@ -1,0 +1,63 @@
+#include "sensors/render/shadow_cascades.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sandbox::render {
+
+std::vector<ShadowCascade> FitShadowCascades(const CameraView& view, const Eigen::Vector3d& sun_W,
+                                             double distance_m, int count, int map_px,
+                                             double caster_reach_m) {
+  const Eigen::Vector3d z = sun_W.normalized();
+  // Light axes: x and y across the map, z towards the sun.
+  const Eigen::Vector3d x =
+      (std::abs(z.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX())
+          .cross(z)
+          .normalized();
+  const Eigen::Vector3d y = z.cross(x);
+  Eigen::Matrix3d R_LW;
+  R_LW.row(0) = x;
+  R_LW.row(1) = y;
+  R_LW.row(2) = z;
+  const double near = view.near_m, far = std::max(distance_m, 2.0 * near);
+  const double ty = std::tan(0.5 * view.fov_y_rad), tx = ty * view.width / view.height;
+  const Eigen::Matrix3d R_WC = view.X_WC.linear();
+  const Eigen::Vector3d camera_L = R_LW * view.X_WC.translation();
+  std::vector<ShadowCascade> cascades;
+  double d0 = near;
+  for (int i = 1; i <= count; ++i) {
+    // Split between logarithmic and uniform spacing.
+    const double f = double(i) / count;
+    const double d1 = 0.75 * near * std::pow(far / near, f) + 0.25 * (near + (far - near) * f);
+    Eigen::Vector3d corners[8];
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 8; ++k) {
+      const double d = k < 4 ? d0 : d1;
+      corners[k] = R_WC * Eigen::Vector3d(d, (k & 1 ? 1 : -1) * tx * d, (k & 2 ? 1 : -1) * ty * d);
+      centre += corners[k] / 8.0;
+    }
+    double r = 0.0;
+    for (const Eigen::Vector3d& c : corners) r = std::max(r, (c - centre).norm());
+    r = std::ceil(r * 16.0) / 16.0;  // a size that changes in steps: steady texels
+    const double texel = 2.0 * r / map_px;
+    // Snap the box centre to whole texels in absolute light coordinates.
+    Eigen::Vector3d centre_L = R_LW * centre + camera_L;
+    centre_L.x() = std::round(centre_L.x() / texel) * texel;
+    centre_L.y() = std::round(centre_L.y() / texel) * texel;
+    centre_L -= camera_L;
+    const double top = centre_L.z() + r + caster_reach_m, bottom = centre_L.z() - r;
+    Eigen::Matrix4d M = Eigen::Matrix4d::Zero();
+    M.block<1, 3>(0, 0) = R_LW.row(0) / r;
+    M(0, 3) = -centre_L.x() / r;
+    M.block<1, 3>(1, 0) = R_LW.row(1) / r;
+    M(1, 3) = -centre_L.y() / r;
+    M.block<1, 3>(2, 0) = -R_LW.row(2) / (top - bottom);
+    M(2, 3) = top / (top - bottom);
+    M(3, 3) = 1.0;
+    cascades.push_back({M, d1, texel});
+    d0 = d1;
+  }
+  return cascades;
+}
+
+}  // namespace sandbox::render
