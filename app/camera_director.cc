@@ -54,7 +54,8 @@ int CameraDirector::Direct(const Shot& shot, FramePipeline* frames, bool write, 
     job.tick = shot.tick;
     job.time_s = shot.t_s;
     job.view = view;
-    job.depth = run.camera->depth;
+    job.settings = run.camera->look;
+    if (shown) job.settings.images |= render::kColorImage;  // the live view shows colour
     job.write = write;
     job.show = shown;
     for (const scene::RobotState* r : shot.robots) job.robots.push_back(*r);

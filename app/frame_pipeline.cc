@@ -15,6 +15,7 @@
 
 #include "app/command_line.h"
 #include "app/images.h"
+#include "sensors/render/segmentation.h"
 
 namespace sandbox::app {
 namespace {
@@ -128,12 +129,12 @@ void FramePipeline::RenderLoop() {
       ++failed_;
       continue;
     }
-    Encoded item{job.camera, job.tick, job.time_s, job.depth, {}, job.robot_pose, job.view};
+    Encoded item{job.camera, job.tick, job.time_s, {}, job.robot_pose, job.view};
     std::vector<const scene::RobotState*> robots;
     for (const scene::RobotState& state : job.robots) robots.push_back(&state);
     try {
       renderer->SetTerrain(job.terrain);
-      renderer->Render(job.view, job.actor_poses, robots, {}, &item.frame, &job.overlay);
+      renderer->Render(job.view, job.actor_poses, robots, job.settings, &item.frame, &job.overlay);
     } catch (const std::exception& e) {
       Fail("camera " + job.camera + ": " + e.what());
       continue;
@@ -204,23 +205,52 @@ void FramePipeline::Write(const Encoded& item) {
       video->writer.write(bgr);
       file = item.camera + "." + config_.video_format;
     }
-    if (!config_.image_format.empty()) {
+    const render::ImageKinds kinds = item.frame.kinds;
+    if (!config_.image_format.empty() && (kinds & render::kColorImage)) {
       file = name.str() + "." + config_.image_format;
       WriteColor(item.frame, (dir / file).string());
     }
-    if (item.depth && config_.depth_format == "npy") {
-      WriteDepthNpy(item.frame, (dir / (name.str() + "_depth.npy")).string());
-    } else if (item.depth && config_.depth_format == "exr") {
-      WriteDepthExr(item.frame, (dir / (name.str() + "_depth.exr")).string());
-    } else if (item.depth) {
-      WriteDepthMillimetres(item.frame, (dir / (name.str() + "_depth.png")).string());
+    std::string depth_file, segmentation_file, normals_file;
+    if (kinds & render::kDepthImage) {
+      depth_file = name.str() + "_depth." + config_.depth_format;
+      if (config_.depth_format == "npy") {
+        WriteDepthNpy(item.frame, (dir / depth_file).string());
+      } else if (config_.depth_format == "exr") {
+        WriteDepthExr(item.frame, (dir / depth_file).string());
+      } else {
+        WriteDepthMillimetres(item.frame, (dir / depth_file).string());
+      }
     }
+    if (kinds & render::kSegmentationImage) {
+      if (!legend_written_) {  // the legend depends on the level alone
+        std::ofstream legend(dir / "segmentation.csv");
+        legend << render::SegmentationLegend(level_).Csv();
+        if (!legend.good())
+          throw std::runtime_error("cannot write " + (dir / "segmentation.csv").string());
+        legend_written_ = true;
+      }
+      segmentation_file = name.str() + "_seg.png";
+      WriteSegmentation(item.frame, (dir / segmentation_file).string());
+    }
+    if (kinds & render::kNormalsImage) {
+      const bool floats = config_.depth_format != "png";
+      normals_file = name.str() + (floats ? "_normals.npy" : "_normals.png");
+      if (floats) {
+        WriteNormalsNpy(item.frame, (dir / normals_file).string());
+      } else {
+        WriteNormals(item.frame, (dir / normals_file).string());
+      }
+    }
+    if (file.empty())
+      file = !depth_file.empty()          ? depth_file
+             : !segmentation_file.empty() ? segmentation_file
+                                          : normals_file;
     std::unique_ptr<RowFile>& index = indexes_[item.camera];
     if (!index) {
       index = std::make_unique<RowFile>(
           (dir / (item.camera + ".csv")).string(),
           "tick,time_s,file,x,y,z,qw,qx,qy,qz,cam_x,cam_y,cam_z,cam_qw,cam_qx,cam_qy,cam_qz,"
-          "fx,fy,cx,cy");
+          "fx,fy,cx,cy,depth_file,segmentation_file,normals_file");
     }
     std::ostringstream row;
     row << std::setprecision(10);
@@ -235,7 +265,8 @@ void FramePipeline::Write(const Encoded& item) {
     // centres at whole coordinates, as OpenCV's camera matrix has them.
     const double f = 0.5 * item.view.height / std::tan(0.5 * item.view.fov_y_rad);
     row << "," << f << "," << f << "," << 0.5 * item.view.width - 0.5 << ","
-        << 0.5 * item.view.height - 0.5;
+        << 0.5 * item.view.height - 0.5 << "," << depth_file << "," << segmentation_file << ","
+        << normals_file;
     // The row is the frame's last part: a frame whose row cannot be written is removed.
     index->Add(row.str());
     if (!index->Flush()) throw std::runtime_error(index->error());
@@ -247,8 +278,9 @@ void FramePipeline::Write(const Encoded& item) {
     if (!config_.image_format.empty()) {
       std::filesystem::remove(dir / (name.str() + "." + config_.image_format), ignored);
     }
-    for (const char* depth : {"_depth.png", "_depth.npy", "_depth.exr"}) {
-      std::filesystem::remove(dir / (name.str() + depth), ignored);
+    for (const char* other :
+         {"_depth.png", "_depth.npy", "_depth.exr", "_seg.png", "_normals.png", "_normals.npy"}) {
+      std::filesystem::remove(dir / (name.str() + other), ignored);
     }
   }
 }

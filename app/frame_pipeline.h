@@ -8,11 +8,14 @@
 //
 // Files: DIR/<camera>_<tick>.jpg (or .png) and/or one DIR/<camera>.mp4 (or
 // .avi) per camera; DIR/<camera>_<tick>_depth.png (16-bit millimetres),
-// _depth.npy or _depth.exr (float32 metres); DIR/<camera>.csv indexing every
+// _depth.npy or _depth.exr (float32 metres); _seg.png (16-bit segment ids,
+// named in DIR/segmentation.csv); _normals.png (8-bit, camera frame) or
+// _normals.npy with a float depth format; DIR/<camera>.csv indexing every
 // frame: tick, time_s, file (the image, else the video), the robot pose, the
-// camera pose X_WC (x forward, y left, z up) and the pinhole intrinsics in
+// camera pose X_WC (x forward, y left, z up), the pinhole intrinsics in
 // pixels (fx = fy, cx, cy; image x to the right, y down, pixel centres at
-// whole coordinates as in OpenCV's camera matrix).
+// whole coordinates as in OpenCV's camera matrix) and the files of the other
+// image kinds (depth, segmentation, normals; empty when not made).
 
 #include <atomic>
 #include <chrono>
@@ -55,7 +58,7 @@ struct RenderJob {
   std::int64_t tick{0};
   double time_s{0.0};
   render::CameraView view;
-  bool depth{false};
+  render::RenderSettings settings;  // the look and the image kinds
   std::vector<scene::RobotState> robots;
   std::vector<Eigen::Isometry3d> actor_poses;
   Eigen::Isometry3d robot_pose{Eigen::Isometry3d::Identity()};  // for the index
@@ -91,7 +94,6 @@ class FramePipeline {
     std::string camera;
     std::int64_t tick;
     double time_s;
-    bool depth;
     render::Frame frame;
     Eigen::Isometry3d robot_pose;
     render::CameraView view;
@@ -117,6 +119,7 @@ class FramePipeline {
   std::map<std::string, std::unique_ptr<Video>> videos_;     // write thread only
   std::map<std::string, std::unique_ptr<RowFile>> indexes_;  // write thread only
   std::chrono::steady_clock::time_point retry_after_{};      // write thread only
+  bool legend_written_{false};                               // write thread only
   std::thread render_thread_, write_thread_;
 };
 

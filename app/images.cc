@@ -1,5 +1,6 @@
 #include "app/images.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -140,11 +141,19 @@ void WriteDepthMillimetres(const render::Frame& frame, const std::string& path) 
   Write(depth, path);
 }
 
-void WriteDepthNpy(const render::Frame& frame, const std::string& path) {
+namespace {
+
+// A float32 NumPy .npy file of the given shape (row-major).
+void WriteNpy(const float* data, const std::vector<int>& shape, const std::string& path) {
   // Format 1.0: magic, version, a little-endian header length, then a Python
   // dict literal padded with spaces and a newline to a multiple of 64 bytes.
-  std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" +
-                       std::to_string(frame.height) + ", " + std::to_string(frame.width) + "), }";
+  std::string dims;
+  std::size_t count = 1;
+  for (const int n : shape) {
+    dims += std::to_string(n) + ", ";
+    count *= std::size_t(n);
+  }
+  std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" + dims + "), }";
   const std::size_t preamble = 10;
   header.append(63 - (preamble + header.size()) % 64, ' ');
   header += '\n';
@@ -154,9 +163,43 @@ void WriteDepthNpy(const render::Frame& frame, const std::string& path) {
   out.write(length, 2);
   out << header;
   static_assert(sizeof(float) == 4, "float32");
-  out.write(reinterpret_cast<const char*>(frame.depth_m.data()),
-            std::streamsize(frame.depth_m.size() * sizeof(float)));  // x86 and ARM: little-endian
+  out.write(reinterpret_cast<const char*>(data),
+            std::streamsize(count * sizeof(float)));  // x86 and ARM: little-endian
   if (!out.good()) throw std::runtime_error("cannot write " + path);
+}
+
+}  // namespace
+
+void WriteDepthNpy(const render::Frame& frame, const std::string& path) {
+  WriteNpy(frame.depth_m.data(), {frame.height, frame.width}, path);
+}
+
+void WriteSegmentation(const render::Frame& frame, const std::string& path) {
+  cv::Mat ids(frame.height, frame.width, CV_16U);
+  for (int i = 0; i < frame.width * frame.height; ++i) {
+    ids.at<std::uint16_t>(i / frame.width, i % frame.width) =
+        std::uint16_t(std::min<std::uint32_t>(frame.segment[std::size_t(i)], 65535u));
+  }
+  Write(ids, path);
+}
+
+void WriteNormals(const render::Frame& frame, const std::string& path) {
+  cv::Mat bgr(frame.height, frame.width, CV_8UC3);
+  for (int i = 0; i < frame.width * frame.height; ++i) {
+    const float* n = &frame.normal_C[3 * std::size_t(i)];
+    cv::Vec3b& pixel = bgr.at<cv::Vec3b>(i / frame.width, i % frame.width);
+    const bool nothing = n[0] == 0.f && n[1] == 0.f && n[2] == 0.f;
+    for (int c = 0; c < 3; ++c) {
+      pixel[2 - c] =
+          nothing ? 0
+                  : std::uint8_t(std::lround(std::clamp(0.5f * (n[c] + 1.f), 0.f, 1.f) * 255.f));
+    }
+  }
+  Write(bgr, path);
+}
+
+void WriteNormalsNpy(const render::Frame& frame, const std::string& path) {
+  WriteNpy(frame.normal_C.data(), {frame.height, frame.width, 3}, path);
 }
 
 void WriteDepthExr(const render::Frame& frame, const std::string& path) {

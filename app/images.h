@@ -28,6 +28,13 @@ void WriteDepthMillimetres(const render::Frame& frame, const std::string& path);
 // Writes depth as a NumPy .npy file: float32 metres, shape (height, width),
 // row 0 at the top, +inf where nothing is (numpy.load, or readNPY in MATLAB).
 void WriteDepthNpy(const render::Frame& frame, const std::string& path);
+// Writes segment ids as a 16-bit PNG (0: sky; the legend names the others).
+void WriteSegmentation(const render::Frame& frame, const std::string& path);
+// Writes camera-frame normals (x forward, y left, z up) as an 8-bit RGB PNG,
+// each channel round(255 (n + 1) / 2); black (0, 0, 0) where nothing is.
+void WriteNormals(const render::Frame& frame, const std::string& path);
+// Writes normals as a NumPy .npy file: float32, shape (height, width, 3), 0 where nothing is.
+void WriteNormalsNpy(const render::Frame& frame, const std::string& path);
 // Writes depth as OpenEXR: one float32 channel (Y) in metres, ZIP compressed,
 // +inf where nothing is. Turns on OpenCV's EXR codec (off by default).
 void WriteDepthExr(const render::Frame& frame, const std::string& path);

@@ -2,7 +2,9 @@
 
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <iomanip>
+#include <sstream>
 #include <variant>
 
 #include "app/bone_values.h"
@@ -14,6 +16,7 @@
 #include "scene/level.h"
 #include "sensors/render/cameras.h"
 #include "sensors/render/debug_overlay.h"
+#include "sensors/render/segmentation.h"
 #include "sensors/sensor.h"
 
 namespace sandbox::app {
@@ -22,13 +25,20 @@ namespace {
 const char* kUsage =
     "usage: sandbox render [LEVEL] --camera chase|trailing|payload|fixed --at X,Y,Z[,R,P,Y]\n"
     "                      [--robot NAME] [--bones LIST] [--width W] [--height H] [--fov DEG]\n"
-    "                      [--overlay] [--stub M] [--isolate] --out FILE.jpg|.png\n"
+    "                      [--kind LIST] [--quality Q] [--overlay] [--stub M] [--isolate]\n"
+    "                      --out FILE.jpg|.png\n"
     "  --camera  chase: the spring arm behind the robot; trailing: 25 m behind, 8 m up;\n"
     "            payload: on the robot, looking forward (also writes FILE_depth.png, 16-bit\n"
     "            millimetres); fixed: the camera itself at --at\n"
     "  --at      the robot pose (chase, trailing, payload) or the camera pose (fixed):\n"
     "            metres, roll/pitch/yaw in degrees\n"
     "  --bones   bone values as for `sandbox pose`\n"
+    "  --kind    the images, a comma list of color, depth (16-bit millimetres), segmentation\n"
+    "            (16-bit ids, legend in FILE_seg.csv) and normals (camera frame, 8-bit);\n"
+    "            default color (payload: color,depth). Colour goes to FILE, the others to\n"
+    "            FILE_depth.png, FILE_seg.png, FILE_normals.png (the first one to FILE\n"
+    "            when colour is not asked for)\n"
+    "  --quality fast or high (default; shadows, 4x multisampling) or plain (the flat look)\n"
     "  --width, --height, --fov   image size (default 640 x 480) and vertical field of view\n"
     "            in degrees (default 60)\n"
     "  --overlay the debug overlay: the robot's face scanners (or a default one, 1 m over\n"
@@ -70,10 +80,10 @@ void BuildOverlay(const scene::Level& level, int robot_index, const scene::Robot
 }  // namespace
 
 int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  const auto parsed = ParseArgs(
-      args, "render",
-      {"--camera", "--at", "--robot", "--bones", "--width", "--height", "--fov", "--out", "--stub"},
-      {"--overlay", "--isolate"}, kUsage, err);
+  const auto parsed = ParseArgs(args, "render",
+                                {"--camera", "--at", "--robot", "--bones", "--width", "--height",
+                                 "--fov", "--out", "--stub", "--kind", "--quality"},
+                                {"--overlay", "--isolate"}, kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
     out << kUsage;
@@ -91,6 +101,22 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
   }
   try {
     const Eigen::Isometry3d X_at = ParsePose(parsed->Value("--at"), "--at");
+    render::RenderSettings settings;
+    try {
+      settings =
+          render::RenderSettings::Preset(render::ParseQuality(parsed->Value("--quality", "high")));
+      settings.images =
+          camera == "payload" ? render::kColorImage | render::kDepthImage : render::kColorImage;
+      if (!parsed->Value("--kind").empty()) {
+        settings.images = 0;
+        std::stringstream list(parsed->Value("--kind"));
+        for (std::string word; std::getline(list, word, ',');) {
+          settings.images |= render::ParseImageKind(word);
+        }
+      }
+    } catch (const std::invalid_argument& error) {
+      throw UsageError(error.what());
+    }
     render::CameraView view;
     auto whole = [&](const std::string& option, int fallback) {
       return parsed->values.count(option) ? int(ParseWhole(parsed->Value(option), option, 1, 16384))
@@ -155,16 +181,43 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
           parsed->values.count("--stub") ? ParseNumber(parsed->Value("--stub"), "--stub") : 0.0;
       BuildOverlay(level, robot_index, robot.get(), stub_m, &overlay);
     }
-    renderer->Render(view, {}, robots, {}, &frame, &overlay);
+    renderer->Render(view, {}, robots, settings, &frame, &overlay);
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    WriteColor(frame, out_file);
-    out << camera << " camera " << frame.width << " x " << frame.height << " -> " << out_file;
-    if (camera == "payload") {
-      std::filesystem::path depth = out_file;
-      depth.replace_filename(depth.stem().string() + "_depth.png");
+    out << camera << " camera " << frame.width << " x " << frame.height;
+    // Colour to FILE, the other kinds beside it (the first of them to FILE without colour).
+    const std::filesystem::path file = out_file;
+    bool file_used = false;
+    auto path_for = [&](const std::string& suffix) {
+      if (!file_used && !(settings.images & render::kColorImage)) {
+        file_used = true;
+        return file;
+      }
+      std::filesystem::path beside = file;
+      beside.replace_filename(file.stem().string() + suffix + ".png");
+      return beside;
+    };
+    if (settings.images & render::kColorImage) {
+      WriteColor(frame, out_file);
+      out << ", color -> " << out_file;
+    }
+    if (settings.images & render::kDepthImage) {
+      const std::filesystem::path depth = path_for("_depth");
       WriteDepthMillimetres(frame, depth.string());
       out << ", depth -> " << depth.string();
+    }
+    if (settings.images & render::kSegmentationImage) {
+      const std::filesystem::path ids = path_for("_seg");
+      WriteSegmentation(frame, ids.string());
+      std::filesystem::path legend = file;
+      legend.replace_filename(file.stem().string() + "_seg.csv");
+      std::ofstream(legend) << render::SegmentationLegend(level).Csv();
+      out << ", segmentation -> " << ids.string() << " (legend " << legend.string() << ")";
+    }
+    if (settings.images & render::kNormalsImage) {
+      const std::filesystem::path normals = path_for("_normals");
+      WriteNormals(frame, normals.string());
+      out << ", normals -> " << normals.string();
     }
     out << std::fixed << std::setprecision(1) << " (" << ms << " ms with set-up, "
         << renderer->description() << ")\n";
