@@ -10,6 +10,7 @@
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <set>
+#include <sstream>
 
 #include "app/images.h"
 #include "scene/collision_world.h"
@@ -209,6 +210,127 @@ TEST(DebugOverlayTest, ActorBoundsFollowTheActorAndStubsPointBackAlongTheRay) {
   ASSERT_EQ(stubs.lines_W.size(), 2u);
   EXPECT_TRUE(stubs.lines_W[1].isApprox(Vector3d(10.5, 2, 3)));
   EXPECT_TRUE(stubs.points_W.empty());
+}
+
+TEST_F(RendererTest, SegmentIdsMatchTheActorsTheRaysHit) {
+  CameraView view;
+  view.X_WC = LookAt(Vector3d(10, -120, 45), Vector3d(-30, 45, 10));  // the tower, the hills
+  RenderSettings settings;
+  settings.images = kSegmentationImage;
+  Frame frame;
+  renderer_->Render(view, {}, {}, settings, &frame);
+  ASSERT_EQ(frame.segment.size(), std::size_t(view.width * view.height));
+  EXPECT_TRUE(frame.rgb.empty());
+  const scene::CollisionWorld world(level_);
+  sensors::RayCaster caster(1);
+  sensors::RayBatch rays;
+  rays.origin_W = view.X_WC.translation();
+  std::vector<std::pair<int, int>> pixels;
+  const double f = 0.5 * view.height / std::tan(0.5 * view.fov_y_rad);
+  for (int row = 1; row < view.height; row += 6) {
+    for (int column = 2; column < view.width; column += 7) {
+      const Vector3d d_C(1.0, -(column + 0.5 - 0.5 * view.width) / f,
+                         -(row + 0.5 - 0.5 * view.height) / f);
+      rays.start.emplace_back(0.f, 0.f, 0.f);
+      rays.direction.push_back((view.X_WC.linear() * d_C.normalized()).cast<float>());
+      rays.length_m.push_back(2000.f);
+      pixels.emplace_back(column, row);
+    }
+  }
+  sensors::RayHits hits;
+  caster.Cast(world, rays, {}, &hits);
+  int same = 0, tower = 0;
+  for (std::size_t i = 0; i < pixels.size(); ++i) {
+    const auto [column, row] = pixels[i];
+    const std::uint32_t id =
+        frame.segment[std::size_t(row) * std::size_t(view.width) + std::size_t(column)];
+    const std::uint32_t expected =
+        hits.body[i] == sensors::RayHits::kNoHit ? 0u : std::uint32_t(1 + hits.body[i]);
+    same += id == expected;
+    tower += expected == 2u;
+  }
+  EXPECT_GT(tower, 40);  // the tower is in view
+  EXPECT_GT(same, 0.99 * double(pixels.size())) << same << " of " << pixels.size();
+}
+
+TEST(RendererLookTest, NormalsOfATiltedPlaneInTheCameraFrame) {
+  // A square tilted 30 degrees about the world y axis: its normal (sin 30, 0, cos 30).
+  testing::TempDir dir;
+  const double s = std::sin(M_PI / 6), c = std::cos(M_PI / 6);
+  std::ostringstream obj;
+  obj << "o plane\n";
+  for (const auto& [u, v] : {std::pair{-5, -5}, {5, -5}, {5, 5}, {-5, 5}}) {
+    // (u, v) in the plane spanned by (cos 30, 0, -sin 30) and (0, 1, 0).
+    obj << "v " << u * c << " " << v << " " << -u * s << "\n";
+  }
+  obj << "f 1 2 3 4\n";
+  dir.Write("plane.obj", obj.str());
+  const scene::Level level = scene::LoadLevel(
+      dir.Write("level.toml", "[[actor]]\nname = \"plane\"\nfile = \"plane.obj\"\n"));
+  auto renderer = MakeRenderer();
+  renderer->SetLevel(level, app::OpenCvTextureDecoder());
+  CameraView view;
+  view.X_WC = LookAt(Vector3d(6, -4, 9), Vector3d::Zero());
+  RenderSettings settings;
+  settings.images = kNormalsImage | kColorImage;
+  Frame frame;
+  renderer->Render(view, {}, {}, settings, &frame);
+  ASSERT_EQ(frame.normal_C.size(), std::size_t(3 * view.width * view.height));
+  const Vector3d n_W(s, 0, c);
+  const Vector3d n_C = view.X_WC.linear().transpose() * n_W;  // x forward, y left, z up
+  const float* n = &frame.normal_C[3 * (std::size_t(240) * 640 + 320)];
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(n[k], n_C[k], 1e-3) << k;
+  const float* sky = &frame.normal_C[0];
+  EXPECT_EQ(sky[0] * sky[0] + sky[1] * sky[1] + sky[2] * sky[2], 0.f);
+}
+
+TEST(RendererLookTest, ABoxCastsItsShadowWhereTrigonometryPutsIt) {
+  // A 2 m x 2 m x 4 m box on a plane; the sun 45 degrees up in the -x
+  // direction: the top edge's shadow ends at x = 1 + 4 / tan 45 = 5.
+  testing::TempDir dir;
+  dir.Write("ground.obj",
+            "o ground\nv -40 -40 0\nv 40 -40 0\nv 40 40 0\nv -40 40 0\nvn 0 0 1\n"
+            "f 1//1 2//1 3//1 4//1\n");
+  std::ostringstream box;
+  box << "o box\n";
+  for (int k = 0; k < 8; ++k) {
+    box << "v " << (k & 1 ? 1 : -1) << " " << (k & 2 ? 1 : -1) << " " << (k & 4 ? 4 : 0) << "\n";
+  }
+  box << "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
+  dir.Write("box.obj", box.str());
+  const scene::Level level =
+      scene::LoadLevel(dir.Write("level.toml",
+                                 "[[actor]]\nname = \"ground\"\nfile = \"ground.obj\"\n"
+                                 "[[actor]]\nname = \"box\"\nfile = \"box.obj\"\n"));
+  auto renderer = MakeRenderer();
+  renderer->SetLevel(level, app::OpenCvTextureDecoder());
+  CameraView view;
+  view.X_WC = LookAt(Vector3d(5, -14, 14), Vector3d(5, 0, 0));
+  RenderSettings settings = RenderSettings::Preset(Quality::kHigh);
+  settings.sun_direction_W = Eigen::Vector3f(-1.f, 0.f, 1.f);
+  settings.haze = false;
+  Frame frame;
+  renderer->Render(view, {}, {}, settings, &frame);
+  // Along the ground's line y = 0 from x = 2 (in shadow) to x = 8 (lit): where
+  // the brightness crosses half way, against the projection of x = 5.
+  const Eigen::Vector2d a = Project(view, Vector3d(2, 0, 0)), b = Project(view, Vector3d(8, 0, 0));
+  auto brightness = [&](const Eigen::Vector2d& p) {
+    const std::uint8_t* rgb = Pixel(frame, int(p.x()), int(p.y()));
+    return rgb[0] + rgb[1] + rgb[2];
+  };
+  const double dark = brightness(a), lit = brightness(b);
+  ASSERT_GT(lit, dark + 60) << "no shadow";
+  const int steps = int((b - a).norm() * 4);
+  double edge = -1;
+  for (int i = 0; i <= steps; ++i) {
+    const Eigen::Vector2d p = a + (b - a) * (double(i) / steps);
+    if (brightness(p) > 0.5 * (dark + lit)) {
+      edge = (p - a).norm();
+      break;
+    }
+  }
+  const double expected = (Project(view, Vector3d(5, 0, 0)) - a).norm();
+  EXPECT_NEAR(edge, expected, 2.0);
 }
 
 TEST(RendererTextureTest, TextureColoursShow) {
