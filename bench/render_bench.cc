@@ -6,7 +6,12 @@
 //     1M triangles), against an empty level as the reference; and the 1M
 //     terrain seen from its middle along the ground, where culling works.
 //
-//   bench_render [--seconds S]
+//  3. The overlay's cost.
+//  4. The looks: the sample level's chase view at 640x480 and 1280x720 with
+//     the plain, fast and high presets, and each image kind, against the
+//     plain look in the same run (ratio).
+//
+//   bench_render [--seconds S] [--looks]   (--looks: section 4 only)
 
 #include <algorithm>
 #include <atomic>
@@ -36,13 +41,88 @@ using namespace sandbox;
 using Clock = std::chrono::steady_clock;
 namespace fs = std::filesystem;
 
+// Median milliseconds a frame of the sample level's chase view (the wing
+// posed mid-turn) with `settings` at `width` x `height`, after a warm-up.
+double ChaseFrameMs(render::Renderer& renderer, const scene::RobotState& wing, int width,
+                    int height, const render::RenderSettings& settings) {
+  render::CameraView view;
+  view.width = width;
+  view.height = height;
+  render::ChaseCamera chase({});
+  view.X_WC = chase.Update(wing.pose(), 0.0);
+  render::Frame frame;
+  std::vector<double> ms;
+  for (int i = 0; i < 13; ++i) {
+    const auto start = Clock::now();
+    renderer.Render(view, {}, {&wing}, settings, &frame);
+    if (i >= 3)  // the first frames of a look compile its shaders
+      ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+  }
+  return bench::Median(ms);
+}
+
+int BenchLooks() {
+  const scene::Level level =
+      scene::LoadLevel(std::string(SANDBOX_SOURCE_DIR) + "/assets/sample/level.toml");
+  auto renderer = render::MakeRenderer();
+  renderer->SetLevel(level, {});
+  scene::RobotState wing(level.robots[0]);
+  wing.SetPose(Eigen::Translation3d(-40, -30, 25) *
+               Eigen::AngleAxisd(0.6, Eigen::Vector3d::UnitZ()));
+  wing.Update();
+  std::printf(
+      "looks: sample level, chase camera, wing mid-turn; median ms a frame (fps), ratio "
+      "to plain at that size\n");
+  std::printf("%-10s %-34s %10s %8s %8s\n", "size", "look", "ms", "fps", "ratio");
+  for (const auto& [width, height] : {std::pair{640, 480}, std::pair{1280, 720}}) {
+    double plain_ms = 0.0;
+    auto row = [&](const std::string& name, const render::RenderSettings& settings) {
+      const double ms = ChaseFrameMs(*renderer, wing, width, height, settings);
+      if (plain_ms == 0.0) plain_ms = ms;
+      std::printf("%4dx%-5d %-34s %10.2f %8.1f %7.2fx\n", width, height, name.c_str(), ms, 1e3 / ms,
+                  ms / plain_ms);
+    };
+    using render::Quality;
+    for (const auto& [name, quality] :
+         {std::pair{"plain", Quality::kPlain}, std::pair{"fast", Quality::kFast},
+          std::pair{"high", Quality::kHigh}}) {
+      row(std::string(name) + " (color, depth)", render::RenderSettings::Preset(quality));
+    }
+    render::RenderSettings shadows = render::RenderSettings::Preset(Quality::kFast);
+    shadows.shadows = true;
+    row("fast + shadows", shadows);
+    render::RenderSettings msaa = render::RenderSettings::Preset(Quality::kFast);
+    msaa.msaa_samples = 4;
+    row("fast + 4x multisampling", msaa);
+    for (const auto& [name, kinds] :
+         {std::pair{"high: color only", render::ImageKinds(render::kColorImage)},
+          std::pair{"high: + segmentation",
+                    render::ImageKinds(render::kColorImage | render::kSegmentationImage)},
+          std::pair{"high: + normals",
+                    render::ImageKinds(render::kColorImage | render::kNormalsImage)},
+          std::pair{"high: all four",
+                    render::ImageKinds(render::kColorImage | render::kDepthImage |
+                                       render::kSegmentationImage | render::kNormalsImage)},
+          std::pair{"depth only", render::ImageKinds(render::kDepthImage)},
+          std::pair{"segmentation only", render::ImageKinds(render::kSegmentationImage)}}) {
+      render::RenderSettings settings = render::RenderSettings::Preset(Quality::kHigh);
+      settings.images = kinds;
+      row(name, settings);
+    }
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   double seconds = 5.0;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    if (!std::strcmp(argv[i], "--seconds")) seconds = std::atof(argv[i + 1]);
+  bool looks_only = false;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--seconds") && i + 1 < argc) seconds = std::atof(argv[++i]);
+    if (!std::strcmp(argv[i], "--looks")) looks_only = true;
   }
+  if (looks_only) return BenchLooks();
   // 1. Chase camera, render thread + encoder thread.
   {
     const scene::Level level =

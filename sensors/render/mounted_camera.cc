@@ -31,7 +31,7 @@ CameraKind ParseCameraKind(const scene::SensorSpec& spec) {
 // quality, shadows, msaa, haze, anisotropy, images: the camera's look.
 void ReadLook(const scene::SensorSpec& spec, scene::SettingsReader* read, RenderSettings* look) {
   try {
-    *look = RenderSettings::Preset(ParseQuality(read->Text("quality", "high")));
+    *look = RenderSettings::Preset(ParseQuality(read->Text("quality", "fast")));
   } catch (const std::invalid_argument& error) {
     throw scene::LevelError(spec.settings.Where("quality") + error.what());
   }

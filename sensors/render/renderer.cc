@@ -74,6 +74,16 @@ GLuint Link(const char* vertex, const char* fragment) {
   return program;
 }
 
+void FlipRows(RgbaImage* image) {
+  const std::size_t row = 4 * std::size_t(image->width);
+  for (int y = 0; y < image->height / 2; ++y) {
+    std::swap_ranges(
+        image->rgba.begin() + std::ptrdiff_t(row * std::size_t(y)),
+        image->rgba.begin() + std::ptrdiff_t(row * std::size_t(y + 1)),
+        image->rgba.begin() + std::ptrdiff_t(row * std::size_t(image->height - 1 - y)));
+  }
+}
+
 // A mesh on the GPU, with what it is drawn as.
 struct GpuMesh {
   GLuint vao{0}, positions{0}, normals{0}, uvs{0}, lightmap_uvs{0}, colors{0}, segments{0},
@@ -234,7 +244,17 @@ class OsMesaRenderer : public Renderer {
     // GL 4.5 calls libOSMesa does not export are found through it.
     clip_control_ = reinterpret_cast<PFNGLCLIPCONTROLPROC>(OSMesaGetProcAddress("glClipControl"));
     if (clip_control_ == nullptr) throw std::runtime_error("Renderer: no glClipControl");
-    shadow_program_ = Link(shaders::kShadowVertex, shaders::kShadowFragment);
+    for (const bool masked : {false, true}) {
+      const std::string fragment = std::string("#version 450 core\n#define ALPHA_MASK ") +
+                                   (masked ? "1" : "0") + "\n" + shaders::kShadowFragment;
+      const GLuint program = shadow_programs_[masked] =
+          Link(shaders::kShadowVertex, fragment.c_str());
+      shadow_uniforms_[masked] = {glGetUniformLocation(program, "model"),
+                                  glGetUniformLocation(program, "view_proj"),
+                                  glGetUniformLocation(program, "alpha_cutoff")};
+      glUseProgram(program);
+      glUniform1i(glGetUniformLocation(program, "base_texture"), 0);
+    }
     overlay_program_ = Link(shaders::kOverlayVertex, shaders::kOverlayFragment);
     sky_program_ = Link(shaders::kSkyVertex, shaders::kSkyFragment);
     glGenVertexArrays(1, &overlay_vao_);
@@ -244,9 +264,7 @@ class OsMesaRenderer : public Renderer {
     glGenSamplers(1, &anisotropic_);
     glSamplerParameteri(anisotropic_, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
     glSamplerParameteri(anisotropic_, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glUseProgram(shadow_program_);
     program_key_ = -1;
-    glUniform1i(glGetUniformLocation(shadow_program_, "base_texture"), 0);
     // The ground's detail textures.
     const std::vector<std::uint8_t> detail = MakeDetailTextures(kDetailPx);
     glGenTextures(1, &detail_);
@@ -294,6 +312,9 @@ class OsMesaRenderer : public Renderer {
             embedded ? &level.textures[std::size_t(embedded_index)] : nullptr;
         const std::string problem = decoder ? decoder(texture, path, &image) : "no decoder";
         if (problem.empty() && image.width > 0 && image.height > 0) {
+          // Model files' texture coordinates come from assimp with v = 0 at the
+          // image's bottom row (it flips glTF's); GL's t = 0 is the first row given.
+          if (what != "lightmap") FlipRows(&image);
           (*to)[int(m)] = UploadTexture(image, wrap, srgb);
         } else {
           warnings_.push_back("material '" + material.name + "': " + what + " " +
@@ -307,7 +328,7 @@ class OsMesaRenderer : public Renderer {
            "drawn without it", GL_REPEAT, false, &normal_maps_);
       if (material.lightmap_texture_embedded >= 0) {
         load(material.lightmap_texture_embedded, "", "lightmap", "lit by the sun instead",
-             GL_CLAMP_TO_EDGE, false, &lightmaps_);
+             GL_CLAMP_TO_EDGE, true, &lightmaps_);
       }
     }
     // The robots' bone groups, per triangle, for segmentation.
@@ -365,17 +386,12 @@ class OsMesaRenderer : public Renderer {
       DrawShadowMaps(cascades, settings.shadow_map_px);
     }
 
-    // The look's programs, each with this frame's uniforms.
+    // The look; each program gets this frame's uniforms at its first use in it.
+    ++frame_number_;
+    gamma_ = settings.gamma_correct;
     const int look = (settings.gamma_correct ? kGamma : 0) | (settings.materials ? kMaterials : 0) |
                      (shadows ? kShadows : 0);
-    for (const int pass_look : {look, look | kDataOnly}) {
-      look_ = pass_look;
-      for (int surface = 0; surface < 3; ++surface) {
-        UseSurface(surface);
-        glUniformMatrix4fv(U("view_proj"), 1, GL_FALSE, view_proj.data());
-        SetLookUniforms(view, settings, sun, cascades);
-      }
-    }
+    SetFrameUniforms(view, view_proj, settings, sun, cascades);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);
     glDisable(GL_CULL_FACE);
@@ -394,8 +410,9 @@ class OsMesaRenderer : public Renderer {
       ClearTargets(samples == 0, horizon);
       glDrawBuffers(1, color_only);
       DrawSky(view_proj_d.inverse().cast<float>(), horizon, sun);
-      if (samples == 0 && want_data) glDrawBuffers(3, all);
-      look_ = look;
+      const bool data_too = samples == 0 && want_data;
+      if (data_too) glDrawBuffers(3, all);
+      look_ = look | (data_too ? kData : 0);
       DrawScene(Pass::kColor, view_proj);
       if (samples > 0) {
         glBindFramebuffer(GL_READ_FRAMEBUFFER, msaa_fbo_);
@@ -415,7 +432,7 @@ class OsMesaRenderer : public Renderer {
       glViewport(0, 0, view.width, view.height);
       ClearTargets(true, horizon, /*keep_color=*/true);
       glDrawBuffers(3, data_only);
-      look_ = look | kDataOnly;
+      look_ = kDataOnly;
       DrawScene(Pass::kData, view_proj);
     }
 
@@ -498,23 +515,40 @@ class OsMesaRenderer : public Renderer {
   std::string description() const override { return description_; }
 
  private:
-  // The scene program for a surface (0 plain, 1 terrain, 2 water) and the
-  // look of the pass (look_), made at its first use, in use. Fixed sampler
-  // units: 0 base colour, 1 lightmap, 2 normal map, 3 detail, 4 shadow map,
-  // 5 triangle segments.
-  void UseSurface(int surface) {
-    const int key = std::clamp(surface, 0, 2) | look_;
+  // The scene program for a surface (0 plain, 1 terrain, 2 water), a mesh's
+  // features (kTexture ...) and the pass's look (look_): made at its first
+  // use, in use, with this frame's uniforms. Fixed sampler units: 0 base
+  // colour, 1 lightmap, 2 normal map, 3 detail, 4 shadow map, 5 triangle segments.
+  void UseProgram(int surface, int features) {
+    int key = look_ | features;
+    if (look_ & kDataOnly) {
+      // Segment and normal only: what decides which fragments exist, and the ids.
+      key = kDataOnly | (features & (kAlphaMask | kTriangleSegments));
+      if (features & kAlphaMask) key |= features & (kTexture | kVertexColors);
+    } else {
+      key |= std::clamp(surface, 0, 2);
+      if (!(look_ & kData)) key &= ~kTriangleSegments;
+      if (!(look_ & kMaterials)) key &= ~kNormalMap;
+    }
     if (key == program_key_) return;
     program_key_ = key;
     auto found = programs_.find(key);
     const bool made = found == programs_.end();
     if (made) {
       std::string fragment = "#version 450 core\n";
-      const std::pair<const char*, int> defines[] = {{"SURFACE", key & 3},
-                                                     {"GAMMA", (key & kGamma) != 0},
-                                                     {"MATERIALS", (key & kMaterials) != 0},
-                                                     {"SHADOWS", (key & kShadows) != 0},
-                                                     {"DATA_ONLY", (key & kDataOnly) != 0}};
+      const std::pair<const char*, int> defines[] = {
+          {"SURFACE", key & 3},
+          {"GAMMA", (key & kGamma) != 0},
+          {"MATERIALS", (key & kMaterials) != 0},
+          {"SHADOWS", (key & kShadows) != 0},
+          {"DATA", (key & kData) != 0},
+          {"DATA_ONLY", (key & kDataOnly) != 0},
+          {"TEXTURE", (key & kTexture) != 0},
+          {"LIGHTMAP", (key & kLightmap) != 0},
+          {"NORMAL_MAP", (key & kNormalMap) != 0},
+          {"ALPHA_MASK", (key & kAlphaMask) != 0},
+          {"VERTEX_COLORS", (key & kVertexColors) != 0},
+          {"TRIANGLE_SEGMENTS", (key & kTriangleSegments) != 0}};
       for (const auto& [name, value] : defines) {
         fragment += "#define " + std::string(name) + " " + std::to_string(value) + "\n";
       }
@@ -530,6 +564,10 @@ class OsMesaRenderer : public Renderer {
                                                    {"normal_texture", 2}, {"detail", 3},
                                                    {"shadow_map", 4},     {"segments", 5}};
       for (const auto& [name, unit] : units) glUniform1i(U(name), unit);
+    }
+    if (program_->frame != frame_number_) {
+      program_->frame = frame_number_;
+      ApplyFrameUniforms();
     }
   }
   // A uniform of the scene program in use.
@@ -557,22 +595,37 @@ class OsMesaRenderer : public Renderer {
     }
   }
 
-  void SetLookUniforms(const CameraView& view, const RenderSettings& settings,
-                       const Eigen::Vector3f& sun, const std::vector<ShadowCascade>& cascades) {
-    glUniform3f(U("sun"), sun.x(), sun.y(), sun.z());
-    const Eigen::Vector3f horizon = settings.sky_rgb, zenith = Zenith(horizon);
-    glUniform3f(U("horizon"), horizon.x(), horizon.y(), horizon.z());
-    glUniform3f(U("zenith"), zenith.x(), zenith.y(), zenith.z());
+  // This frame's uniforms, for every scene program used in it. Colours in
+  // the shading space (linear light with gamma-correct shading).
+  void SetFrameUniforms(const CameraView& view, const Eigen::Matrix4f& view_proj,
+                        const RenderSettings& settings, const Eigen::Vector3f& sun,
+                        const std::vector<ShadowCascade>& cascades) {
+    FrameUniforms& u = frame_uniforms_;
+    u.view_proj = view_proj;
+    u.sun = sun;
+    u.horizon = Shading(settings.sky_rgb, false);
+    u.zenith = Shading(Zenith(settings.sky_rgb), false);
     // The haze: the level's visibility when it gives one.
     const bool default_fog = settings.fog_end_m == RenderSettings{}.fog_end_m;
     const double visibility = level_->horizon ? level_->horizon->visibility_m : 0.0;
     if (!settings.haze) {
-      glUniform2f(U("fog"), 0.f, 0.f);
+      u.fog = Eigen::Vector2f::Zero();
     } else if (default_fog && visibility > 0.0) {
-      glUniform2f(U("fog"), float(0.1 * visibility), float(visibility));
+      u.fog = Eigen::Vector2f(float(0.1 * visibility), float(visibility));
     } else {
-      glUniform2f(U("fog"), settings.fog_start_m, settings.fog_end_m);
+      u.fog = Eigen::Vector2f(settings.fog_start_m, settings.fog_end_m);
     }
+    u.camera_z = float(camera_.z());
+    u.camera_xy = Eigen::Vector2f(float(std::fmod(camera_.x(), kPatternPeriod_m)),
+                                  float(std::fmod(camera_.y(), kPatternPeriod_m)));
+    const Eigen::Vector3f grass =
+        level_->horizon ? level_->horizon->rgb : Eigen::Vector3f(0.36f, 0.45f, 0.24f);
+    const Eigen::Vector3f layers[4] = {
+        grass, {0.45f, 0.42f, 0.38f}, {0.93f, 0.94f, 0.96f}, {0.74f, 0.67f, 0.48f}};
+    for (int i = 0; i < 4; ++i) u.ground[i] = Shading(layers[i], false);
+    u.view_axis = view.X_WC.linear().col(0).cast<float>();
+    u.R_CW = view.X_WC.linear().transpose().cast<float>();
+    u.cascades = cascades;
     // Anisotropic filtering of material textures (the sampler repeats at the edges).
     const float anisotropy = std::clamp(float(settings.anisotropy), 1.f, max_anisotropy_);
     if (anisotropy > 1.f) {
@@ -583,31 +636,52 @@ class OsMesaRenderer : public Renderer {
       glBindSampler(0, 0);
       glBindSampler(2, 0);
     }
-    glUniform1f(U("camera_z"), float(camera_.z()));
-    glUniform2f(U("camera_xy"), float(std::fmod(camera_.x(), kPatternPeriod_m)),
-                float(std::fmod(camera_.y(), kPatternPeriod_m)));
-    glUniform1f(U("water_level"), water_level_);
-    glUniform1f(U("snow_line"), 2800.f);
-    const Eigen::Vector3f grass =
-        level_->horizon ? level_->horizon->rgb : Eigen::Vector3f(0.36f, 0.45f, 0.24f);
-    glUniform3f(U("grass_rgb"), grass.x(), grass.y(), grass.z());
-    const Eigen::Vector3f axis = view.X_WC.linear().col(0).cast<float>();
-    glUniform3f(U("view_axis"), axis.x(), axis.y(), axis.z());
-    const Eigen::Matrix3f R_CW = view.X_WC.linear().transpose().cast<float>();
-    glUniformMatrix3fv(U("world_to_camera"), 1, GL_FALSE, R_CW.data());
-    glUniform1i(U("cascades"), int(cascades.size()));
-    for (std::size_t c = 0; c < cascades.size(); ++c) {
-      const std::string i = "[" + std::to_string(c) + "]";
-      const Eigen::Matrix4f M = cascades[c].light_clip.cast<float>();
-      glUniformMatrix4fv(U(("shadow_clip" + i).c_str()), 1, GL_FALSE, M.data());
-      glUniform1f(U(("cascade_far" + i).c_str()), float(cascades[c].far_m));
-      glUniform1f(U(("shadow_texel" + i).c_str()), float(cascades[c].texel_m));
-    }
     glActiveTexture(GL_TEXTURE3);
     glBindTexture(GL_TEXTURE_2D_ARRAY, detail_);
     glActiveTexture(GL_TEXTURE4);
     glBindTexture(GL_TEXTURE_2D_ARRAY, shadow_map_);
     glActiveTexture(GL_TEXTURE0);
+  }
+
+  void ApplyFrameUniforms() {
+    const FrameUniforms& u = frame_uniforms_;
+    glUniformMatrix4fv(U("view_proj"), 1, GL_FALSE, u.view_proj.data());
+    glUniform3fv(U("sun"), 1, u.sun.data());
+    glUniform3fv(U("horizon"), 1, u.horizon.data());
+    glUniform3fv(U("zenith"), 1, u.zenith.data());
+    glUniform2fv(U("fog"), 1, u.fog.data());
+    glUniform1f(U("camera_z"), u.camera_z);
+    glUniform2fv(U("camera_xy"), 1, u.camera_xy.data());
+    glUniform1f(U("water_level"), water_level_);
+    glUniform1f(U("snow_line"), 2800.f);
+    glUniform3fv(U("ground_rgb"), 4, u.ground[0].data());
+    glUniform3fv(U("view_axis"), 1, u.view_axis.data());
+    glUniformMatrix3fv(U("world_to_camera"), 1, GL_FALSE, u.R_CW.data());
+    glUniform1i(U("cascades"), int(u.cascades.size()));
+    for (std::size_t c = 0; c < u.cascades.size(); ++c) {
+      const std::string i = "[" + std::to_string(c) + "]";
+      const Eigen::Matrix4f M = u.cascades[c].light_clip.cast<float>();
+      glUniformMatrix4fv(U(("shadow_clip" + i).c_str()), 1, GL_FALSE, M.data());
+      glUniform1f(U(("cascade_far" + i).c_str()), float(u.cascades[c].far_m));
+      glUniform1f(U(("shadow_texel" + i).c_str()), float(u.cascades[c].texel_m));
+    }
+  }
+
+  // A colour to the shading space: linear light with gamma-correct shading,
+  // else display (sRGB) values. `linear`: the colour is given linear (glTF).
+  Eigen::Vector3f Shading(const Eigen::Vector3f& rgb, bool linear) const {
+    Eigen::Vector3f out;
+    for (int i = 0; i < 3; ++i) {
+      const float c = std::clamp(rgb[i], 0.f, 1.f);
+      if (gamma_ && !linear) {
+        out[i] = c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+      } else if (!gamma_ && linear) {
+        out[i] = c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.f / 2.4f) - 0.055f;
+      } else {
+        out[i] = c;
+      }
+    }
+    return out;
   }
 
   static Eigen::Vector3f Zenith(const Eigen::Vector3f& horizon) {
@@ -677,51 +751,75 @@ class OsMesaRenderer : public Renderer {
     const scene::Material& m = material != nullptr ? *material : kDefault;
     const auto texture = textures_.find(mesh.material);
     const GLuint texture_id = texture != textures_.end() ? texture->second : 0;
+    const auto lightmap = lightmaps_.find(mesh.material);
+    const auto normal_map = normal_maps_.find(mesh.material);
+    const GLuint lightmap_id = lightmap != lightmaps_.end() ? lightmap->second : 0;
+    const GLuint normal_map_id = normal_map != normal_maps_.end() ? normal_map->second : 0;
+    const int features = (texture_id != 0 && mesh.uvs != 0 ? kTexture : 0) |
+                         (lightmap_id != 0 && mesh.lightmap_uvs != 0 ? kLightmap : 0) |
+                         (normal_map_id != 0 && mesh.uvs != 0 ? kNormalMap : 0) |
+                         (m.alpha_mode == scene::AlphaMode::kMask ? kAlphaMask : 0) |
+                         (mesh.colors != 0 ? kVertexColors : 0) |
+                         (mesh.triangle_segments != 0 ? kTriangleSegments : 0);
     if (pass_ == Pass::kShadow) {
-      const bool masked =
-          m.alpha_mode == scene::AlphaMode::kMask && texture_id != 0 && mesh.uvs != 0;
-      glUniform1i(shadow_uniforms_.masked, masked);
-      glUniform1f(shadow_uniforms_.alpha_cutoff, m.alpha_cutoff);
-      glUniformMatrix4fv(shadow_uniforms_.model, 1, GL_FALSE, model.data());
+      const bool masked = (features & kAlphaMask) && (features & kTexture);
+      UseShadowProgram(masked);
+      glUniform1f(shadow_uniforms_[masked].alpha_cutoff, m.alpha_cutoff);
+      glUniformMatrix4fv(shadow_uniforms_[masked].model, 1, GL_FALSE, model.data());
       glBindTexture(GL_TEXTURE_2D, masked ? texture_id : 0);
       glBindVertexArray(mesh.vao);
       glDrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
       return;
     }
-    UseSurface(mesh.surface >= 0 ? mesh.surface : int(m.surface));
+    UseProgram(mesh.surface >= 0 ? mesh.surface : int(m.surface), features);
     glUniformMatrix4fv(U("model"), 1, GL_FALSE, model.data());
-    glUniform4f(U("base_color"), m.base_color.x(), m.base_color.y(), m.base_color.z(),
-                m.base_color.w());
-    glUniform1i(U("linear_factor"), m.linear_color);
-    glUniform1i(U("alpha_mode"), int(m.alpha_mode));
+    const Eigen::Vector3f base = Shading(m.base_color.head<3>(), m.linear_color);
+    glUniform4f(U("base_color"), base.x(), base.y(), base.z(), m.base_color.w());
+    glUniform1i(U("vertex_color_space"), gamma_ == m.linear_color ? 0 : gamma_ ? 1 : 2);
     glUniform1f(U("alpha_cutoff"), m.alpha_cutoff);
     glUniform2f(U("metal_rough"), m.metallic, m.roughness);
-    BindTexture(GL_TEXTURE0, "has_texture", texture_id, mesh.uvs != 0);
-    const auto lightmap = lightmaps_.find(mesh.material);
-    BindTexture(GL_TEXTURE1, "has_lightmap", lightmap != lightmaps_.end() ? lightmap->second : 0,
-                mesh.lightmap_uvs != 0);
-    const auto normal_map = normal_maps_.find(mesh.material);
-    BindTexture(GL_TEXTURE2, "has_normal_map",
-                normal_map != normal_maps_.end() ? normal_map->second : 0, mesh.uvs != 0);
+    BindTexture(GL_TEXTURE0, features & kTexture ? texture_id : 0, true);
+    BindTexture(GL_TEXTURE1, features & kLightmap ? lightmap_id : 0, true);
+    BindTexture(GL_TEXTURE2, features & kNormalMap ? normal_map_id : 0, false);
     DrawIds(mesh);
   }
 
   // The rest of a draw: segment ids, then the triangles.
   void DrawIds(const GpuMesh& mesh) {
     glUniform1ui(U("segment_base"), mesh.segment_base);
-    glUniform1i(U("triangle_segments"), mesh.triangle_segments != 0);
-    glActiveTexture(GL_TEXTURE5);
-    glBindTexture(GL_TEXTURE_BUFFER, mesh.triangle_segments);
-    glActiveTexture(GL_TEXTURE0);
+    if (mesh.triangle_segments != 0) {
+      glActiveTexture(GL_TEXTURE5);
+      glBindTexture(GL_TEXTURE_BUFFER, mesh.triangle_segments);
+      glActiveTexture(GL_TEXTURE0);
+    }
     glBindVertexArray(mesh.vao);
     glDrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
   }
 
-  void BindTexture(GLenum unit, const char* flag, GLuint texture, bool usable) {
-    glUniform1i(U(flag), texture != 0 && usable);
+  // Binds a texture; colour textures (sRGB) are decoded to linear light by
+  // the sampler with gamma-correct shading and read as display values without.
+  void BindTexture(GLenum unit, GLuint texture, bool srgb) {
     glActiveTexture(unit);
     glBindTexture(GL_TEXTURE_2D, texture);
+    if (texture != 0 && srgb) {
+      // A texture decodes until told otherwise.
+      bool& decoding = srgb_decode_.emplace(texture, true).first->second;
+      if (decoding != gamma_) {
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_SRGB_DECODE_EXT,
+                        gamma_ ? GL_DECODE_EXT : GL_SKIP_DECODE_EXT);
+        decoding = gamma_;
+      }
+    }
     glActiveTexture(GL_TEXTURE0);
+  }
+
+  // The depth-only program for the sun's view; `masked`: cut-outs cut.
+  void UseShadowProgram(bool masked) {
+    const int key = masked ? -3 : -2;
+    if (program_key_ == key) return;
+    program_key_ = key;
+    glUseProgram(shadow_programs_[masked]);
+    glUniformMatrix4fv(shadow_uniforms_[masked].view_proj, 1, GL_FALSE, view_proj_.data());
   }
 
   // A mesh in one colour (and texture, 0: none), not a level material: the
@@ -730,20 +828,17 @@ class OsMesaRenderer : public Renderer {
                 GLuint texture,
                 const std::vector<std::pair<std::uint32_t, std::uint32_t>>* ranges = nullptr) {
     if (pass_ == Pass::kShadow) {
-      glUniform1i(shadow_uniforms_.masked, 0);
-      glUniformMatrix4fv(shadow_uniforms_.model, 1, GL_FALSE, model.data());
+      UseShadowProgram(false);
+      glUniformMatrix4fv(shadow_uniforms_[0].model, 1, GL_FALSE, model.data());
     } else {
-      UseSurface(mesh.surface >= 0 ? mesh.surface : 0);
+      const bool textured = texture != 0 && mesh.uvs != 0;
+      UseProgram(mesh.surface >= 0 ? mesh.surface : 0, textured ? kTexture : 0);
       glUniformMatrix4fv(U("model"), 1, GL_FALSE, model.data());
-      glUniform4f(U("base_color"), color.x(), color.y(), color.z(), color.w());
-      glUniform1i(U("linear_factor"), 0);
-      glUniform1i(U("alpha_mode"), 0);
+      const Eigen::Vector3f base = Shading(color.head<3>(), false);
+      glUniform4f(U("base_color"), base.x(), base.y(), base.z(), color.w());
       glUniform2f(U("metal_rough"), 0.f, 1.f);
-      BindTexture(GL_TEXTURE0, "has_texture", texture, mesh.uvs != 0);
-      BindTexture(GL_TEXTURE1, "has_lightmap", 0, false);
-      BindTexture(GL_TEXTURE2, "has_normal_map", 0, false);
+      BindTexture(GL_TEXTURE0, textured ? texture : 0, true);
       glUniform1ui(U("segment_base"), mesh.segment_base);
-      glUniform1i(U("triangle_segments"), 0);
     }
     glBindVertexArray(mesh.vao);
     if (ranges == nullptr) {
@@ -776,12 +871,6 @@ class OsMesaRenderer : public Renderer {
       shadow_px_ = px;
       shadow_layers_ = layers;
     }
-    glUseProgram(shadow_program_);
-    program_key_ = -1;
-    shadow_uniforms_ = {glGetUniformLocation(shadow_program_, "model"),
-                        glGetUniformLocation(shadow_program_, "view_proj"),
-                        glGetUniformLocation(shadow_program_, "masked"),
-                        glGetUniformLocation(shadow_program_, "alpha_cutoff")};
     glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo_);
     glDrawBuffer(GL_NONE);
     glReadBuffer(GL_NONE);
@@ -796,9 +885,8 @@ class OsMesaRenderer : public Renderer {
       glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, shadow_map_, 0, c);
       glClearDepth(1.0);
       glClear(GL_DEPTH_BUFFER_BIT);
-      const Eigen::Matrix4f clip = cascades[std::size_t(c)].light_clip.cast<float>();
-      glUniformMatrix4fv(shadow_uniforms_.view_proj, 1, GL_FALSE, clip.data());
-      DrawScene(Pass::kShadow, clip);
+      program_key_ = -1;  // the shadow programs take this cascade's clip at first use
+      DrawScene(Pass::kShadow, cascades[std::size_t(c)].light_clip.cast<float>());
     }
     glDisable(GL_POLYGON_OFFSET_FILL);
   }
@@ -1152,16 +1240,32 @@ class OsMesaRenderer : public Renderer {
   struct SceneProgram {
     GLuint id{0};
     std::map<std::string, GLint> uniforms;
+    long frame{-1};  // the frame its frame uniforms are from
   };
-  static constexpr int kGamma = 4, kMaterials = 8, kShadows = 16, kDataOnly = 32;
+  // Program keys: the surface (bits 0-1), the look, the mesh's features.
+  static constexpr int kGamma = 4, kMaterials = 8, kShadows = 16, kData = 32, kDataOnly = 64;
+  static constexpr int kTexture = 128, kLightmap = 256, kNormalMap = 512, kAlphaMask = 1024,
+                       kVertexColors = 2048, kTriangleSegments = 4096;
   std::map<int, SceneProgram> programs_;
   SceneProgram* program_{nullptr};
   int program_key_{-1};
   int look_{0};
-  GLuint shadow_program_{0}, overlay_program_{0}, sky_program_{0};
-  struct {
-    GLint model{-1}, view_proj{-1}, masked{-1}, alpha_cutoff{-1};
-  } shadow_uniforms_;
+  GLuint shadow_programs_[2]{0, 0}, overlay_program_{0}, sky_program_{0};  // [masked]
+  struct ShadowUniforms {
+    GLint model{-1}, view_proj{-1}, alpha_cutoff{-1};
+  } shadow_uniforms_[2];
+  // This frame's uniforms for the scene programs.
+  struct FrameUniforms {
+    Eigen::Matrix4f view_proj;
+    Eigen::Vector3f sun, horizon, zenith, ground[4], view_axis;
+    Eigen::Vector2f fog, camera_xy;
+    float camera_z{0.f};
+    Eigen::Matrix3f R_CW;
+    std::vector<ShadowCascade> cascades;
+  } frame_uniforms_;
+  long frame_number_{0};
+  bool gamma_{true};                    // this frame's shading is in linear light
+  std::map<GLuint, bool> srgb_decode_;  // by colour texture: decoding to linear now
   GLuint fbo_{0}, buffers_[4]{0, 0, 0, 0}, msaa_fbo_{0}, msaa_buffers_[2]{0, 0};
   GLuint shadow_fbo_{0}, shadow_map_{0}, detail_{0};
   int shadow_px_{0}, shadow_layers_{0};

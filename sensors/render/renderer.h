@@ -62,8 +62,8 @@ struct RenderSettings {
   // Anisotropic filtering of material textures (1: trilinear mipmaps only).
   // Off by default: llvmpipe takes about 9 s to compile each shader variant that uses it.
   int anisotropy{1};
-  int shadow_map_px{2048};
-  int shadow_cascades{3};
+  int shadow_map_px{1024};
+  int shadow_cascades{2};
   double shadow_distance_m{300.0};  // shadows end this far along the optical axis
   ImageKinds images{kColorImage | kDepthImage};
 

@@ -16,6 +16,7 @@ layout(location = 4) in vec4 vertex_rgba;
 layout(location = 5) in uint vertex_segment;
 uniform mat4 model;       // object to camera-centred world
 uniform mat4 view_proj;   // camera-centred world to clip
+uniform int vertex_color_space;  // to the shading space: 0 as they are, 1 decode sRGB, 2 encode
 out vec3 world_normal;
 out vec3 rel_position;
 out vec2 tex_uv;
@@ -28,16 +29,24 @@ void main() {
   rel_position = p.xyz;
   tex_uv = uv;
   baked_uv = lightmap_uv;
-  vertex_color = vertex_rgba;
+  vec3 c = clamp(vertex_rgba.rgb, 0.0, 1.0);
+  if (vertex_color_space == 1) c = mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(0.04045, c));
+  if (vertex_color_space == 2) c = mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(0.0031308, c));
+  vertex_color = vec4(c, vertex_rgba.a);
   segment_of_vertex = vertex_segment;
   gl_Position = view_proj * p;
 }
 )";
 
-// Compiled for each use with defines after the version line: SURFACE 0
-// (plain), 1 (terrain) or 2 (water); GAMMA, MATERIALS, SHADOWS (the look's
-// switches) and DATA_ONLY (segment and normal only) 0 or 1. llvmpipe runs
-// every branch of a shader, so each program holds only what it uses.
+// Compiled for each use with defines after the version line (llvmpipe runs
+// every branch of a shader, and a shader that may discard loses the early
+// depth test, so each program holds only what its draws use):
+//   the look: GAMMA (shade in linear light, write sRGB),
+//     MATERIALS, SHADOWS, and SURFACE 0 plain, 1 terrain, 2 water;
+//   the mesh: TEXTURE, LIGHTMAP, NORMAL_MAP, ALPHA_MASK, VERTEX_COLORS,
+//     TRIANGLE_SEGMENTS (per-triangle ids for robots' bones);
+//   the outputs: DATA (segment and normal too), DATA_ONLY (only those).
+// Colours reach it in the shading space (linear with GAMMA, else display).
 inline constexpr const char* kSceneFragment = R"(
 in vec3 world_normal;
 in vec3 rel_position;
@@ -46,28 +55,25 @@ in vec2 baked_uv;
 in vec4 vertex_color;
 flat in uint segment_of_vertex;
 layout(location = 0) out vec4 color;
+#if DATA == 1 || DATA_ONLY == 1
 layout(location = 1) out uint segment;
 layout(location = 2) out vec4 camera_normal;
+#endif
 
-uniform vec4 base_color;          // as the material gives it
-uniform bool linear_factor;       // base_color is linear (glTF); else display (sRGB)
-uniform bool has_texture;
-uniform sampler2D base_texture;   // sRGB texels, sampled linear
-uniform bool has_lightmap;        // baked lighting replaces the sun (Quake 3 maps)
-uniform sampler2D lightmap;
-uniform bool has_normal_map;
+uniform vec4 base_color;          // shading space
+uniform sampler2D base_texture;   // sampled in the shading space
+uniform sampler2D lightmap;       // baked lighting replaces the sun (Quake 3 maps)
 uniform sampler2D normal_texture;
-uniform int alpha_mode;           // 0 opaque, 1 mask, 2 blend
 uniform float alpha_cutoff;
 uniform vec2 metal_rough;
 uniform float camera_z;           // the camera's world height: heights for the ground's layers
 uniform vec2 camera_xy;           // the camera's world x, y modulo 6900 m (patterns repeat there)
 uniform float water_level;
 uniform float snow_line;
-uniform vec3 grass_rgb;           // display colours
+uniform vec3 ground_rgb[4];       // grass, rock, snow, sand; shading space
 uniform sampler2DArray detail;    // grass, rock, snow, sand
 uniform vec3 sun;
-uniform vec3 horizon;             // display colours of the sky
+uniform vec3 horizon;             // the sky's colours, shading space
 uniform vec3 zenith;
 uniform vec2 fog;                 // start, end; end <= 0: none
 uniform sampler2DArrayShadow shadow_map;
@@ -76,21 +82,9 @@ uniform float cascade_far[4];
 uniform float shadow_texel[4];
 uniform int cascades;
 uniform vec3 view_axis;           // the camera's optical axis in the world
-uniform mat3 world_to_camera;     // rows: camera x (forward), y (left), z (up)
+uniform mat3 world_to_camera;     // rows: camera x (forward), y (left), z up
 uniform uint segment_base;
-uniform bool triangle_segments;
 uniform usamplerBuffer segments;  // per triangle, added to segment_base
-
-vec3 Decode(vec3 c) {  // sRGB to linear
-  return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(0.04045, c));
-}
-vec3 Encode(vec3 c) {  // linear to sRGB
-  c = clamp(c, 0.0, 1.0);
-  return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(0.0031308, c));
-}
-// Display colours to the shading space and back.
-vec3 In(vec3 display) { return GAMMA == 1 ? Decode(display) : display; }
-vec3 Out(vec3 shaded) { return GAMMA == 1 ? Encode(shaded) : shaded; }
 
 float Hash(vec2 p) { return fract(sin(dot(p, vec2(127.1, 311.7))) * 43758.5453); }
 float Noise(vec2 p) {
@@ -103,21 +97,25 @@ float Shadow(vec3 n, float view_depth) {
 #if SHADOWS == 0
   return 1.0;
 #else
+  if (view_depth > cascade_far[cascades - 1]) return 1.0;
   int c = 0;
   while (c < cascades - 1 && view_depth > cascade_far[c]) ++c;
-  if (view_depth > cascade_far[cascades - 1]) return 1.0;
-  // Pushed off the surface along its normal by about a texel: no acne.
-  vec3 p = rel_position + n * (1.5 * shadow_texel[c]);
-  vec4 q = shadow_clip[c] * vec4(p, 1.0);
+  // Pushed off the surface along its normal, more where the sun grazes it: no acne.
+  float grazing = 1.0 - clamp(dot(n, sun), 0.0, 1.0);
+  vec4 q = shadow_clip[c] * vec4(rel_position + n * ((0.4 + 1.5 * grazing) * shadow_texel[c]), 1.0);
   vec2 st = 0.5 * q.xy + 0.5;
   if (any(lessThan(st, vec2(0.0))) || any(greaterThan(st, vec2(1.0)))) return 1.0;
-  vec2 texel = 1.0 / vec2(textureSize(shadow_map, 0).xy);
-  float lit = 0.0;
-  for (int k = 0; k < 4; ++k) {
-    vec2 o = vec2((k & 1) == 1 ? 0.5 : -0.5, (k & 2) == 2 ? 0.5 : -0.5) * texel;
-    lit += texture(shadow_map, vec4(st + o, float(c), q.z));
-  }
-  return 0.25 * lit;
+  return texture(shadow_map, vec4(st, float(c), q.z));  // bilinear percentage-closer
+#endif
+}
+
+// The shading space to display values (sRGB).
+vec3 Out(vec3 c) {
+#if GAMMA == 1
+  c = clamp(c, 0.0, 1.0);
+  return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(0.0031308, c));
+#else
+  return c;
 #endif
 }
 
@@ -127,23 +125,34 @@ vec3 Sky(vec3 d) {
 }
 
 void main() {
-#if GAMMA == 1
-  vec4 albedo = vec4(linear_factor ? base_color.rgb : Decode(base_color.rgb), base_color.a);
-#else
-  vec4 albedo = vec4(linear_factor ? Encode(base_color.rgb) : base_color.rgb, base_color.a);
+  vec4 albedo = base_color;
+#if TEXTURE == 1
+  albedo *= texture(base_texture, tex_uv);
 #endif
-  if (has_texture) {
-    vec4 t = texture(base_texture, tex_uv);
-    albedo *= vec4(GAMMA == 1 ? t.rgb : Encode(t.rgb), t.a);
-  }
-  albedo *= vec4(In(vertex_color.rgb), vertex_color.a);
-  if (alpha_mode == 1 && albedo.a < alpha_cutoff) discard;
-  if (alpha_mode == 1) albedo.a = 1.0;
+#if VERTEX_COLORS == 1
+  albedo *= vertex_color;
+#endif
+#if ALPHA_MASK == 1
+  if (albedo.a < alpha_cutoff) discard;
+  albedo.a = 1.0;
+#endif
 
   vec3 n = normalize(world_normal);
   if (!gl_FrontFacing) n = -n;  // thin surfaces: the side seen
-#if MATERIALS == 1 && DATA_ONLY == 0
-  if (has_normal_map) {
+#if DATA == 1 || DATA_ONLY == 1
+#if TRIANGLE_SEGMENTS == 1
+  segment = segment_base + segment_of_vertex + texelFetch(segments, gl_PrimitiveID).r;
+#else
+  segment = segment_base + segment_of_vertex;
+#endif
+  camera_normal = vec4(world_to_camera * n, 1.0);
+#endif
+#if DATA_ONLY == 1
+  color = vec4(0.0);
+}
+#else
+#if NORMAL_MAP == 1
+  {
     // Tangent frame from the screen derivatives of position and uv.
     vec3 dp1 = dFdx(rel_position), dp2 = dFdy(rel_position);
     vec2 du1 = dFdx(tex_uv), du2 = dFdy(tex_uv);
@@ -154,85 +163,69 @@ void main() {
     n = normalize(mat3(t * scale, bt * scale, n) * m);
   }
 #endif
-  uint id = segment_base + segment_of_vertex;
-  if (triangle_segments) id += texelFetch(segments, gl_PrimitiveID).r;
-  segment = id;
-  camera_normal = vec4(world_to_camera * n, 1.0);
-#if DATA_ONLY == 1
-  color = vec4(0.0);
-}
-#else
 
   float distance_m = length(rel_position);
-  vec3 to_eye = -rel_position / max(distance_m, 1e-6);
-  float specular = 0.0;
-  float height = camera_z + rel_position.z;
+  float haze = fog.y > 0.0 ? clamp((distance_m - fog.x) / max(fog.y - fog.x, 1e-3), 0.0, 1.0) : 0.0;
 #if SURFACE == 1 && MATERIALS == 1
   {
     // Ground: sand by the water, rock on steep slopes, snow high up, grass elsewhere.
     vec2 st = rel_position.xy + camera_xy;
+    float height = camera_z + rel_position.z;
     float up = clamp(n.z, 0.0, 1.0);
     float rock = smoothstep(0.82, 0.7, up);
     float snow = smoothstep(snow_line - 150.0, snow_line + 150.0, height + 200.0 * (Noise(0.01 * st) - 0.5)) * (1.0 - rock);
     float sand = (1.0 - smoothstep(water_level + 0.8, water_level + 2.5, height)) * (1.0 - rock);
-    vec3 layers[4] = vec3[4](In(grass_rgb), In(vec3(0.45, 0.42, 0.38)), In(vec3(0.93, 0.94, 0.96)),
-                             In(vec3(0.74, 0.67, 0.48)));
-    vec3 grass = layers[0] * (0.85 + 0.3 * Noise(0.05 * st));
-    vec3 ground = has_texture ? albedo.rgb : grass;
-    ground = mix(ground, layers[3], sand);
-    ground = mix(ground, layers[1], rock);
-    ground = mix(ground, layers[2], snow);
+#if TEXTURE == 1
+    vec3 ground = albedo.rgb;
+#else
+    vec3 ground = ground_rgb[0] * (0.85 + 0.3 * Noise(0.05 * st));
+#endif
+    ground = mix(ground, ground_rgb[3], sand);
+    ground = mix(ground, ground_rgb[1], rock);
+    ground = mix(ground, ground_rgb[2], snow);
     // Detail texture: world-anchored, two scales against visible tiling; fades with distance.
-    vec2 world_xy = st;
     int layer = rock > 0.5 ? 1 : snow > 0.5 ? 2 : sand > 0.5 ? 3 : 0;
-    float d = 2.0 * texture(detail, vec3(world_xy / 3.0, float(layer))).r *
-              (2.0 * texture(detail, vec3(world_xy / 23.0, float(layer))).r);
-    d = mix(d, 1.0, smoothstep(60.0, 400.0, distance_m));
-    albedo.rgb = ground * d;
+    float d = 4.0 * texture(detail, vec3(st / 3.0, float(layer))).r *
+              texture(detail, vec3(st / 23.0, float(layer))).r;
+    albedo.rgb = ground * mix(d, 1.0, smoothstep(60.0, 400.0, distance_m));
   }
 #elif SURFACE == 2 && MATERIALS == 1
   {
     // Water: ripples, the sky reflected by Fresnel's law, the sun's glint.
+    vec3 to_eye = -rel_position / max(distance_m, 1e-6);
     vec2 p = rel_position.xy + camera_xy;
     vec3 rn = normalize(vec3(0.06 * (Noise(0.7 * p) - 0.5) + 0.04 * (Noise(2.3 * p.yx) - 0.5),
                              0.06 * (Noise(0.7 * p + 17.0) - 0.5) + 0.04 * (Noise(2.3 * p + 5.0) - 0.5), 1.0));
     float cos_i = clamp(dot(rn, to_eye), 0.0, 1.0);
     float fresnel = 0.02 + 0.98 * pow(1.0 - cos_i, 5.0);
-    vec3 reflected = In(Sky(reflect(-to_eye, rn)));
     vec3 body = albedo.rgb * (0.35 + 0.4 * max(sun.z, 0.0));
     vec3 h = normalize(sun + to_eye);
     float glint = pow(max(dot(rn, h), 0.0), 400.0) * 4.0 * Shadow(n, dot(rel_position, view_axis));
-    vec3 c = mix(body, reflected, fresnel) + vec3(glint);
-    float f = fog.y > 0.0 ? clamp((distance_m - fog.x) / max(fog.y - fog.x, 1e-3), 0.0, 1.0) : 0.0;
-    color = vec4(Out(mix(c, In(horizon), f)), mix(0.55 + 0.45 * fresnel, 1.0, f));
+    vec3 c = mix(body, Sky(reflect(-to_eye, rn)), fresnel) + vec3(glint);
+    color = vec4(Out(mix(c, horizon, haze)), mix(0.55 + 0.45 * fresnel, 1.0, haze));
     return;
   }
 #endif
 
-  vec3 lit;
-  if (has_lightmap) {
-    // Quake 3 stores lightmaps at half brightness (its "overbright" bit).
-    lit = albedo.rgb * In(min(2.0 * texture(lightmap, baked_uv).rgb, vec3(1.0)));
-  } else {
-    float sun_light = max(dot(n, sun), 0.0) * Shadow(n, dot(rel_position, view_axis));
-    // Sky light from above, less from the ground below.
-    float sky_light = mix(0.55, 1.0, 0.5 + 0.5 * n.z);
-#if GAMMA == 1
-    lit = albedo.rgb * (0.75 * sun_light + 0.25 * sky_light);
-#else
-    lit = albedo.rgb * (0.35 + 0.65 * abs(dot(n, sun)));  // the plain look
-#endif
+#if LIGHTMAP == 1
+  // Quake 3 stores lightmaps at half brightness (its "overbright" bit): twice the display value.
+  vec3 lit = albedo.rgb * min((GAMMA == 1 ? 4.595 : 2.0) * texture(lightmap, baked_uv).rgb, vec3(1.0));
+#elif GAMMA == 1
+  float sun_light = max(dot(n, sun), 0.0) * Shadow(n, dot(rel_position, view_axis));
+  // Sky light from above, less from the ground below.
+  vec3 lit = albedo.rgb * (0.75 * sun_light + 0.25 * mix(0.55, 1.0, 0.5 + 0.5 * n.z));
 #if MATERIALS == 1
-    if (metal_rough.y < 0.95 && sun_light > 0.0) {
-      vec3 h = normalize(sun + to_eye);
-      float shininess = 2.0 / max(metal_rough.y * metal_rough.y, 0.002);
-      vec3 f0 = mix(vec3(0.04), albedo.rgb, metal_rough.x);
-      lit += f0 * pow(max(dot(n, h), 0.0), shininess) * sun_light * (shininess + 8.0) / 32.0;
-    }
-#endif
+  if (metal_rough.y < 0.95 && sun_light > 0.0) {
+    vec3 h = normalize(sun - rel_position / max(distance_m, 1e-6));
+    float shininess = 2.0 / max(metal_rough.y * metal_rough.y, 0.002);
+    vec3 f0 = mix(vec3(0.04), albedo.rgb, metal_rough.x);
+    lit += f0 * pow(max(dot(n, h), 0.0), shininess) * sun_light * (shininess + 8.0) / 32.0;
   }
-  float f = fog.y > 0.0 ? clamp((distance_m - fog.x) / max(fog.y - fog.x, 1e-3), 0.0, 1.0) : 0.0;
-  color = vec4(Out(mix(lit, In(horizon), f)), albedo.a);
+#endif
+#else
+  vec3 lit = albedo.rgb * (0.35 + 0.65 * abs(dot(n, sun)));  // the plain look
+#endif
+  color = vec4(Out(mix(lit, horizon, haze)), albedo.a);
 }
 #endif
 )";
@@ -250,13 +243,15 @@ void main() {
 }
 )";
 
-inline constexpr const char* kShadowFragment = R"(#version 450 core
+// Without ALPHA_MASK it does nothing (depth only, tested early); with it, cut-outs cut.
+inline constexpr const char* kShadowFragment = R"(
 in vec2 tex_uv;
-uniform bool masked;
 uniform float alpha_cutoff;
 uniform sampler2D base_texture;
 void main() {
-  if (masked && texture(base_texture, tex_uv).a < alpha_cutoff) discard;
+#if ALPHA_MASK == 1
+  if (texture(base_texture, tex_uv).a < alpha_cutoff) discard;
+#endif
 }
 )";
 

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <set>
 #include <sstream>
 
@@ -374,6 +375,60 @@ int ChromaBin(int r, int g, int b) {
   const int sum = r + g + b;
   if (sum < 90) return -1;
   return int(50.0 * r / sum) * 64 + int(50.0 * g / sum);
+}
+
+TEST(RendererTextureTest, ATexturedQuadRendersItsTexels) {
+  // A 2 m square on the ground with a texture of 4 x 4 distinct colours, seen
+  // from straight above with the sun overhead and no haze: every look then
+  // lights it by exactly 1 (gamma-correct: 0.75 sun + 0.25 sky from above;
+  // plain: 0.35 + 0.65 cos 0), so each texel's centre shows the file's colour.
+  // Each cell is 8 x 8 texels, so that filtering at its centre mixes only its own colour.
+  testing::TempDir dir;
+  cv::Mat cells(4, 4, CV_8UC3), texture;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) {
+      cells.at<cv::Vec3b>(r, c) = cv::Vec3b(std::uint8_t(30 + 60 * c), std::uint8_t(240 - 50 * r),
+                                            std::uint8_t(17 * (r + 4 * c) % 256));
+    }
+  }
+  cv::resize(cells, texture, cv::Size(32, 32), 0, 0, cv::INTER_NEAREST);
+  ASSERT_TRUE(cv::imwrite((dir.path() / "cells.png").string(), texture));
+  dir.Write("quad.mtl", "newmtl cells\nKd 1 1 1\nmap_Kd cells.png\n");
+  dir.Write("quad.obj",
+            "mtllib quad.mtl\no quad\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvn 0 0 1\n"
+            "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl cells\nf 1/1/1 2/2/1 3/3/1 4/4/1\n");
+  const scene::Level level = scene::LoadLevel(
+      dir.Write("level.toml", "[[actor]]\nname = \"quad\"\nfile = \"quad.obj\"\n"));
+  auto renderer = MakeRenderer();
+  renderer->SetLevel(level, app::OpenCvTextureDecoder());
+  ASSERT_TRUE(renderer->warnings().empty());
+  CameraView view;
+  Eigen::Matrix3d R_WC;  // looking down: x forward = -z, y left = +y, z up = +x
+  R_WC.col(0) = -Vector3d::UnitZ();
+  R_WC.col(1) = Vector3d::UnitY();
+  R_WC.col(2) = Vector3d::UnitX();
+  view.X_WC.linear() = R_WC;
+  view.X_WC.translation() = Vector3d(0, 0, 3);
+  for (const Quality quality : {Quality::kPlain, Quality::kFast, Quality::kHigh}) {
+    RenderSettings settings = RenderSettings::Preset(quality);
+    settings.haze = false;
+    settings.sun_direction_W = Eigen::Vector3f(0, 0, 1);
+    Frame frame;
+    renderer->Render(view, {}, {}, settings, &frame);
+    for (int r = 0; r < 4; ++r) {
+      for (int c = 0; c < 4; ++c) {
+        // Row 0 of the image is its top, v = 1 (OBJ texture coordinates point up).
+        const double u = (c + 0.5) / 4, v = 1.0 - (r + 0.5) / 4;
+        const Eigen::Vector2d px = Project(view, Vector3d(-1 + 2 * u, -1 + 2 * v, 0));
+        const std::uint8_t* got = Pixel(frame, int(px.x()), int(px.y()));
+        const cv::Vec3b bgr = cells.at<cv::Vec3b>(r, c);
+        for (int k = 0; k < 3; ++k) {
+          EXPECT_NEAR(int(got[k]), int(bgr[2 - k]), 2)
+              << "quality " << int(quality) << ", texel (" << r << ", " << c << "), channel " << k;
+        }
+      }
+    }
+  }
 }
 
 TEST(RendererTextureTest, CesiumManShowsItsEmbeddedTextureColours) {
