@@ -215,7 +215,8 @@ int RunDemo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
         << "  chase.mp4, trailing.mp4, belly.mp4   the cameras as video\n"
         << "  chase_<tick>.jpg, ...                the frames, indexed by chase.csv, ...\n"
         << "  belly_<tick>_depth.png               the payload camera's depth (16-bit mm)\n"
-        << "  scans/scanner_<tick>.ply             the face scan every second (red occupied)\n"
+        << "  scans/scanner_<tick>.ply, .png       the face scan every second (red occupied) and\n"
+        << "                                       its sheet (the six faces as distance images)\n"
         << "  ticks.csv, ticks.png                 every tick's duration, and its plot\n"
         << "  overview.jpg                         the cameras' last frames and the plot\n";
     if (model > 0) out << "  fly_wing.log                         the example model's output\n";

@@ -352,10 +352,10 @@ void SandboxLoop::WriteDueScans(double t) {
     const auto* scan = std::get_if<sensors::FaceScan>(&sensor.output());
     if (scan == nullptr || scan->n == 0) continue;
     std::ostringstream name;
-    name << sensor.mounted().spec.name << "_" << std::setw(6) << std::setfill('0') << tick_
-         << ".ply";
+    name << sensor.mounted().spec.name << "_" << std::setw(6) << std::setfill('0') << tick_;
     scan_files_.Submit(*scan,
-                       (std::filesystem::path(options_.out_dir) / "scans" / name.str()).string());
+                       (std::filesystem::path(options_.out_dir) / "scans" / name.str()).string(),
+                       sensor.get<sensors::FaceScanner>()->config().half_extent_m);
   }
 }
 

@@ -10,6 +10,7 @@
 #include "app/command_line.h"
 #include "app/defaults.h"
 #include "app/loaded_level.h"
+#include "app/scan_sheet.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
 #include "scene/terrain_streamer.h"
@@ -24,7 +25,7 @@ namespace {
 const char* kUsage =
     "usage: sandbox scan [LEVEL] --at X,Y,Z[,ROLL,PITCH,YAW] [--sensor face|ground|lidar|ray]\n"
     "                    [--resolution R] [--half-extent E] [--aligned body|world]\n"
-    "                    [--see-robots] [--isolate] --out FILE.csv|FILE.ply\n"
+    "                    [--see-robots] [--isolate] --out FILE.csv|FILE.ply|FILE.png\n"
     "  LEVEL          a level (default: the bundled sample level)\n"
     "  --isolate      read a manifest's files apart first (scene files always are)\n"
     "  --at           sensor pose: metres, roll/pitch/yaw in degrees\n"
@@ -37,7 +38,9 @@ const char* kUsage =
     "  --out          CSV (face: face,row,col,occupancy,x,y,z; lidar: "
     "channel,step,hit,x,y,z,range;\n"
     "                 ground: row,col,valid,x,y,z; ray: hit,x,y,z,range) or PLY when it ends\n"
-    "                 in .ply (occupied points red, free points green); see docs/sensors.md\n";
+    "                 in .ply (occupied points red, free points green); face scans also as a\n"
+    "                 sheet when it ends in .png (the six faces as distance images, unfolded\n"
+    "                 cube, colour bar); see docs/sensors.md\n";
 
 // One sample for the writers.
 struct Sample {
@@ -105,6 +108,12 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     err << "sandbox scan: --sensor must be face, ground, lidar or ray, got '" << sensor << "'\n";
     return 2;
   }
+  const bool sheet = out_file.size() > 4 && out_file.substr(out_file.size() - 4) == ".png";
+  if (sheet && sensor != "face") {
+    err << "sandbox scan: a .png sheet is drawn for face scans only; use .csv or .ply for "
+        << sensor << "\n";
+    return 2;
+  }
   if (aligned != "body" && aligned != "world") {
     err << "sandbox scan: --aligned must be body or world, got '" << aligned << "'\n";
     return 2;
@@ -143,6 +152,16 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       const sensors::FaceScanner scanner(config);
       sensors::FaceScan scan = scanner.EmptyScan();
       scanner.Scan(world, caster, filter, X_WS, 0, &scan);
+      if (sheet) {
+        try {
+          std::ostringstream title;
+          title << "face scan " << scan.n << "x" << scan.n << "x6 at " << res << " m, half extent "
+                << extent << " m, " << level_file;
+          WriteFaceScanSheet(scan, extent, out_file, title.str());
+        } catch (const std::runtime_error& error) {
+          throw CommandError(error.what());
+        }
+      }
       header = "face,row,col,occupancy,x,y,z";
       for (int f = 0; f < 6; ++f) {
         for (int k = 0; k < scan.n * scan.n; ++k) {
@@ -195,7 +214,7 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     }
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    WriteSamples(out_file, header, samples);
+    if (!sheet) WriteSamples(out_file, header, samples);
     std::size_t occupied = 0;
     for (const Sample& s : samples) occupied += s.occupied ? 1 : 0;
     const Eigen::Vector3d p = X_WS.translation();

@@ -1,8 +1,11 @@
 #include "app/scan_files.h"
 
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <stdexcept>
+
+#include "app/scan_sheet.h"
 
 namespace sandbox::app {
 
@@ -44,14 +47,14 @@ void ScanFileWriter::Finish() {
   thread_.join();
 }
 
-void ScanFileWriter::Submit(sensors::FaceScan scan, std::string path) {
+void ScanFileWriter::Submit(sensors::FaceScan scan, std::string path, double half_extent_m) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (queue_.size() >= 4) {
       queue_.pop_front();
       ++dropped_;
     }
-    queue_.emplace_back(std::move(scan), std::move(path));
+    queue_.push_back({std::move(scan), std::move(path), half_extent_m});
   }
   wake_.notify_one();
 }
@@ -63,7 +66,7 @@ std::string ScanFileWriter::error() const {
 
 void ScanFileWriter::Loop() {
   for (;;) {
-    std::pair<sensors::FaceScan, std::string> item;
+    Item item;
     {
       std::unique_lock<std::mutex> lock(mutex_);
       wake_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
@@ -72,7 +75,9 @@ void ScanFileWriter::Loop() {
       queue_.pop_front();
     }
     try {
-      WriteFaceScanPly(item.first, item.second);
+      WriteFaceScanPly(item.scan, item.path + ".ply");
+      WriteFaceScanSheet(item.scan, item.half_extent_m, item.path + ".png",
+                         std::filesystem::path(item.path).filename().string());
       ++written_;
     } catch (const std::exception& e) {
       if (failed_++ == 0) {

@@ -51,13 +51,15 @@ TEST(ReplayTest, TwoReplaysGiveOneTickPerPoseAndIdenticalFrameIndexesAndScans) {
   int lines = 0;
   for (const char c : Read(dir.path() / "a" / "chase.csv")) lines += c == '\n';
   EXPECT_EQ(lines - 1, 72);
-  int scans = 0;
+  int scans = 0, sheets = 0;
   for (const auto& entry : fs::directory_iterator(dir.path() / "a" / "scans")) {
-    ++scans;
+    scans += entry.path().extension() == ".ply";
+    sheets += entry.path().extension() == ".png";
     EXPECT_EQ(Read(entry.path()), Read(dir.path() / "b" / "scans" / entry.path().filename()))
         << entry.path().filename();
   }
   EXPECT_EQ(scans, 5);  // at 0, 0.5, 1.0, 1.5 and 2.0 s of input time
+  EXPECT_EQ(sheets, 5);  // each with its sheet
 }
 
 TEST(ReplayTest, PosesForRobotsTheLevelDoesNotHaveAreCountedAndReportedNotApplied) {

@@ -49,7 +49,7 @@ std::vector<IndexRow> ReadIndex(const std::filesystem::path& csv) {
   std::getline(in, line);
   EXPECT_EQ(line,
             "tick,time_s,file,x,y,z,qw,qx,qy,qz,cam_x,cam_y,cam_z,cam_qw,cam_qx,cam_qy,cam_qz,"
-            "fx,fy,cx,cy")
+            "fx,fy,cx,cy,depth_file,segmentation_file,normals_file")
       << csv;
   std::vector<IndexRow> rows;
   while (std::getline(in, line)) {
@@ -59,8 +59,12 @@ std::vector<IndexRow> ReadIndex(const std::filesystem::path& csv) {
     std::getline(cells, time, ',');
     std::getline(cells, file, ',');
     std::vector<double> v;
-    while (std::getline(cells, cell, ',')) v.push_back(std::stod(cell));
+    std::vector<std::string> image_files;  // depth, segmentation, normals ("" when none)
+    while (v.size() < 18u && std::getline(cells, cell, ',')) v.push_back(std::stod(cell));
+    while (std::getline(cells, cell, ',')) image_files.push_back(cell);
+    if (!line.empty() && line.back() == ',') image_files.push_back("");
     EXPECT_EQ(v.size(), 18u) << line;
+    EXPECT_EQ(image_files.size(), 3u) << line;
     if (v.size() != 18u) break;
     rows.push_back({std::stol(tick), std::stod(time), file, Pose(v, 0), Pose(v, 7), v[14], v[15],
                     v[16], v[17]});
