@@ -350,12 +350,13 @@ void SandboxLoop::WriteDueScans(double t) {
   scan_file_schedule_.Done(t);
   for (const sensors::Sensor& sensor : sensors_) {
     const auto* scan = std::get_if<sensors::FaceScan>(&sensor.output());
-    if (scan == nullptr || scan->n == 0) continue;
+    const sensors::FaceScanner* scanner = sensor.get<sensors::FaceScanner>();
+    if (scan == nullptr || scan->n == 0 || scanner == nullptr) continue;
     std::ostringstream name;
     name << sensor.mounted().spec.name << "_" << std::setw(6) << std::setfill('0') << tick_;
     scan_files_.Submit(*scan,
                        (std::filesystem::path(options_.out_dir) / "scans" / name.str()).string(),
-                       sensor.get<sensors::FaceScanner>()->config().half_extent_m);
+                       scanner->config().half_extent_m);
   }
 }
 
