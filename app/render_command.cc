@@ -184,7 +184,9 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
     renderer->Render(view, {}, robots, settings, &frame, &overlay);
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    out << camera << " camera " << frame.width << " x " << frame.height;
+    // Said once all is written, so that an error is not run into the line.
+    std::ostringstream said;
+    said << camera << " camera " << frame.width << " x " << frame.height;
     // Colour to FILE, the other kinds beside it (the first of them to FILE without colour).
     const std::filesystem::path file = out_file;
     bool file_used = false;
@@ -199,12 +201,12 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
     };
     if (settings.images & render::kColorImage) {
       WriteColor(frame, out_file);
-      out << ", color -> " << out_file;
+      said << ", color -> " << out_file;
     }
     if (settings.images & render::kDepthImage) {
       const std::filesystem::path depth = path_for("_depth");
       WriteDepthMillimetres(frame, depth.string());
-      out << ", depth -> " << depth.string();
+      said << ", depth -> " << depth.string();
     }
     if (settings.images & render::kSegmentationImage) {
       const std::filesystem::path ids = path_for("_seg");
@@ -212,15 +214,16 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
       std::filesystem::path legend = file;
       legend.replace_filename(file.stem().string() + "_seg.csv");
       std::ofstream(legend) << render::SegmentationLegend(level).Csv();
-      out << ", segmentation -> " << ids.string() << " (legend " << legend.string() << ")";
+      said << ", segmentation -> " << ids.string() << " (legend " << legend.string() << ")";
     }
     if (settings.images & render::kNormalsImage) {
       const std::filesystem::path normals = path_for("_normals");
       WriteNormals(frame, normals.string());
-      out << ", normals -> " << normals.string();
+      said << ", normals -> " << normals.string();
     }
-    out << std::fixed << std::setprecision(1) << " (" << ms << " ms with set-up, "
+    said << std::fixed << std::setprecision(1) << " (" << ms << " ms with set-up, "
         << renderer->description() << ")\n";
+    out << said.str();
     return 0;
   } catch (const UsageError& error) {
     err << "sandbox render: " << error.what() << "\n";
