@@ -45,6 +45,32 @@ const std::uint8_t* Pixel(const Frame& frame, int column, int row) {
 
 class RendererTest : public ::testing::Test {
  protected:
+  // Casts the level's rays through the centres of every `row_step`-th row from
+  // `row0` and `column_step`-th column from `column0`; returns those pixels.
+  std::vector<std::pair<int, int>> CastThroughPixels(const CameraView& view, int row0, int row_step,
+                                                     int column0, int column_step,
+                                                     sensors::RayHits* hits) const {
+    const scene::CollisionWorld world(level_);
+    sensors::RayCaster caster(1);
+    sensors::RayBatch rays;
+    rays.origin_W = view.X_WC.translation();
+    std::vector<std::pair<int, int>> pixels;
+    const double f = 0.5 * view.height / std::tan(0.5 * view.fov_y_rad);
+    for (int row = row0; row < view.height; row += row_step) {
+      for (int column = column0; column < view.width; column += column_step) {
+        // The ray through the pixel centre, in the camera frame (x forward).
+        const Vector3d d_C(1.0, -(column + 0.5 - 0.5 * view.width) / f,
+                           -(row + 0.5 - 0.5 * view.height) / f);
+        rays.start.emplace_back(0.f, 0.f, 0.f);
+        rays.direction.push_back((view.X_WC.linear() * d_C.normalized()).cast<float>());
+        rays.length_m.push_back(2000.f);
+        pixels.emplace_back(column, row);
+      }
+    }
+    caster.Cast(world, rays, {}, hits);
+    return pixels;
+  }
+
   // The sample terrain and tower only (no water, no robot): what the rays see is drawn.
   RendererTest()
       : level_(scene::LoadLevel(dir_.Write(
@@ -88,25 +114,9 @@ TEST_F(RendererTest, DepthAgreesWithTheRayCaster) {
   view.X_WC = LookAt(Vector3d(10, -120, 45), Vector3d(-30, 45, 10));  // the tower, the hills
   Frame frame;
   renderer_->Render(view, {}, {}, {}, &frame);
-  const scene::CollisionWorld world(level_);
-  sensors::RayCaster caster(1);
-  sensors::RayBatch rays;
-  rays.origin_W = view.X_WC.translation();
-  std::vector<std::pair<int, int>> pixels;
-  const double f = 0.5 * view.height / std::tan(0.5 * view.fov_y_rad);
-  for (int row = 4; row < view.height; row += 37) {
-    for (int column = 4; column < view.width; column += 41) {
-      // The ray through the pixel centre, in the camera frame (x forward).
-      const Vector3d d_C(1.0, -(column + 0.5 - 0.5 * view.width) / f,
-                         -(row + 0.5 - 0.5 * view.height) / f);
-      rays.start.emplace_back(0.f, 0.f, 0.f);
-      rays.direction.push_back((view.X_WC.linear() * d_C.normalized()).cast<float>());
-      rays.length_m.push_back(2000.f);
-      pixels.emplace_back(column, row);
-    }
-  }
   sensors::RayHits hits;
-  caster.Cast(world, rays, {}, &hits);
+  const std::vector<std::pair<int, int>> pixels = CastThroughPixels(view, 4, 37, 4, 41, &hits);
+  const double f = 0.5 * view.height / std::tan(0.5 * view.fov_y_rad);
   int compared = 0;
   for (std::size_t i = 0; i < pixels.size(); ++i) {
     const auto [column, row] = pixels[i];
@@ -222,24 +232,8 @@ TEST_F(RendererTest, SegmentIdsMatchTheActorsTheRaysHit) {
   renderer_->Render(view, {}, {}, settings, &frame);
   ASSERT_EQ(frame.segment.size(), std::size_t(view.width * view.height));
   EXPECT_TRUE(frame.rgb.empty());
-  const scene::CollisionWorld world(level_);
-  sensors::RayCaster caster(1);
-  sensors::RayBatch rays;
-  rays.origin_W = view.X_WC.translation();
-  std::vector<std::pair<int, int>> pixels;
-  const double f = 0.5 * view.height / std::tan(0.5 * view.fov_y_rad);
-  for (int row = 1; row < view.height; row += 6) {
-    for (int column = 2; column < view.width; column += 7) {
-      const Vector3d d_C(1.0, -(column + 0.5 - 0.5 * view.width) / f,
-                         -(row + 0.5 - 0.5 * view.height) / f);
-      rays.start.emplace_back(0.f, 0.f, 0.f);
-      rays.direction.push_back((view.X_WC.linear() * d_C.normalized()).cast<float>());
-      rays.length_m.push_back(2000.f);
-      pixels.emplace_back(column, row);
-    }
-  }
   sensors::RayHits hits;
-  caster.Cast(world, rays, {}, &hits);
+  const std::vector<std::pair<int, int>> pixels = CastThroughPixels(view, 1, 6, 2, 7, &hits);
   int same = 0, tower = 0;
   for (std::size_t i = 0; i < pixels.size(); ++i) {
     const auto [column, row] = pixels[i];
