@@ -147,12 +147,13 @@ namespace {
 void WriteNpy(const float* data, const std::vector<int>& shape, const std::string& path) {
   // Format 1.0: magic, version, a little-endian header length, then a Python
   // dict literal padded with spaces and a newline to a multiple of 64 bytes.
-  std::string dims;
+  std::string dims;  // as numpy writes them: "(2, 3)", "(5,)"
   std::size_t count = 1;
   for (const int n : shape) {
-    dims += std::to_string(n) + ", ";
+    dims += (dims.empty() ? "" : ", ") + std::to_string(n);
     count *= std::size_t(n);
   }
+  if (shape.size() == 1) dims += ",";
   std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" + dims + "), }";
   const std::size_t preamble = 10;
   header.append(63 - (preamble + header.size()) % 64, ' ');

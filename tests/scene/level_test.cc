@@ -96,8 +96,9 @@ TEST(LevelTest, GltfIsYUpAndNodeTransformsPlaceActors) {
   const int material = plain.meshes[0].material;
   ASSERT_GE(material, 0);
   EXPECT_EQ(level.materials[static_cast<std::size_t>(material)].name, "red");
+  // Without an alphaMode the material is OPAQUE and glTF ignores its alpha.
   EXPECT_TRUE(level.materials[static_cast<std::size_t>(material)].base_color.isApprox(
-      Eigen::Vector4f(1, 0, 0, 0.5f)));
+      Eigen::Vector4f(1, 0, 0, 1)));
   EXPECT_EQ(plain.meshes[0].normals_A.size(), 3u);
 }
 
