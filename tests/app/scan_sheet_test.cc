@@ -73,7 +73,9 @@ TEST(ScanSheetTest, PixelsGiveBackTheDistancesOfTheWallAndTheFloor) {
   };
   int checked = 0;
   // +X: every ray meets the wall 10 m out; -Z: the floor 7 m down.
-  for (const auto& [face, expected] : {std::pair{0, 10.0}, std::pair{5, 7.0}}) {
+  for (const std::pair<int, double>& face_distance : {std::pair{0, 10.0}, std::pair{5, 7.0}}) {
+    const int face = face_distance.first;  // not a structured binding: lambdas capture it
+    const double expected = face_distance.second;
     each_sample(face, [&](int r, int c, const cv::Vec3b& bgr) {
       EXPECT_NEAR(DistanceOf(bgr, 25.0), expected, 25.0 / 255.0 * 1.01)
           << "face " << face << " row " << r << " column " << c;
