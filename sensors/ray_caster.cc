@@ -431,27 +431,47 @@ void RayCaster::WorkerLoop() {
       std::unique_lock<std::mutex> lock(mutex_);
       wake_.wait(lock, [&] { return stop_ || generation_.load() != seen; });
     }
-    if (stop_) return;
-    seen = generation_.load(std::memory_order_acquire);
-    for (int chunk = next_chunk_.fetch_add(1); chunk < chunks_; chunk = next_chunk_.fetch_add(1)) {
-      (*job_)(chunk);
+    const std::function<void(int)>* job;
+    int chunks;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (stop_) return;
+      seen = generation_.load();
+      job = job_;
+      chunks = chunks_;
+    }
+    for (int chunk; Claim(seen, chunks, &chunk);) {
+      (*job)(chunk);
       unfinished_.fetch_sub(1, std::memory_order_release);
     }
   }
 }
 
+bool RayCaster::Claim(std::uint64_t generation, int chunks, int* chunk) {
+  std::uint64_t claim = claim_.load(std::memory_order_acquire);
+  while ((claim >> 32) == (generation & 0xFFFFFFFFu) && int(claim & 0xFFFFFFFFu) < chunks) {
+    if (claim_.compare_exchange_weak(claim, claim + 1, std::memory_order_acq_rel)) {
+      *chunk = int(claim & 0xFFFFFFFFu);
+      return true;
+    }
+  }
+  return false;
+}
+
 void RayCaster::RunParallel(int chunks, const std::function<void(int)>& job) {
+  std::uint64_t generation;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     job_ = &job;
     chunks_ = chunks;
     unfinished_.store(chunks);
-    next_chunk_.store(0);
-    generation_.fetch_add(1, std::memory_order_release);
+    generation = generation_.load() + 1;
+    claim_.store((generation & 0xFFFFFFFFu) << 32);
+    generation_.store(generation, std::memory_order_release);
   }
   wake_.notify_all();
   // The calling thread works too, then waits for the chunks others took.
-  for (int chunk = next_chunk_.fetch_add(1); chunk < chunks; chunk = next_chunk_.fetch_add(1)) {
+  for (int chunk; Claim(generation, chunks, &chunk);) {
     job(chunk);
     unfinished_.fetch_sub(1, std::memory_order_release);
   }

@@ -87,15 +87,20 @@ class RayCaster {
 
  private:
   void WorkerLoop();
+  // Takes the next chunk of job `generation` into *chunk; false once that
+  // job's chunks are all taken or a newer job has begun.
+  bool Claim(std::uint64_t generation, int chunks, int* chunk);
 
   // Work hand-out: a job generation counter the workers watch (spinning a
-  // little, then sleeping), and an atomic chunk counter they all draw from.
+  // little, then sleeping), and a claim counter they all draw chunks from,
+  // tagged with the generation so that a late worker cannot take a chunk
+  // of the next job for the job it woke for.
   std::vector<std::thread> workers_;
   std::mutex mutex_;
   std::condition_variable wake_;
   const std::function<void(int)>* job_{nullptr};
   int chunks_{0};
-  std::atomic<int> next_chunk_{0};
+  std::atomic<std::uint64_t> claim_{0};  // generation << 32 | next chunk
   std::atomic<int> unfinished_{0};
   std::atomic<std::uint64_t> generation_{0};
   std::atomic<bool> stop_{false};
