@@ -38,7 +38,7 @@ const char* kUsage =
     "            default color (payload: color,depth). Colour goes to FILE, the others to\n"
     "            FILE_depth.png, FILE_seg.png, FILE_normals.png (the first one to FILE\n"
     "            when colour is not asked for)\n"
-    "  --quality fast or high (default; shadows, 4x multisampling) or plain (the flat look)\n"
+    "  --quality fast or high (default; shadows, FXAA) or plain (the flat look)\n"
     "  --width, --height, --fov   image size (default 640 x 480) and vertical field of view\n"
     "            in degrees (default 60)\n"
     "  --overlay the debug overlay: the robot's face scanners (or a default one, 1 m over\n"

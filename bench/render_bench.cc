@@ -94,6 +94,13 @@ int BenchLooks() {
     render::RenderSettings msaa = render::RenderSettings::Preset(Quality::kFast);
     msaa.msaa_samples = 4;
     row("fast + 4x multisampling", msaa);
+    render::RenderSettings fxaa = render::RenderSettings::Preset(Quality::kFast);
+    fxaa.fxaa = true;
+    row("fast + FXAA", fxaa);
+    render::RenderSettings high_msaa = render::RenderSettings::Preset(Quality::kHigh);
+    high_msaa.fxaa = false;
+    high_msaa.msaa_samples = 4;
+    row("high with 4x MSAA for FXAA", high_msaa);
     for (const auto& [name, kinds] :
          {std::pair{"high: color only", render::ImageKinds(render::kColorImage)},
           std::pair{"high: + segmentation",

@@ -28,7 +28,7 @@ CameraKind ParseCameraKind(const scene::SensorSpec& spec) {
                           scene::ChoiceList(types) + ", got '" + spec.type + "'");
 }
 
-// quality, shadows, msaa, haze, anisotropy, images: the camera's look.
+// quality, shadows, fxaa, msaa, haze, anisotropy, images: the camera's look.
 void ReadLook(const scene::SensorSpec& spec, scene::SettingsReader* read, RenderSettings* look) {
   try {
     *look = RenderSettings::Preset(ParseQuality(read->Text("quality", "fast")));
@@ -37,6 +37,7 @@ void ReadLook(const scene::SensorSpec& spec, scene::SettingsReader* read, Render
   }
   look->shadows = read->Flag("shadows", look->shadows);
   look->haze = read->Flag("haze", look->haze);
+  look->fxaa = read->Flag("fxaa", look->fxaa);
   look->msaa_samples = read->Whole("msaa", look->msaa_samples);
   if (look->msaa_samples != 0 && look->msaa_samples != 1 && look->msaa_samples != 4) {
     read->Fail("msaa", "'msaa' must be 0 (off) or 4 samples");

@@ -31,7 +31,8 @@ Quality ParseQuality(const std::string& word) {
 RenderSettings RenderSettings::Preset(Quality quality) {
   RenderSettings settings;
   settings.shadows = quality == Quality::kHigh;
-  settings.msaa_samples = quality == Quality::kHigh ? 4 : 0;
+  settings.msaa_samples = 0;
+  settings.fxaa = quality == Quality::kHigh;
   settings.gamma_correct = quality != Quality::kPlain;
   settings.materials = quality != Quality::kPlain;
   return settings;
@@ -256,7 +257,8 @@ class OsMesaRenderer : public Renderer {
       glUniform1i(glGetUniformLocation(program, "base_texture"), 0);
     }
     overlay_program_ = Link(shaders::kOverlayVertex, shaders::kOverlayFragment);
-    sky_program_ = Link(shaders::kSkyVertex, shaders::kSkyFragment);
+    sky_program_ = Link(shaders::kFullScreenVertex, shaders::kSkyFragment);
+    edge_filter_program_ = Link(shaders::kFullScreenVertex, shaders::kEdgeFilterFragment);
     glGenVertexArrays(1, &overlay_vao_);
     glGenBuffers(2, overlay_buffers_);
     glGetFloatv(GL_MAX_TEXTURE_MAX_ANISOTROPY, &max_anisotropy_);
@@ -408,12 +410,14 @@ class OsMesaRenderer : public Renderer {
       glBindFramebuffer(GL_FRAMEBUFFER, samples > 0 ? msaa_fbo_ : fbo_);
       glViewport(0, 0, view.width, view.height);
       ClearTargets(samples == 0, horizon);
-      glDrawBuffers(1, color_only);
-      DrawSky(view_proj_d.inverse().cast<float>(), horizon, sun);
       const bool data_too = samples == 0 && want_data;
-      if (data_too) glDrawBuffers(3, all);
+      glDrawBuffers(data_too ? 3 : 1, data_too ? all : color_only);
       look_ = look | (data_too ? kData : 0);
-      DrawScene(Pass::kColor, view_proj);
+      DrawScene(Pass::kColor, view_proj, [&] {
+        glDrawBuffers(1, color_only);
+        DrawSky(view_proj_d.inverse().cast<float>(), horizon, sun);
+        glDrawBuffers(data_too ? 3 : 1, data_too ? all : color_only);
+      });
       if (samples > 0) {
         glBindFramebuffer(GL_READ_FRAMEBUFFER, msaa_fbo_);
         glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo_);
@@ -423,6 +427,7 @@ class OsMesaRenderer : public Renderer {
                           GL_COLOR_BUFFER_BIT, GL_NEAREST);
         glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
       }
+      if (settings.fxaa) FilterEdges(view.width, view.height);
     }
     // Depth, segment and normal at pixel centres, when colour did not give
     // them (the overlay is hidden by this depth too).
@@ -690,43 +695,64 @@ class OsMesaRenderer : public Renderer {
 
   // Everything in the world, in one pass. Opaque first, then the translucent
   // (water) on top; whatever lies outside the view is skipped.
-  void DrawScene(Pass pass, const Eigen::Matrix4f& view_proj) {
+  // Opaque surfaces nearest first (robots, movable actors, level chunks by
+  // distance, terrain, the ground beyond), so that llvmpipe's early depth
+  // test skips the shading of what is hidden; then `between` (the sky, into
+  // what no surface covered); then translucent surfaces far to near.
+  void DrawScene(Pass pass, const Eigen::Matrix4f& view_proj,
+                 const std::function<void()>& between = {}) {
     pass_ = pass;
     view_proj_ = view_proj;
     const Eigen::Matrix4f static_model =
         Relative(Eigen::Affine3d(Eigen::Translation3d(origin_)), camera_);
     const Eigen::Matrix4f static_clip = view_proj * static_model;
+    const Eigen::Vector3f eye_S = (camera_ - origin_).cast<float>();  // in the chunks' frame
+    auto actor_model = [&](int actor) {
+      const Eigen::Isometry3d& X_WA = actor_poses_->size() == level_->actors.size()
+                                          ? (*actor_poses_)[std::size_t(actor)]
+                                          : level_->actors[std::size_t(actor)].X_WA;
+      return Relative(Eigen::Affine3d(X_WA.matrix()), camera_);
+    };
+    // The level's chunks in view, nearest first.
+    static_order_.clear();
+    for (std::size_t i = 0; i < static_meshes_.size(); ++i) {
+      const auto& [bounds, mesh] = static_meshes_[i];
+      if (!InFrustum(static_clip, bounds)) continue;
+      static_order_.push_back({bounds.exteriorDistance(eye_S), i});
+    }
+    std::sort(static_order_.begin(), static_order_.end());
+
+    for (const auto& [pose, meshes] : posed_robots_) {
+      for (const GpuMesh* mesh : meshes)
+        Draw(*mesh, Relative(Eigen::Affine3d(pose.matrix()), camera_));
+    }
+    for (const auto& [actor, mesh] : actor_meshes_) {
+      if (!IsTranslucent(mesh)) Draw(mesh, actor_model(actor));
+    }
+    for (const auto& [distance, i] : static_order_) {
+      const GpuMesh& mesh = static_meshes_[i].second;
+      if (!IsTranslucent(mesh)) Draw(mesh, static_model);
+    }
+    DrawTerrain();
     if (horizon_.index_count > 0 && pass != Pass::kShadow) {
       const Eigen::Vector3f& rgb = level_->horizon->rgb;
       DrawMesh(horizon_, static_model, Eigen::Vector4f(rgb.x(), rgb.y(), rgb.z(), 1.f), 0);
     }
-    DrawTerrain();
-    const bool blend = pass == Pass::kColor;
-    for (const bool translucent : {false, true}) {
-      if (translucent && pass == Pass::kShadow) break;
-      if (translucent && blend) {
-        glEnable(GL_BLEND);
-        glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-      }
-      for (const auto& [bounds, mesh] : static_meshes_) {
-        if (IsTranslucent(mesh) != translucent || !InFrustum(static_clip, bounds)) continue;
-        Draw(mesh, static_model);
-      }
-      for (const auto& [actor, mesh] : actor_meshes_) {
-        if (IsTranslucent(mesh) != translucent) continue;
-        const Eigen::Isometry3d& X_WA = actor_poses_->size() == level_->actors.size()
-                                            ? (*actor_poses_)[std::size_t(actor)]
-                                            : level_->actors[std::size_t(actor)].X_WA;
-        Draw(mesh, Relative(Eigen::Affine3d(X_WA.matrix()), camera_));
-      }
-      if (!translucent) {
-        for (const auto& [pose, meshes] : posed_robots_) {
-          for (const GpuMesh* mesh : meshes)
-            Draw(*mesh, Relative(Eigen::Affine3d(pose.matrix()), camera_));
-        }
-      }
-      glDisable(GL_BLEND);
+    if (between) between();
+    if (pass == Pass::kShadow) return;
+
+    if (pass == Pass::kColor) {
+      glEnable(GL_BLEND);
+      glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
     }
+    for (auto it = static_order_.rbegin(); it != static_order_.rend(); ++it) {
+      const GpuMesh& mesh = static_meshes_[it->second].second;
+      if (IsTranslucent(mesh)) Draw(mesh, static_model);
+    }
+    for (const auto& [actor, mesh] : actor_meshes_) {
+      if (IsTranslucent(mesh)) Draw(mesh, actor_model(actor));
+    }
+    glDisable(GL_BLEND);
   }
 
   bool IsTranslucent(const GpuMesh& mesh) const {
@@ -1020,12 +1046,42 @@ class OsMesaRenderer : public Renderer {
     const Eigen::Vector3f zenith = Zenith(horizon);
     glUniform3f(glGetUniformLocation(sky_program_, "zenith"), zenith.x(), zenith.y(), zenith.z());
     glUniform3f(glGetUniformLocation(sky_program_, "sun"), sun.x(), sun.y(), sun.z());
+    // At the far plane (depth 0): only where no surface was drawn.
     glDepthMask(GL_FALSE);
+    glDepthFunc(GL_GEQUAL);
+    glBindVertexArray(overlay_vao_);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glDepthFunc(GL_GREATER);
+    glDepthMask(GL_TRUE);
+  }
+
+  // The edge filter: from a copy of the colour buffer back into it.
+  void FilterEdges(int width, int height) {
+    if (edge_source_ == 0) glGenTextures(1, &edge_source_);
+    glBindTexture(GL_TEXTURE_2D, edge_source_);
+    if (edge_source_size_ != Eigen::Vector2i(width, height)) {
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                   nullptr);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+      edge_source_size_ = {width, height};
+    }
+    glCopyImageSubData(buffers_[0], GL_RENDERBUFFER, 0, 0, 0, 0, edge_source_, GL_TEXTURE_2D, 0, 0,
+                       0, 0, width, height, 1);
+    const GLenum color_only[] = {GL_COLOR_ATTACHMENT0};
+    glDrawBuffers(1, color_only);
+    glUseProgram(edge_filter_program_);
+    program_key_ = -1;
+    glUniform1i(glGetUniformLocation(edge_filter_program_, "image"), 0);
+    glActiveTexture(GL_TEXTURE0);
+    glBindSampler(0, 0);
     glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
     glBindVertexArray(overlay_vao_);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glEnable(GL_DEPTH_TEST);
-    glDepthMask(GL_TRUE);
   }
 
   struct TileGpu {
@@ -1063,14 +1119,20 @@ class OsMesaRenderer : public Renderer {
     const Eigen::Vector4f plain(level_->horizon ? level_->horizon->rgb.x() : 0.45f,
                                 level_->horizon ? level_->horizon->rgb.y() : 0.5f,
                                 level_->horizon ? level_->horizon->rgb.z() : 0.35f, 1.f);
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges;
+    // The tiles in view, nearest first.
+    std::vector<std::pair<float, const scene::TerrainTile*>> order;
     for (const auto& tile : *terrain_) {
-      const TileGpu& gpu = tile_gpu_.at(tile.get());
       if (tile->indices.empty() || tile->bounds_W.isEmpty()) continue;
       if (pass_ == Pass::kShadow && tile->id.lod != 0) continue;  // far tiles cast no shadow here
       const Eigen::AlignedBox3f box((tile->bounds_W.min() - camera_).cast<float>(),
                                     (tile->bounds_W.max() - camera_).cast<float>());
       if (!InFrustum(view_proj_, box)) continue;
+      order.push_back({box.exteriorDistance(Eigen::Vector3f::Zero()), tile.get()});
+    }
+    std::sort(order.begin(), order.end());
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges;
+    for (const auto& [distance, tile] : order) {
+      const TileGpu& gpu = tile_gpu_.at(tile);
       const Eigen::Matrix4f model =
           Relative(Eigen::Affine3d(Eigen::Translation3d(tile->origin_W)), camera_);
       // Index ranges: the surface (coarse: without the blocks fine tiles cover), the skirts.
@@ -1251,6 +1313,7 @@ class OsMesaRenderer : public Renderer {
   int program_key_{-1};
   int look_{0};
   GLuint shadow_programs_[2]{0, 0}, overlay_program_{0}, sky_program_{0};  // [masked]
+  GLuint edge_filter_program_{0}, edge_source_{0};  // the filter reads a copy of the colour
   struct ShadowUniforms {
     GLint model{-1}, view_proj{-1}, alpha_cutoff{-1};
   } shadow_uniforms_[2];
@@ -1274,12 +1337,14 @@ class OsMesaRenderer : public Renderer {
   GLuint anisotropic_{0};  // a sampler
   std::vector<Eigen::Vector3f> overlay_positions_, overlay_colors_;
   int width_{0}, height_{0}, samples_{-1};
+  Eigen::Vector2i edge_source_size_{0, 0};
   const scene::Level* level_{nullptr};
   std::unique_ptr<SegmentationLegend> legend_;
   float water_level_{-1e9f};
   Eigen::Vector3d origin_{Eigen::Vector3d::Zero()};  // of the static chunks
   std::vector<std::pair<Eigen::AlignedBox3f, GpuMesh>> static_meshes_;
-  std::vector<std::pair<int, GpuMesh>> actor_meshes_;  // movable actors'
+  std::vector<std::pair<int, GpuMesh>> actor_meshes_;        // movable actors'
+  std::vector<std::pair<float, std::size_t>> static_order_;  // this pass's chunks in view
   std::map<const scene::RobotModel*, std::vector<GpuMesh>> robot_meshes_;
   std::map<const scene::RobotModel*, std::vector<std::vector<std::uint32_t>>> robot_groups_;
   std::shared_ptr<const scene::TileList> terrain_;

@@ -5,7 +5,7 @@
 // shaded by slope and height with detail textures, water with reflections, the
 // robots skinned as posed, a sun with cascaded shadow maps, sky light, a sky
 // with a horizon gradient, the ground beyond the level out to the horizon,
-// distance haze, 4x multisampling; colour, depth, segmentation and normal
+// distance haze, FXAA or 4x multisampling; colour, depth, segmentation and normal
 // images read back. Depth is reversed (1 near, 0 far, in a float buffer):
 // precise from 0.1 m to hundreds of kilometres.
 // GL stays inside renderer.cc; nothing else sees a GL header (the types it
@@ -42,7 +42,8 @@ using TextureDecoder = std::function<std::string(const scene::EmbeddedTexture* e
 // How much of the look a camera pays for. kPlain is the flat look of before
 // (a reference for benchmarks); kFast adds gamma-correct shading with sky
 // light, the ground's and the water's materials, normal maps and highlights;
-// kHigh adds sun shadows and 4x multisampling.
+// kHigh adds sun shadows and FXAA (4x multisampling is a setting of its own:
+// on llvmpipe it costs 2.5-3.5x a frame, FXAA about 0.1x).
 enum class Quality { kPlain, kFast, kHigh };
 
 // "plain", "fast", "high"; throws std::invalid_argument naming the word.
@@ -58,7 +59,10 @@ struct RenderSettings {
   bool materials{true};      // ground layers, water, normal maps, highlights
   bool haze{true};
   bool shadows{true};
-  int msaa_samples{4};  // 0 or 1: none
+  int msaa_samples{0};  // 0 or 1: none
+  // FXAA: an edge-directed filter over the finished colour image that
+  // smooths jagged edges for about the cost of one full-screen pass.
+  bool fxaa{true};
   // Anisotropic filtering of material textures (1: trilinear mipmaps only).
   // Off by default: llvmpipe takes about 9 s to compile each shader variant that uses it.
   int anisotropy{1};

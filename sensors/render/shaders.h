@@ -86,7 +86,12 @@ uniform mat3 world_to_camera;     // rows: camera x (forward), y (left), z up
 uniform uint segment_base;
 uniform usamplerBuffer segments;  // per triangle, added to segment_base
 
-float Hash(vec2 p) { return fract(sin(dot(p, vec2(127.1, 311.7))) * 43758.5453); }
+// Value noise on a 1-unit lattice; the lattice's hash is integer arithmetic
+// (llvmpipe's sin costs several times as much).
+float Hash(vec2 p) {
+  uvec2 q = uvec2(ivec2(p)) * uvec2(1597334673u, 3812015801u);
+  return float(((q.x ^ q.y) * 1597334673u) >> 8) * (1.0 / 16777216.0);
+}
 float Noise(vec2 p) {
   vec2 i = floor(p), f = fract(p);
   vec2 s = f * f * (3.0 - 2.0 * f);
@@ -173,7 +178,10 @@ void main() {
     float height = camera_z + rel_position.z;
     float up = clamp(n.z, 0.0, 1.0);
     float rock = smoothstep(0.82, 0.7, up);
-    float snow = smoothstep(snow_line - 150.0, snow_line + 150.0, height + 200.0 * (Noise(0.01 * st) - 0.5)) * (1.0 - rock);
+    float snow = 0.0;
+    if (height > snow_line - 250.0) {  // the noise moves the line by 100 m at most
+      snow = smoothstep(snow_line - 150.0, snow_line + 150.0, height + 200.0 * (Noise(0.01 * st) - 0.5)) * (1.0 - rock);
+    }
     float sand = (1.0 - smoothstep(water_level + 0.8, water_level + 2.5, height)) * (1.0 - rock);
 #if TEXTURE == 1
     vec3 ground = albedo.rgb;
@@ -184,10 +192,16 @@ void main() {
     ground = mix(ground, ground_rgb[1], rock);
     ground = mix(ground, ground_rgb[2], snow);
     // Detail texture: world-anchored, two scales against visible tiling; fades with distance.
+    // (Sampled only where it shows, with the derivatives taken outside the branch.)
     int layer = rock > 0.5 ? 1 : snow > 0.5 ? 2 : sand > 0.5 ? 3 : 0;
-    float d = 4.0 * texture(detail, vec3(st / 3.0, float(layer))).r *
-              texture(detail, vec3(st / 23.0, float(layer))).r;
-    albedo.rgb = ground * mix(d, 1.0, smoothstep(60.0, 400.0, distance_m));
+    float fade = smoothstep(60.0, 400.0, distance_m);
+    vec2 st_dx = dFdx(st), st_dy = dFdy(st);
+    float d = 1.0;
+    if (fade < 1.0) {
+      d = 4.0 * textureGrad(detail, vec3(st / 3.0, float(layer)), st_dx / 3.0, st_dy / 3.0).r *
+          textureGrad(detail, vec3(st / 23.0, float(layer)), st_dx / 23.0, st_dy / 23.0).r;
+    }
+    albedo.rgb = ground * mix(d, 1.0, fade);
   }
 #elif SURFACE == 2 && MATERIALS == 1
   {
@@ -274,9 +288,9 @@ out vec4 color;
 void main() { color = vec4(mark_rgb, 1.0); }
 )";
 
-// The sky: a full-screen triangle behind everything, light at the horizon
-// (the haze colour, so distant ground fades into it), deeper overhead, with the sun's disc.
-inline constexpr const char* kSkyVertex = R"(#version 450 core
+// A triangle covering the screen (the sky, the edge filter); ndc: its
+// normalised device coordinates.
+inline constexpr const char* kFullScreenVertex = R"(#version 450 core
 out vec2 ndc;
 void main() {
   ndc = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);
@@ -284,6 +298,8 @@ void main() {
 }
 )";
 
+// The sky, where no surface was drawn: light at the horizon (the haze
+// colour, so distant ground fades into it), deeper overhead, with the sun's disc.
 inline constexpr const char* kSkyFragment = R"(#version 450 core
 in vec2 ndc;
 uniform mat4 clip_to_world;  // directions: clip to camera-centred world
@@ -299,6 +315,44 @@ void main() {
   float s = dot(d, sun);
   c = mix(c, vec3(1.0, 0.98, 0.9), smoothstep(0.99985, 0.99995, s));
   color = vec4(c, 1.0);
+}
+)";
+
+// The edge filter (the approach of Lottes' FXAA, console variant): a pixel
+// whose luma differs little from its four diagonal neighbours' stays as it
+// is; on an edge it is averaged along the edge's direction (across the
+// luma gradient), two or four taps, the wider only if it stays within the
+// neighbourhood's luma range. Reads the finished (display-encoded) image.
+inline constexpr const char* kEdgeFilterFragment = R"(#version 450 core
+uniform sampler2D image;  // bilinear, clamped to its edge
+out vec4 color;
+float Luma(vec3 c) { return dot(c, vec3(0.299, 0.587, 0.114)); }
+void main() {
+  ivec2 size = textureSize(image, 0);
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  ivec2 lo_p = max(p - 1, ivec2(0)), hi_p = min(p + 1, size - 1);
+  vec3 m = texelFetch(image, p, 0).rgb;
+  float l_m = Luma(m);
+  float l_a = Luma(texelFetch(image, lo_p, 0).rgb);
+  float l_b = Luma(texelFetch(image, ivec2(hi_p.x, lo_p.y), 0).rgb);
+  float l_c = Luma(texelFetch(image, ivec2(lo_p.x, hi_p.y), 0).rgb);
+  float l_d = Luma(texelFetch(image, hi_p, 0).rgb);
+  float lo = min(l_m, min(min(l_a, l_b), min(l_c, l_d)));
+  float hi = max(l_m, max(max(l_a, l_b), max(l_c, l_d)));
+  if (hi - lo < max(1.0 / 32.0, hi / 8.0)) {
+    color = vec4(m, 1.0);
+    return;
+  }
+  // Along the edge: the luma gradient (x, y) turned to (y, -x).
+  vec2 dir = vec2((l_c + l_d) - (l_a + l_b), (l_a + l_c) - (l_b + l_d));
+  float reduce = max((l_a + l_b + l_c + l_d) / 32.0, 1.0 / 128.0);
+  vec2 px = 1.0 / vec2(size), uv = gl_FragCoord.xy * px;
+  dir = clamp(dir / (min(abs(dir.x), abs(dir.y)) + reduce), vec2(-8.0), vec2(8.0)) * px;
+  vec3 near_pair = 0.5 * (texture(image, uv - dir / 6.0).rgb + texture(image, uv + dir / 6.0).rgb);
+  vec3 wide = 0.5 * near_pair +
+              0.25 * (texture(image, uv - dir / 2.0).rgb + texture(image, uv + dir / 2.0).rgb);
+  float l_wide = Luma(wide);
+  color = vec4(l_wide < lo || l_wide > hi ? near_pair : wide, 1.0);
 }
 )";
 

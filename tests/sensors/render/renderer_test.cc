@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -326,6 +327,94 @@ TEST(RendererLookTest, ABoxCastsItsShadowWhereTrigonometryPutsIt) {
   }
   const double expected = (Project(view, Vector3d(5, 0, 0)) - a).norm();
   EXPECT_NEAR(edge, expected, 2.0);
+}
+
+// FXAA on the silhouette of a dark square against the sky. The square's top
+// edge, projected, is a line known to a fraction of a pixel; each column's
+// coverage (how far its luma lies between sky and square) puts the edge at
+// a sub-pixel row. Without antialiasing that row is the pixel centres'
+// quantisation (RMS 1 / sqrt(12) = 0.29 px); 4x multisampling and FXAA come
+// closer to the line. Where the image is flat FXAA changes nothing.
+TEST(RendererLookTest, FxaaPutsEdgesNearerTheirLineAndLeavesFlatAreas) {
+  testing::TempDir dir;
+  dir.Write("dark.mtl", "newmtl dark\nKd 0.03 0.03 0.03\n");
+  dir.Write("square.obj",
+            "mtllib dark.mtl\no square\nusemtl dark\nv -5 -5 0\nv 5 -5 0\nv 5 5 0\nv -5 5 0\n"
+            "f 1 2 3 4\n");
+  const scene::Level level = scene::LoadLevel(
+      dir.Write("level.toml", "[[actor]]\nname = \"square\"\nfile = \"square.obj\"\n"));
+  auto renderer = MakeRenderer();
+  renderer->SetLevel(level, app::OpenCvTextureDecoder());
+  CameraView view;
+  // From below and to the side: the square's top edge crosses the sky at about 25 degrees.
+  view.X_WC = LookAt(Vector3d(3, -12, -6), Vector3d(0.5, 0.3, 0)) *
+              Eigen::AngleAxisd(0.3, Vector3d::UnitX());
+  RenderSettings none = RenderSettings::Preset(Quality::kFast);
+  none.haze = false;
+  none.images = kColorImage;
+  RenderSettings fxaa = none, msaa = none;
+  fxaa.fxaa = true;
+  msaa.msaa_samples = 4;
+  Frame none_frame, fxaa_frame, msaa_frame;
+  renderer->Render(view, {}, {}, none, &none_frame);
+  renderer->Render(view, {}, {}, fxaa, &fxaa_frame);
+  renderer->Render(view, {}, {}, msaa, &msaa_frame);
+  auto luma = [](const Frame& frame, int x, int y) {
+    const std::uint8_t* p = Pixel(frame, x, y);
+    return 0.299 * p[0] + 0.587 * p[1] + 0.114 * p[2];
+  };
+  // The top edge: from the leftmost projected corner to the topmost.
+  std::vector<Eigen::Vector2d> corners;
+  for (const auto& [x, y] : {std::pair{-5, -5}, {5, -5}, {5, 5}, {-5, 5}}) {
+    corners.push_back(Project(view, Vector3d(x, y, 0)));
+  }
+  const auto by_x = [](const auto& p, const auto& q) { return p.x() < q.x(); };
+  const auto by_y = [](const auto& p, const auto& q) { return p.y() < q.y(); };
+  const Eigen::Vector2d left = *std::min_element(corners.begin(), corners.end(), by_x);
+  const Eigen::Vector2d top = *std::min_element(corners.begin(), corners.end(), by_y);
+  ASSERT_GT(top.x() - left.x(), 200.0);
+  auto rms_error = [&](const Frame& frame) {
+    double sum = 0.0;
+    int n = 0;
+    for (int x = int(left.x()) + 20; x < int(top.x()) - 20; ++x) {
+      const double true_y =
+          left.y() + (x + 0.5 - left.x()) * (top.y() - left.y()) / (top.x() - left.x());
+      const int r0 = int(true_y);
+      const double sky = luma(frame, x, r0 - 4), dark = luma(frame, x, r0 + 5);
+      double sky_rows = 0.0;
+      for (int r = r0 - 3; r <= r0 + 4; ++r) {
+        sky_rows += std::clamp((luma(frame, x, r) - dark) / (sky - dark), 0.0, 1.0);
+      }
+      const double y = r0 - 3 + sky_rows;
+      sum += (y - true_y) * (y - true_y);
+      ++n;
+    }
+    return std::sqrt(sum / n);
+  };
+  const double error_none = rms_error(none_frame), error_fxaa = rms_error(fxaa_frame),
+               error_msaa = rms_error(msaa_frame);
+  EXPECT_NEAR(error_none, 1.0 / std::sqrt(12.0), 0.08);  // the measure holds without AA
+  EXPECT_LT(error_msaa, 0.7 * error_none);               // and sees what multisampling does
+  EXPECT_LT(error_fxaa, 0.8 * error_none)
+      << "RMS px: none " << error_none << ", FXAA " << error_fxaa << ", MSAA " << error_msaa;
+  int flat_pixels = 0, flat_changed = 0;
+  for (int y = 2; y < view.height - 2; ++y) {
+    for (int x = 2; x < view.width - 2; ++x) {
+      double lo = 255.0, hi = 0.0;
+      for (int dy = -2; dy <= 2; ++dy) {
+        for (int dx = -2; dx <= 2; ++dx) {
+          lo = std::min(lo, luma(none_frame, x + dx, y + dy));
+          hi = std::max(hi, luma(none_frame, x + dx, y + dy));
+        }
+      }
+      if (hi - lo <= 2.0) {
+        ++flat_pixels;
+        flat_changed += std::memcmp(Pixel(none_frame, x, y), Pixel(fxaa_frame, x, y), 3) != 0;
+      }
+    }
+  }
+  ASSERT_GT(flat_pixels, 100000);
+  EXPECT_EQ(flat_changed, 0);
 }
 
 TEST(RendererTextureTest, TextureColoursShow) {
