@@ -44,6 +44,18 @@ const std::uint8_t* Pixel(const Frame& frame, int column, int row) {
   return &frame.rgb[3 * (std::size_t(row) * std::size_t(frame.width) + std::size_t(column))];
 }
 
+// A level of one actor, `name`, from `file` in `dir`, and a renderer with it.
+struct OneActorScene {
+  OneActorScene(const testing::TempDir& dir, const std::string& name, const std::string& file)
+      : level(scene::LoadLevel(dir.Write("level.toml", "[[actor]]\nname = \"" + name +
+                                                           "\"\nfile = \"" + file + "\"\n"))),
+        renderer(MakeRenderer()) {
+    renderer->SetLevel(level, app::OpenCvTextureDecoder());
+  }
+  scene::Level level;
+  std::unique_ptr<Renderer> renderer;
+};
+
 class RendererTest : public ::testing::Test {
  protected:
   // Casts the level's rays through the centres of every `row_step`-th row from
@@ -261,10 +273,8 @@ TEST(RendererLookTest, NormalsOfATiltedPlaneInTheCameraFrame) {
   }
   obj << "f 1 2 3 4\n";
   dir.Write("plane.obj", obj.str());
-  const scene::Level level = scene::LoadLevel(
-      dir.Write("level.toml", "[[actor]]\nname = \"plane\"\nfile = \"plane.obj\"\n"));
-  auto renderer = MakeRenderer();
-  renderer->SetLevel(level, app::OpenCvTextureDecoder());
+  const OneActorScene scene(dir, "plane", "plane.obj");
+  Renderer* renderer = scene.renderer.get();
   CameraView view;
   view.X_WC = LookAt(Vector3d(6, -4, 9), Vector3d::Zero());
   RenderSettings settings;
@@ -341,10 +351,8 @@ TEST(RendererLookTest, FxaaPutsEdgesNearerTheirLineAndLeavesFlatAreas) {
   dir.Write("square.obj",
             "mtllib dark.mtl\no square\nusemtl dark\nv -5 -5 0\nv 5 -5 0\nv 5 5 0\nv -5 5 0\n"
             "f 1 2 3 4\n");
-  const scene::Level level = scene::LoadLevel(
-      dir.Write("level.toml", "[[actor]]\nname = \"square\"\nfile = \"square.obj\"\n"));
-  auto renderer = MakeRenderer();
-  renderer->SetLevel(level, app::OpenCvTextureDecoder());
+  const OneActorScene scene(dir, "square", "square.obj");
+  Renderer* renderer = scene.renderer.get();
   CameraView view;
   // From below and to the side: the square's top edge crosses the sky at about 25 degrees.
   view.X_WC = LookAt(Vector3d(3, -12, -6), Vector3d(0.5, 0.3, 0)) *
@@ -427,10 +435,8 @@ TEST(RendererTextureTest, TextureColoursShow) {
   dir.Write("square.obj",
             "mtllib square.mtl\no square\nv 0 -1 -1\nv 0 1 -1\nv 0 1 1\nv 0 -1 1\n"
             "vt 1 0\nvt 0 0\nvt 0 1\nvt 1 1\nusemtl check\nf 1/1 2/2 3/3 4/4\n");
-  const scene::Level level = scene::LoadLevel(
-      dir.Write("level.toml", "[[actor]]\nname = \"square\"\nfile = \"square.obj\"\n"));
-  auto renderer = MakeRenderer();
-  renderer->SetLevel(level, app::OpenCvTextureDecoder());
+  const OneActorScene scene(dir, "square", "square.obj");
+  Renderer* renderer = scene.renderer.get();
   EXPECT_TRUE(renderer->warnings().empty());
   CameraView view;
   view.X_WC = LookAt(Vector3d(-5, 0, 0), Vector3d::Zero());  // facing the square's -x side
@@ -480,10 +486,8 @@ TEST(RendererTextureTest, ATexturedQuadRendersItsTexels) {
   dir.Write("quad.obj",
             "mtllib quad.mtl\no quad\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvn 0 0 1\n"
             "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl cells\nf 1/1/1 2/2/1 3/3/1 4/4/1\n");
-  const scene::Level level = scene::LoadLevel(
-      dir.Write("level.toml", "[[actor]]\nname = \"quad\"\nfile = \"quad.obj\"\n"));
-  auto renderer = MakeRenderer();
-  renderer->SetLevel(level, app::OpenCvTextureDecoder());
+  const OneActorScene scene(dir, "quad", "quad.obj");
+  Renderer* renderer = scene.renderer.get();
   ASSERT_TRUE(renderer->warnings().empty());
   CameraView view;
   Eigen::Matrix3d R_WC;  // looking down: x forward = -z, y left = +y, z up = +x
