@@ -47,8 +47,8 @@ const std::uint8_t* Pixel(const Frame& frame, int column, int row) {
 // A level of one actor, `name`, from `file` in `dir`, and a renderer with it.
 struct OneActorScene {
   OneActorScene(const testing::TempDir& dir, const std::string& name, const std::string& file)
-      : level(scene::LoadLevel(dir.Write("level.toml", "[[actor]]\nname = \"" + name +
-                                                           "\"\nfile = \"" + file + "\"\n"))),
+      : level(scene::LoadLevel(dir.Write(
+            "level.toml", "[[actor]]\nname = \"" + name + "\"\nfile = \"" + file + "\"\n"))),
         renderer(MakeRenderer()) {
     renderer->SetLevel(level, app::OpenCvTextureDecoder());
   }
