@@ -6,6 +6,7 @@
 #include <GL/osmesa.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -237,9 +238,7 @@ class OsMesaRenderer : public Renderer {
     if (context_ == nullptr)
       throw std::runtime_error("Renderer: cannot create an OSMesa GL 4.5 context");
     backing_.resize(4);
-    if (!OSMesaMakeCurrent(context_, backing_.data(), GL_UNSIGNED_BYTE, 1, 1)) {
-      throw std::runtime_error("Renderer: cannot make the OSMesa context current");
-    }
+    MakeCurrent();
     description_ = std::string("OpenGL ") + reinterpret_cast<const char*>(glGetString(GL_VERSION)) +
                    ", " + reinterpret_cast<const char*>(glGetString(GL_RENDERER));
     // GL 4.5 calls libOSMesa does not export are found through it.
@@ -280,7 +279,9 @@ class OsMesaRenderer : public Renderer {
   ~OsMesaRenderer() override { OSMesaDestroyContext(context_); }
 
   void SetLevel(const scene::Level& level, const TextureDecoder& decoder) override {
+    MakeCurrent();
     level_ = &level;
+    static_shadow_keys_.clear();
     legend_ = std::make_unique<SegmentationLegend>(level);
     water_level_ = -1e9f;
     for (const scene::Actor& actor : level.actors) {
@@ -345,6 +346,7 @@ class OsMesaRenderer : public Renderer {
   void Render(const CameraView& view, const std::vector<Eigen::Isometry3d>& actor_poses,
               const std::vector<const scene::RobotState*>& robots, const RenderSettings& settings,
               Frame* frame, const Overlay* overlay) override {
+    MakeCurrent();
     view.ValidateOrThrow();
     if (overlay != nullptr && (overlay->point_rgb.size() != overlay->points_W.size() ||
                                overlay->line_rgb.size() * 2 != overlay->lines_W.size())) {
@@ -385,7 +387,7 @@ class OsMesaRenderer : public Renderer {
       cascades = FitShadowCascades(view, sun.cast<double>(), settings.shadow_distance_m,
                                    std::clamp(settings.shadow_cascades, 1, 4),
                                    std::clamp(settings.shadow_map_px, 256, 8192), 1500.0);
-      DrawShadowMaps(cascades, settings.shadow_map_px);
+      DrawShadowMaps(cascades, sun, std::clamp(settings.shadow_map_px, 256, 8192));
     }
 
     // The look; each program gets this frame's uniforms at its first use in it.
@@ -520,6 +522,15 @@ class OsMesaRenderer : public Renderer {
   std::string description() const override { return description_; }
 
  private:
+  // This renderer's context, current on the calling thread (another
+  // renderer made on the thread since, or destroyed, leaves it not current).
+  void MakeCurrent() {
+    if (OSMesaGetCurrentContext() == context_) return;
+    if (!OSMesaMakeCurrent(context_, backing_.data(), GL_UNSIGNED_BYTE, 1, 1)) {
+      throw std::runtime_error("Renderer: cannot make the OSMesa context current");
+    }
+  }
+
   // The scene program for a surface (0 plain, 1 terrain, 2 water), a mesh's
   // features (kTexture ...) and the pass's look (look_): made at its first
   // use, in use, with this frame's uniforms. Fixed sampler units: 0 base
@@ -722,18 +733,25 @@ class OsMesaRenderer : public Renderer {
     }
     std::sort(static_order_.begin(), static_order_.end());
 
-    for (const auto& [pose, meshes] : posed_robots_) {
-      for (const GpuMesh* mesh : meshes)
-        Draw(*mesh, Relative(Eigen::Affine3d(pose.matrix()), camera_));
+    // (Shadow maps draw what moves and what stays apart.)
+    const bool moving = pass != Pass::kShadow || shadow_casters_ != Casters::kStill;
+    const bool still = pass != Pass::kShadow || shadow_casters_ != Casters::kMoving;
+    if (moving) {
+      for (const auto& [pose, meshes] : posed_robots_) {
+        for (const GpuMesh* mesh : meshes)
+          Draw(*mesh, Relative(Eigen::Affine3d(pose.matrix()), camera_));
+      }
+      for (const auto& [actor, mesh] : actor_meshes_) {
+        if (!IsTranslucent(mesh)) Draw(mesh, actor_model(actor));
+      }
     }
-    for (const auto& [actor, mesh] : actor_meshes_) {
-      if (!IsTranslucent(mesh)) Draw(mesh, actor_model(actor));
+    if (still) {
+      for (const auto& [distance, i] : static_order_) {
+        const GpuMesh& mesh = static_meshes_[i].second;
+        if (!IsTranslucent(mesh)) Draw(mesh, static_model);
+      }
+      DrawTerrain();
     }
-    for (const auto& [distance, i] : static_order_) {
-      const GpuMesh& mesh = static_meshes_[i].second;
-      if (!IsTranslucent(mesh)) Draw(mesh, static_model);
-    }
-    DrawTerrain();
     if (horizon_.index_count > 0 && pass != Pass::kShadow) {
       const Eigen::Vector3f& rgb = level_->horizon->rgb;
       DrawMesh(horizon_, static_model, Eigen::Vector4f(rgb.x(), rgb.y(), rgb.z(), 1.f), 0);
@@ -879,24 +897,33 @@ class OsMesaRenderer : public Renderer {
   }
 
   // The sun's depth from each cascade's box.
-  void DrawShadowMaps(const std::vector<ShadowCascade>& cascades, int px) {
+  // The shadow maps: per cascade, what does not move (level chunks, terrain)
+  // drawn into a map of its own only when the cascade's box, the sun or the
+  // terrain's tiles change; each frame that map copied and what moves (robots,
+  // movable actors) drawn over it.
+  void DrawShadowMaps(const std::vector<ShadowCascade>& cascades, const Eigen::Vector3f& sun,
+                      int px) {
     const int layers = int(cascades.size());
     if (shadow_map_ == 0 || shadow_px_ != px || shadow_layers_ < layers) {
-      if (shadow_map_ != 0) glDeleteTextures(1, &shadow_map_);
+      for (GLuint* map : {&shadow_map_, &shadow_static_}) {
+        if (*map != 0) glDeleteTextures(1, map);
+        glGenTextures(1, map);
+        glBindTexture(GL_TEXTURE_2D_ARRAY, *map);
+        glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_DEPTH_COMPONENT32F, px, px, layers, 0,
+                     GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
+        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+      }
       if (shadow_fbo_ == 0) glGenFramebuffers(1, &shadow_fbo_);
-      glGenTextures(1, &shadow_map_);
-      glBindTexture(GL_TEXTURE_2D_ARRAY, shadow_map_);
-      glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_DEPTH_COMPONENT32F, px, px, layers, 0,
-                   GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
-      glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-      glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-      glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-      glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-      glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
-      glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
       shadow_px_ = px;
       shadow_layers_ = layers;
+      static_shadow_keys_.clear();
     }
+    static_shadow_keys_.resize(std::size_t(layers));
     glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo_);
     glDrawBuffer(GL_NONE);
     glReadBuffer(GL_NONE);
@@ -907,13 +934,26 @@ class OsMesaRenderer : public Renderer {
     glDisable(GL_BLEND);
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(1.5f, 2.f);
+    glClearDepth(1.0);
     for (int c = 0; c < layers; ++c) {
+      const ShadowCascade& cascade = cascades[std::size_t(c)];
+      const StaticShadowKey key{cascade.cell, cascade.half_size_m, sun, terrain_.get()};
+      if (!(static_shadow_keys_[std::size_t(c)] == key)) {
+        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, shadow_static_, 0, c);
+        glClear(GL_DEPTH_BUFFER_BIT);
+        program_key_ = -1;  // the shadow programs take this cascade's clip at first use
+        shadow_casters_ = Casters::kStill;
+        DrawScene(Pass::kShadow, cascade.light_clip.cast<float>());
+        static_shadow_keys_[std::size_t(c)] = key;
+      }
+      glCopyImageSubData(shadow_static_, GL_TEXTURE_2D_ARRAY, 0, 0, 0, c, shadow_map_,
+                         GL_TEXTURE_2D_ARRAY, 0, 0, 0, c, px, px, 1);
       glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, shadow_map_, 0, c);
-      glClearDepth(1.0);
-      glClear(GL_DEPTH_BUFFER_BIT);
-      program_key_ = -1;  // the shadow programs take this cascade's clip at first use
-      DrawScene(Pass::kShadow, cascades[std::size_t(c)].light_clip.cast<float>());
+      program_key_ = -1;
+      shadow_casters_ = Casters::kMoving;
+      DrawScene(Pass::kShadow, cascade.light_clip.cast<float>());
     }
+    shadow_casters_ = Casters::kAll;
     glDisable(GL_POLYGON_OFFSET_FILL);
   }
 
@@ -1330,7 +1370,20 @@ class OsMesaRenderer : public Renderer {
   bool gamma_{true};                    // this frame's shading is in linear light
   std::map<GLuint, bool> srgb_decode_;  // by colour texture: decoding to linear now
   GLuint fbo_{0}, buffers_[4]{0, 0, 0, 0}, msaa_fbo_{0}, msaa_buffers_[2]{0, 0};
-  GLuint shadow_fbo_{0}, shadow_map_{0}, detail_{0};
+  GLuint shadow_fbo_{0}, shadow_map_{0}, shadow_static_{0}, detail_{0};
+  // What a shadow pass draws: all, what never moves, or what may.
+  enum class Casters { kAll, kStill, kMoving } shadow_casters_{Casters::kAll};
+  // What each cascade's map of still casters was drawn for.
+  struct StaticShadowKey {
+    std::array<std::int64_t, 3> cell{0, 0, 0};
+    double half_size_m{-1.0};
+    Eigen::Vector3f sun{Eigen::Vector3f::Zero()};
+    const scene::TileList* terrain{nullptr};
+    bool operator==(const StaticShadowKey& o) const {
+      return cell == o.cell && half_size_m == o.half_size_m && sun == o.sun && terrain == o.terrain;
+    }
+  };
+  std::vector<StaticShadowKey> static_shadow_keys_;
   int shadow_px_{0}, shadow_layers_{0};
   GLuint overlay_vao_{0}, overlay_buffers_[2]{0, 0};
   GLfloat max_anisotropy_{1.f};

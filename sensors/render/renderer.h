@@ -12,7 +12,8 @@
 // takes and gives are in view.h).
 //
 // Threads: a Renderer and everything it renders belong to one thread (the
-// render thread); make it there.
+// render thread); make it there. Several renderers on one thread may take
+// turns (each makes its own context current).
 
 #include <Eigen/Geometry>
 #include <cstdint>

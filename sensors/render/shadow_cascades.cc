@@ -36,14 +36,20 @@ std::vector<ShadowCascade> FitShadowCascades(const CameraView& view, const Eigen
       corners[k] = R_WC * Eigen::Vector3d(d, (k & 1 ? 1 : -1) * tx * d, (k & 2 ? 1 : -1) * ty * d);
       centre += corners[k] / 8.0;
     }
-    double r = 0.0;
-    for (const Eigen::Vector3d& c : corners) r = std::max(r, (c - centre).norm());
-    r = std::ceil(r * 16.0) / 16.0;  // a size that changes in steps: steady texels
+    double radius = 0.0;
+    for (const Eigen::Vector3d& c : corners) radius = std::max(radius, (c - centre).norm());
+    radius = std::ceil(radius * 16.0) / 16.0;  // a size that changes in steps: steady texels
+    // The box's half size r: the slice's sphere plus half a step of the
+    // centre (a step is r / 4, px / 8 whole texels).
+    const double r = radius * 16.0 / 15.0, step = r / 8.0;
     const double texel = 2.0 * r / map_px;
-    // Snap the box centre to whole texels in absolute light coordinates.
+    // Snap the box centre to whole steps in absolute light coordinates.
     Eigen::Vector3d centre_L = R_LW * centre + camera_L;
-    centre_L.x() = std::round(centre_L.x() / texel) * texel;
-    centre_L.y() = std::round(centre_L.y() / texel) * texel;
+    std::array<std::int64_t, 3> cell;
+    for (int k = 0; k < 3; ++k) {
+      cell[std::size_t(k)] = std::llround(centre_L[k] / step);
+      centre_L[k] = double(cell[std::size_t(k)]) * step;
+    }
     centre_L -= camera_L;
     const double top = centre_L.z() + r + caster_reach_m, bottom = centre_L.z() - r;
     Eigen::Matrix4d M = Eigen::Matrix4d::Zero();
@@ -54,7 +60,7 @@ std::vector<ShadowCascade> FitShadowCascades(const CameraView& view, const Eigen
     M.block<1, 3>(2, 0) = -R_LW.row(2) / (top - bottom);
     M(2, 3) = top / (top - bottom);
     M(3, 3) = 1.0;
-    cascades.push_back({M, d1, texel});
+    cascades.push_back({M, d1, texel, cell, r});
     d0 = d1;
   }
   return cascades;

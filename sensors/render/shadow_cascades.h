@@ -1,10 +1,14 @@
 #pragma once
 // The sun's shadow maps fitted to a camera's view: the view's frustum up to a
 // distance cut into slices (near ones short, far ones long), each covered by an
-// orthographic box along the sun, snapped to whole shadow-map texels in world
-// coordinates so that shadows do not shimmer as the camera moves.
+// orthographic box along the sun. The box's size depends on the slice's size
+// only, and its centre moves in steps of an eighth of the map (whole texels),
+// so shadows do not shimmer as the camera moves, and a map of what does not
+// move stays valid until the box steps (`cell` tells when).
 
 #include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
 #include <vector>
 
 #include "sensors/render/view.h"
@@ -17,6 +21,10 @@ struct ShadowCascade {
   Eigen::Matrix4d light_clip;
   double far_m{0.0};    // the slice ends this far along the optical axis
   double texel_m{0.0};  // one shadow-map texel on the ground
+  // The box in absolute light coordinates: its centre in steps, and its half
+  // size; equal cells of equal sun and size: the same box.
+  std::array<std::int64_t, 3> cell{0, 0, 0};
+  double half_size_m{0.0};
 };
 
 // `sun_W`: towards the sun (any length). `caster_reach_m`: how far towards the

@@ -425,6 +425,72 @@ TEST(RendererLookTest, FxaaPutsEdgesNearerTheirLineAndLeavesFlatAreas) {
   EXPECT_EQ(flat_changed, 0);
 }
 
+// The shadow maps keep what never moves between frames and redraw what
+// moves: a renderer that drew other views and other placements before gives
+// the image a new renderer gives, as the camera moves a little (the kept map
+// stays) and far (it is redrawn) and a movable box moves under the sun.
+// (The new renderer's context is made after the kept one's: the kept one
+// makes its own current again.)
+TEST(RendererLookTest, KeptShadowMapsGiveWhatFreshOnesGive) {
+  testing::TempDir dir;
+  dir.Write("ground.obj",
+            "o ground\nv -60 -60 0\nv 60 -60 0\nv 60 60 0\nv -60 60 0\nvn 0 0 1\n"
+            "f 1//1 2//1 3//1 4//1\n");
+  auto block = [](double half, double height) {
+    std::ostringstream obj;
+    obj << "o block\n";
+    for (int k = 0; k < 8; ++k) {
+      obj << "v " << (k & 1 ? half : -half) << " " << (k & 2 ? half : -half) << " "
+          << (k & 4 ? height : 0.0) << "\n";
+    }
+    obj << "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
+    return obj.str();
+  };
+  dir.Write("pole.obj", block(0.5, 8.0));
+  dir.Write("box.obj", block(1.0, 3.0));
+  const scene::Level level = scene::LoadLevel(
+      dir.Write("level.toml",
+                "[[actor]]\nname = \"ground\"\nfile = \"ground.obj\"\n"
+                "[[actor]]\nname = \"pole\"\nfile = \"pole.obj\"\nposition = [-6, 4, 0]\n"
+                "[[actor]]\nname = \"box\"\nfile = \"box.obj\"\nmovable = true\n"));
+  const int box = level.FindActor("box");
+  ASSERT_GE(box, 0);
+  RenderSettings settings = RenderSettings::Preset(Quality::kHigh);
+  settings.haze = false;
+  settings.images = kColorImage;
+  settings.sun_direction_W = Eigen::Vector3f(1.f, -0.3f, 1.2f);  // shadows fall towards -x
+  auto kept = MakeRenderer();
+  kept->SetLevel(level, app::OpenCvTextureDecoder());
+  struct Step {
+    Vector3d eye, box_at;
+  };
+  int frames_with_shadows = 0;
+  for (const Step& step : {Step{{4, -20, 12}, {0, 0, 0}}, Step{{4.3, -20.2, 12}, {3, -2, 0}},
+                           Step{{-25, -5, 15}, {-2, 3, 0}}, Step{{-25.2, -5, 15.1}, {0, 0, 0}}}) {
+    CameraView view;
+    view.X_WC = LookAt(step.eye, Vector3d(0, 0, 0));
+    std::vector<Isometry3d> poses;
+    for (const scene::Actor& actor : level.actors) poses.push_back(actor.X_WA);
+    poses[std::size_t(box)] = Isometry3d(Eigen::Translation3d(step.box_at));
+    Frame from_kept, from_fresh;
+    kept->Render(view, poses, {}, settings, &from_kept);
+    auto fresh = MakeRenderer();
+    fresh->SetLevel(level, app::OpenCvTextureDecoder());
+    fresh->Render(view, poses, {}, settings, &from_fresh);
+    int differing = 0;
+    for (std::size_t i = 0; i < from_kept.rgb.size(); ++i) {
+      differing += std::abs(int(from_kept.rgb[i]) - int(from_fresh.rgb[i])) > 2;
+    }
+    EXPECT_LE(differing, 20) << "camera at " << step.eye.transpose();
+    // The box's shadow is there: the ground beside it, away from the sun, darker than the open.
+    const Eigen::Vector2d p = Project(view, step.box_at + Vector3d(-1.6, 0.3, 0.0)),
+                          q = Project(view, Vector3d(10, -10, 0));
+    frames_with_shadows += Pixel(from_kept, int(p.x()), int(p.y()))[1] + 30 <
+                           Pixel(from_kept, int(q.x()), int(q.y()))[1];
+  }
+  EXPECT_EQ(frames_with_shadows, 4);
+}
+
 TEST(RendererTextureTest, TextureColoursShow) {
   // A square with a two-colour texture: red on the left half, blue on the right.
   testing::TempDir dir;
