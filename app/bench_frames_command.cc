@@ -27,12 +27,15 @@ namespace sandbox::app {
 namespace {
 
 const char* kUsage =
-    "usage: sandbox bench-frames [--frames N] [--runs R] [--out DIR]\n"
+    "usage: sandbox bench-frames [--frames N] [--runs R] [--quality Q] [--kind LIST] [--out DIR]\n"
     "  {empty level, sample level} x {robot only, + face scanner, + scanner and debug overlay}:\n"
     "  each frame flies the example flight one 10 ms step (pose and bones), scans when asked,\n"
     "  publishes the outputs (memq://) and renders the chase camera 640 x 480 to the end.\n"
     "  --frames  frames per run (default 500)\n"
     "  --runs    runs per case (default 3)\n"
+    "  --quality the camera's look: plain, fast (default: the loop cameras' default) or high\n"
+    "  --kind    the images rendered, a comma list of color (default), depth, segmentation,\n"
+    "            normals\n"
     "  --out     folder for frames.csv and one plot per case (default: bench-frames)\n";
 
 struct Case {
@@ -61,7 +64,8 @@ void Fly(double t, std::int64_t seq, scene::RobotState* robot) {
 
 int RunBenchFrames(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   const auto parsed =
-      ParseArgs(args, "bench-frames", {"--frames", "--runs", "--out"}, {}, kUsage, err);
+      ParseArgs(args, "bench-frames", {"--frames", "--runs", "--quality", "--kind", "--out"}, {},
+                kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
     out << kUsage;
@@ -75,6 +79,14 @@ int RunBenchFrames(const std::vector<std::string>& args, std::ostream& out, std:
     };
     const int frames = whole("--frames", 500), runs = whole("--runs", 3);
     const std::filesystem::path dir = parsed->Value("--out", "bench-frames");
+    render::RenderSettings look;
+    try {
+      look =
+          render::RenderSettings::Preset(render::ParseQuality(parsed->Value("--quality", "fast")));
+      look.images = render::ParseImageKinds(parsed->Value("--kind", "color"));
+    } catch (const std::invalid_argument& error) {
+      throw UsageError(error.what());
+    }
     CreateOutputFolder(dir.string());
     std::ofstream csv(dir / "frames.csv");
     csv << "case,run,frame,duration_ms\n" << std::fixed << std::setprecision(4);
@@ -105,7 +117,8 @@ int RunBenchFrames(const std::vector<std::string>& args, std::ostream& out, std:
 
     out << "sandbox bench-frames: " << runs << " runs of " << frames << " frames a case, chase "
         << chase_camera.view.width << " x " << chase_camera.view.height << ", "
-        << renderer->description() << "\n\n"
+        << parsed->Value("--quality", "fast") << " look, " << render::ImageKindsText(look.images)
+        << ", " << renderer->description() << "\n\n"
         << std::left << std::setw(18) << "case" << std::right << std::setw(10) << "mean ms"
         << std::setw(10) << "p50 ms" << std::setw(10) << "p99 ms" << std::setw(10) << "max ms"
         << std::setw(10) << "fps" << std::setw(10) << "vs robot"
@@ -149,7 +162,7 @@ int RunBenchFrames(const std::vector<std::string>& args, std::ostream& out, std:
               render::AddBoneFrames(robot, 1.0, &overlay);
               render::AddActorBounds(level, {}, false, &overlay);
             }
-            renderer->Render(view, {}, {&robot}, {}, &frame, &overlay);
+            renderer->Render(view, {}, {&robot}, look, &frame, &overlay);
             link.Drain();
             if (i < 0) continue;
             durations.push_back(

@@ -108,11 +108,7 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
       settings.images =
           camera == "payload" ? render::kColorImage | render::kDepthImage : render::kColorImage;
       if (!parsed->Value("--kind").empty()) {
-        settings.images = 0;
-        std::stringstream list(parsed->Value("--kind"));
-        for (std::string word; std::getline(list, word, ',');) {
-          settings.images |= render::ParseImageKind(word);
-        }
+        settings.images = render::ParseImageKinds(parsed->Value("--kind"));
       }
     } catch (const std::invalid_argument& error) {
       throw UsageError(error.what());
@@ -222,7 +218,7 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
       said << ", normals -> " << normals.string();
     }
     said << std::fixed << std::setprecision(1) << " (" << ms << " ms with set-up, "
-        << renderer->description() << ")\n";
+         << renderer->description() << ")\n";
     out << said.str();
     return 0;
   } catch (const UsageError& error) {

@@ -1,6 +1,7 @@
 #include "sensors/render/view.h"
 
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -45,6 +46,14 @@ ImageKind ParseImageKind(const std::string& word) {
   }
   throw std::invalid_argument("unknown image kind '" + word +
                               "' (color, depth, segmentation or normals)");
+}
+
+ImageKinds ParseImageKinds(const std::string& comma_list) {
+  ImageKinds kinds = 0;
+  std::stringstream list(comma_list);
+  for (std::string word; std::getline(list, word, ',');) kinds |= ParseImageKind(word);
+  if (kinds == 0) throw std::invalid_argument("no image kind in '" + comma_list + "'");
+  return kinds;
 }
 
 std::string ImageKindsText(ImageKinds kinds) {

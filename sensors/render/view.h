@@ -34,6 +34,8 @@ using ImageKinds = unsigned;
 // "color", "depth", "segmentation", "normals" (also "all"), by name; throws
 // std::invalid_argument naming the word and the choices.
 ImageKind ParseImageKind(const std::string& word);
+// A comma list of them ("color,depth"); throws as above, or on an empty list.
+ImageKinds ParseImageKinds(const std::string& comma_list);
 std::string ImageKindsText(ImageKinds kinds);  // "color,depth"
 
 struct Frame {
