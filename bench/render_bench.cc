@@ -107,8 +107,7 @@ int BenchLooks() {
     high_msaa.fxaa = false;
     high_msaa.msaa_samples = 4;
     row("high with 4x MSAA for FXAA", high_msaa);
-    row("high, flying 10 m a frame (300 m/s at 30 fps)",
-        render::RenderSettings::Preset(Quality::kHigh), 10.0);
+    row("high, flying 10 m a frame", render::RenderSettings::Preset(Quality::kHigh), 10.0);
     for (const auto& [name, kinds] :
          {std::pair{"high: color only", render::ImageKinds(render::kColorImage)},
           std::pair{"high: + segmentation",
