@@ -39,11 +39,16 @@ using Clock = std::chrono::steady_clock;
 enum class EmbreeMode { kOne, kPacket4, kPacket8, kPacket16, kStream };
 const char* Name(EmbreeMode mode) {
   switch (mode) {
-    case EmbreeMode::kOne: return "1";
-    case EmbreeMode::kPacket4: return "4";
-    case EmbreeMode::kPacket8: return "8";
-    case EmbreeMode::kPacket16: return "16";
-    case EmbreeMode::kStream: return "1M";
+    case EmbreeMode::kOne:
+      return "1";
+    case EmbreeMode::kPacket4:
+      return "4";
+    case EmbreeMode::kPacket8:
+      return "8";
+    case EmbreeMode::kPacket16:
+      return "16";
+    case EmbreeMode::kStream:
+      return "1M";
   }
   return "?";
 }
@@ -115,8 +120,8 @@ class EmbreeScene {
                                    hit);
         break;
       case EmbreeMode::kPacket16:
-        CastPackets<16, RTCRayHit16>(rtcIntersect16, &context, rays, origin_B, first, end,
-                                     distance, hit);
+        CastPackets<16, RTCRayHit16>(rtcIntersect16, &context, rays, origin_B, first, end, distance,
+                                     hit);
         break;
       case EmbreeMode::kStream: {
         std::vector<RTCRayHit> stream;
@@ -156,10 +161,9 @@ class EmbreeScene {
     (*distance)[i] = (*hit)[i] ? tfar : rays.length_m[i];
   }
   template <int N, typename RayHitN, typename Intersect>
-  void CastPackets(Intersect intersect, RTCIntersectContext* context,
-                   const sensors::RayBatch& rays, const Eigen::Vector3f& origin_B,
-                   std::size_t first, std::size_t end, std::vector<float>* distance,
-                   std::vector<char>* hit) const {
+  void CastPackets(Intersect intersect, RTCIntersectContext* context, const sensors::RayBatch& rays,
+                   const Eigen::Vector3f& origin_B, std::size_t first, std::size_t end,
+                   std::vector<float>* distance, std::vector<char>* hit) const {
     for (std::size_t i = first; i < end; i += N) {
       alignas(64) RayHitN packet;
       alignas(64) int valid[N];
@@ -298,11 +302,12 @@ Agreement Agree(const scene::CollisionWorld& world, const EmbreeScene& watertigh
     if (ours_hit != bool(hit[i]) || (ours_hit && diff_mm > 1.0)) {
       if (agreement.mismatches < show) {
         const Eigen::Vector3d o = rays.origin_W + rays.start[i].cast<double>();
-        std::printf("  ray %zu from (%.6g, %.6g, %.6g) along (%.6g, %.6g, %.6g): ours %s %.6g, "
-                    "Embree %s %.6g\n",
-                    i, o.x(), o.y(), o.z(), rays.direction[i].x(), rays.direction[i].y(),
-                    rays.direction[i].z(), ours_hit ? "hit at" : "miss", ours.distance_m[i],
-                    hit[i] ? "hit at" : "miss", distance[i]);
+        std::printf(
+            "  ray %zu from (%.6g, %.6g, %.6g) along (%.6g, %.6g, %.6g): ours %s %.6g, "
+            "Embree %s %.6g\n",
+            i, o.x(), o.y(), o.z(), rays.direction[i].x(), rays.direction[i].y(),
+            rays.direction[i].z(), ours_hit ? "hit at" : "miss", ours.distance_m[i],
+            hit[i] ? "hit at" : "miss", distance[i]);
       }
     }
     if (ours_hit != bool(hit[i])) {
@@ -316,25 +321,33 @@ Agreement Agree(const scene::CollisionWorld& world, const EmbreeScene& watertigh
   return agreement;
 }
 
+// With `grids`, ours is the structured kernel (RayCaster::CastGrids) on them.
 void Compare(const char* level, const char* name, const scene::CollisionWorld& world,
-             const Reference& embree, const sensors::RayBatch& rays, double seconds, int show) {
+             const Reference& embree, const sensors::RayBatch& rays, double seconds, int show,
+             const std::vector<sensors::RayGrid>* grids = nullptr) {
   const std::size_t n = rays.size();
   const Eigen::Vector3f origin_B = (rays.origin_W - world.origin()).cast<float>();
   for (const int threads : {1, 2}) {
     sensors::RayCaster caster(threads);
     sensors::RayHits ours;
-    const double ours_rate =
-        n * CallsPerSecond(seconds, [&] { caster.Cast(world, rays, {}, &ours); });
-    const double one_rate = EmbreeRate(embree.fast, EmbreeMode::kOne, rays, origin_B, threads,
-                                       seconds);
+    const double ours_rate = n * CallsPerSecond(seconds, [&] {
+                               if (grids != nullptr) {
+                                 caster.CastGrids(world, rays, *grids, {}, &ours);
+                               } else {
+                                 caster.Cast(world, rays, {}, &ours);
+                               }
+                             });
+    const double one_rate =
+        EmbreeRate(embree.fast, EmbreeMode::kOne, rays, origin_B, threads, seconds);
     double best_rate = 0.0;
     EmbreeMode best = EmbreeMode::kOne;
-    for (const EmbreeMode mode : {EmbreeMode::kPacket4, EmbreeMode::kPacket8,
-                                  EmbreeMode::kPacket16, EmbreeMode::kStream}) {
+    for (const EmbreeMode mode :
+         {EmbreeMode::kPacket4, EmbreeMode::kPacket8, EmbreeMode::kPacket16, EmbreeMode::kStream}) {
       const double rate = EmbreeRate(embree.fast, mode, rays, origin_B, threads, seconds);
       if (rate > best_rate) best_rate = rate, best = mode;
     }
-    const Agreement agreement = Agree(world, embree.watertight, rays, ours, threads == 1 ? show : 0);
+    const Agreement agreement =
+        Agree(world, embree.watertight, rays, ours, threads == 1 ? show : 0);
     // Bullet's own btCollisionWorld::rayTest, one ray at a time (one thread only:
     // it is not thread-safe), for perspective.
     std::string ray_test = "-";
@@ -375,9 +388,14 @@ void RunLevel(const char* name, const fs::path& file, const Eigen::Isometry3d& X
   face_config.half_extent_m = face_case.half_extent_m;
   const sensors::FaceScanner face(face_config);
   sensors::RayBatch face_rays;
+  std::vector<sensors::RayGrid> face_grids;
   face_rays.origin_W = X_WS.translation();
-  for (const auto& part : face.DueAt(0)) face.AppendRays(part, X_WS, &face_rays);
+  for (const auto& part : face.DueAt(0)) {
+    face_grids.push_back(face.GridOf(part, X_WS, face_rays.size()));
+    face.AppendRays(part, X_WS, &face_rays);
+  }
   Compare(name, "face scan", world, embree, face_rays, seconds, show);
+  Compare(name, "face, grid", world, embree, face_rays, seconds, show, &face_grids);
   const sensors::Lidar lidar16(sensors::LidarConfig::Uniform(16, -15, 15, 1024, 100.0));
   Compare(name, "lidar 16x1024", world, embree, lidar16.Rays(X_WS, X_WS), seconds, show);
   const sensors::Lidar lidar64(sensors::LidarConfig::Uniform(64, -25, 15, 2048, 100.0));
@@ -439,9 +457,9 @@ int main(int argc, char** argv) {
     return 2;
   }
   std::printf("ray kernel: %s\n", sensors::RayCaster::kernel());
-  std::printf("%-12s %-14s %7s %2s %7s %7s %7s %11s %7s %12s %8s %14s\n", "level", "rays",
-              "count", "th", "ours", "Embree1", "ratio", "Embree best", "ratio", "mismatches",
-              "diff mm", "rayTest");
+  std::printf("%-12s %-14s %7s %2s %7s %7s %7s %11s %7s %12s %8s %14s\n", "level", "rays", "count",
+              "th", "ours", "Embree1", "ratio", "Embree best", "ratio", "mismatches", "diff mm",
+              "rayTest");
   try {
     if (level != nullptr) {
       const std::string name = fs::path(level).stem().string().substr(0, 12);

@@ -122,6 +122,24 @@ void FaceScanner::AppendRays(const Part& part, const Eigen::Isometry3d& X_WS,
   }
 }
 
+RayGrid FaceScanner::GridOf(const Part& part, const Eigen::Isometry3d& X_WS,
+                            std::size_t first) const {
+  const Eigen::Matrix3d R_WS = config_.alignment == Alignment::kBody
+                                   ? Eigen::Matrix3d(X_WS.linear())
+                                   : Eigen::Matrix3d::Identity();
+  Eigen::Vector3d u, v;
+  FaceFrame(part.face, &u, &v);
+  const double E = config_.half_extent_m, res = config_.resolution_m;
+  RayGrid grid;
+  grid.first = first;
+  grid.rows = part.row_end - part.row_begin;
+  grid.cols = n_;
+  grid.corner_W = X_WS.translation() + R_WS * (u * -E + v * (-E + part.row_begin * res));
+  grid.step_u_W = R_WS * u * res;
+  grid.step_v_W = R_WS * v * res;
+  return grid;
+}
+
 void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
                        const RayFilter& filter, const Eigen::Isometry3d& X_WS, std::int64_t tick,
                        FaceScan* scan) const {
@@ -134,8 +152,13 @@ void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
   thread_local RayHits hits;
   rays.origin_W = X_WS.translation();
   rays.start.clear(), rays.direction.clear(), rays.length_m.clear();
-  for (const Part& part : parts) AppendRays(part, X_WS, &rays);
-  caster.Cast(world, rays, filter, &hits);
+  thread_local std::vector<RayGrid> grids;
+  grids.clear();
+  for (const Part& part : parts) {
+    grids.push_back(GridOf(part, X_WS, rays.size()));
+    AppendRays(part, X_WS, &rays);
+  }
+  caster.CastGrids(world, rays, grids, filter, &hits);
   // Write each part's results back into its face.
   std::size_t i = 0;
   for (const Part& part : parts) {

@@ -113,6 +113,9 @@ class FaceScanner {
   // Appends the rays of `part` from pose X_WS to `rays` (origin_W must be the
   // sensor position).
   void AppendRays(const Part& part, const Eigen::Isometry3d& X_WS, RayBatch* rays) const;
+  // The grid those rays form (RayCaster::CastGrids), `first` being the index
+  // of the part's first ray in the batch.
+  RayGrid GridOf(const Part& part, const Eigen::Isometry3d& X_WS, std::size_t first) const;
 
  private:
   FaceScannerConfig config_;

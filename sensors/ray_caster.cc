@@ -1,10 +1,12 @@
 #include "sensors/ray_caster.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 #if defined(__SSE2__)
@@ -313,6 +315,17 @@ inline __m128 MeetsCornerBox4(const Eigen::Vector3f corner[3], const Vec4& o, co
                       Mul(t_exit, _mm_set1_ps(1.0f + slack)));
 }
 
+// The rays of a band of rows of one grid block (RayGrid) as the grid kernel
+// reads them: origins in the Bullet frame and results, row by row, padded by a
+// packet's width.
+struct GridBand {
+  int cols{0};
+  __m128 dx, dy, dz;  // the block's direction
+  std::vector<float> ox, oy, oz, t_max;
+  std::vector<int> body;
+  std::vector<Eigen::Vector3f> normal;
+};
+
 // The packet's BVH walk and triangle test (sensors/packet_walk.inc), compiled twice:
 // for any SSE2 CPU, in plain arithmetic redone fused (emulated) where
 // rounding could turn a decision; and for CPUs with an FMA unit, fused
@@ -363,6 +376,62 @@ inline void WalkTarget4(const Target& target, Packet* packet) {
     fma_kernel::WalkTarget4(target, packet);
   } else {
     sse2_kernel::WalkTarget4(target, packet);
+  }
+}
+
+inline void HitGridCells(const Eigen::Vector3f corner[3], int body_id, int r0, int r1, int c0,
+                         int c1, float near, GridBand* band) {
+  if (kHasFma) {
+    fma_kernel::HitGridCells(corner, body_id, r0, r1, c0, c1, near, band);
+  } else {
+    sse2_kernel::HitGridCells(corner, body_id, r0, r1, c0, c1, near, band);
+  }
+}
+
+// A band's grid as seen from one object's quantized BVH: a node box [lo, hi]
+// (quantized) spans columns, rows and depths (u, v, s) of at most
+// w0 + sum_k (q_k * a_k) over its corners; `margin` widens them, `limit`
+// is (columns - 1, rows - 1, ray length).
+struct GridCull {
+  __m128 positive[3], negative[3];  // per axis k: the (u, v, s) weights a_k, split by sign
+  __m128 w0, margin, limit;
+};
+
+// Whether a node's box reaches a grid point in columns and rows and the rays'
+// span in depth.
+inline bool NodeMeetsGrid(const btQuantizedBvhNode& node, const GridCull& cull) {
+  __m128 low = cull.w0, high = cull.w0;
+  for (int k = 0; k < 3; ++k) {
+    const __m128 q_min = _mm_set1_ps(float(node.m_quantizedAabbMin[k]));
+    const __m128 q_max = _mm_set1_ps(float(node.m_quantizedAabbMax[k]));
+    low = Add(low, Add(Mul(q_min, cull.positive[k]), Mul(q_max, cull.negative[k])));
+    high = Add(high, Add(Mul(q_max, cull.positive[k]), Mul(q_min, cull.negative[k])));
+  }
+  const __m128 from = _mm_max_ps(Sub(low, cull.margin), _mm_setzero_ps());
+  const __m128 to = _mm_min_ps(Add(high, cull.margin), cull.limit);
+  // Columns and rows need a whole number in [from, to]; depth an overlap.
+  const __m128 whole = _mm_cvtepi32_ps(_mm_cvttps_epi32(to));
+  const __m128 integral = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, 0, 0));
+  const __m128 top = Select(integral, whole, to);
+  return _mm_movemask_ps(_mm_cmpge_ps(top, from)) == 0xF;
+}
+
+// Calls visit(part, triangle) for each triangle of `target` whose BVH
+// leaf box meets the grid (NodeMeetsGrid): a stackless walk of the node array
+// that skips every subtree whose box falls between grid points.
+template <typename Visit>
+void ForEachTriangleOverGrid(const Target& target, const GridCull& cull, Visit&& visit) {
+  const btQuantizedBvhNode* nodes = target.nodes;
+  const int end = nodes[0].isLeafNode() ? 1 : nodes[0].getEscapeIndex();
+  for (int i = 0; i < end;) {
+    const btQuantizedBvhNode& node = nodes[i];
+    const bool meets = NodeMeetsGrid(node, cull);
+    const bool leaf = node.isLeafNode();
+    if (leaf && meets) {
+      const int packed = node.m_escapeIndexOrTriangleIndex;
+      visit(packed >> 21, packed & ((1 << 21) - 1));
+    }
+    i += meets || leaf ? 1 : node.getEscapeIndex();
   }
 }
 
@@ -615,6 +684,182 @@ void RayCaster::Cast(const scene::CollisionWorld& world, const RayBatch& rays,
     }
   };
   RunParallel(static_cast<int>((n + kRaysPerChunk - 1) / kRaysPerChunk), job);
+}
+
+void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& rays,
+                          const std::vector<RayGrid>& grids, const RayFilter& filter,
+                          RayHits* hits) {
+  const std::size_t n = rays.size();
+  std::size_t next = 0;
+  for (const RayGrid& grid : grids) {
+    if (grid.first != next || grid.rows < 0 || grid.cols <= 0 ||
+        grid.first + std::size_t(grid.rows) * std::size_t(grid.cols) > n) {
+      throw std::invalid_argument("RayCaster::CastGrids(): the blocks do not cover the batch's " +
+                                  std::to_string(n) + " rays in order");
+    }
+    next = grid.first + std::size_t(grid.rows) * std::size_t(grid.cols);
+    for (std::size_t i = grid.first + 1; i < next; ++i) {
+      if (rays.direction[i] != rays.direction[grid.first] ||
+          rays.length_m[i] != rays.length_m[grid.first]) {
+        throw std::invalid_argument("RayCaster::CastGrids(): ray " + std::to_string(i) +
+                                    " differs in direction or length from its block's first");
+      }
+    }
+  }
+  if (next != n) {
+    throw std::invalid_argument("RayCaster::CastGrids(): the blocks cover " + std::to_string(next) +
+                                " of the batch's " + std::to_string(n) + " rays");
+  }
+#if !defined(__SSE2__)
+  Cast(world, rays, filter, hits);
+#else
+  rays_cast_ += std::int64_t(n);
+  hits->distance_m.resize(n);
+  hits->normal_W.resize(n);
+  hits->body.resize(n);
+  if (n == 0) return;
+  const Eigen::Vector3f origin_B = (rays.origin_W - world.origin()).cast<float>();
+  const std::vector<Target>& all_targets = TargetsOf(world).all;
+  const int num_actors = world.internals().num_actors;
+  auto wanted = [&filter, num_actors](const Target& t) {
+    return (t.group & filter.group_mask) != 0 &&
+           !(filter.ignore_actor >= 0 && t.body == filter.ignore_actor) &&
+           !(filter.ignore_robot >= 0 && t.body == num_actors + filter.ignore_robot);
+  };
+  // Bands of rows: eight a block (a face), at least four rows each.
+  struct Band {
+    const RayGrid* grid;
+    int row_begin, row_end;
+  };
+  std::vector<Band> bands;
+  for (const RayGrid& grid : grids) {
+    const int rows_per_band = std::max(4, (grid.rows + 7) / 8);
+    for (int r = 0; r < grid.rows; r += rows_per_band) {
+      bands.push_back({&grid, r, std::min(grid.rows, r + rows_per_band)});
+    }
+  }
+
+  const std::function<void(int)> job = [&](int band_index) {
+    const Band& this_band = bands[std::size_t(band_index)];
+    const RayGrid& grid = *this_band.grid;
+    const int row_begin = this_band.row_begin;
+    const int rows = this_band.row_end - row_begin, cols = grid.cols;
+    const std::size_t first = grid.first + std::size_t(row_begin) * std::size_t(cols);
+    const std::size_t count = std::size_t(rows) * std::size_t(cols);
+    const Eigen::Vector3f d = rays.direction[first];
+    const float length = rays.length_m[first];
+    thread_local GridBand band;
+    band.cols = cols;
+    band.dx = _mm_set1_ps(d.x()), band.dy = _mm_set1_ps(d.y()), band.dz = _mm_set1_ps(d.z());
+    for (auto* values : {&band.ox, &band.oy, &band.oz, &band.t_max})
+      values->assign(count + 4, 0.0f);
+    band.body.assign(count + 4, RayHits::kNoHit);
+    band.normal.resize(count + 4);
+    for (std::size_t i = 0; i < count; ++i) {
+      const Eigen::Vector3f o = origin_B + rays.start[first + i];  // as Cast() forms it
+      band.ox[i] = o.x(), band.oy[i] = o.y(), band.oz[i] = o.z();
+      band.t_max[i] = length;
+    }
+    // The band's grid in the Bullet frame, in double: a point's column is
+    // (p - corner) . to_column, its row (p - corner) . to_row, its depth
+    // along the rays (p - corner) . direction. The margin covers the float
+    // rounding of the rays' origins and of the triangle test's tolerance.
+    const Eigen::Vector3d corner = grid.corner_W - world.origin() + row_begin * grid.step_v_W;
+    const double step_u = grid.step_u_W.norm(), step_v = grid.step_v_W.norm();
+    const Eigen::Vector3d to_column = grid.step_u_W / (step_u * step_u);
+    const Eigen::Vector3d to_row = grid.step_v_W / (step_v * step_v);
+    const Eigen::Vector3d direction = d.cast<double>();
+    const double margin =
+        1e-5 * (corner.norm() + cols * step_u + rows * step_v + double(length)) + 1e-5;
+    const double margin_columns = margin / step_u, margin_rows = margin / step_v;
+    Eigen::AlignedBox3d box;
+    for (const double u : {-margin_columns, cols - 1 + margin_columns}) {
+      for (const double v : {-margin_rows, rows - 1 + margin_rows}) {
+        for (const double s : {-margin, double(length) + margin}) {
+          box.extend(corner + u * grid.step_u_W + v * grid.step_v_W + s * direction);
+        }
+      }
+    }
+    const Eigen::Vector3f box_min = (box.min().array() - margin).cast<float>();
+    const Eigen::Vector3f box_max = (box.max().array() + margin).cast<float>();
+    for (const Target& target : all_targets) {
+      if (!wanted(target) || (target.aabb_min.array() > box_max.array()).any() ||
+          (target.aabb_max.array() < box_min.array()).any()) {
+        continue;
+      }
+      // The grid's coordinates as linear functions of the object's quantized
+      // BVH coordinates: w = (X_BL (q / quantization + bvh_min) - corner) . axis.
+      const btTransform& X_BL = target.X_BL;
+      Eigen::Matrix3d R_BL;
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) R_BL(r, c) = double(X_BL.getBasis()[r][c]);
+      }
+      const Eigen::Vector3d p_BL(X_BL.getOrigin().x(), X_BL.getOrigin().y(), X_BL.getOrigin().z());
+      const Eigen::Vector3d offset = R_BL * target.bvh_min.cast<double>() + p_BL - corner;
+      const Eigen::Vector3d* axes[3] = {&to_column, &to_row, &direction};
+      alignas(16) float positive[3][4] = {}, negative[3][4] = {}, w0[4] = {}, slack[4] = {};
+      for (int w = 0; w < 3; ++w) {
+        const Eigen::Vector3d a =
+            (R_BL.transpose() * *axes[w]).cwiseQuotient(target.quantization.cast<double>());
+        w0[w] = float(offset.dot(*axes[w]));
+        double reach = std::abs(w0[w]);
+        for (int k = 0; k < 3; ++k) {
+          positive[k][w] = float(std::max(a[k], 0.0));
+          negative[k][w] = float(std::min(a[k], 0.0));
+          reach += 65535.0 * std::abs(a[k]);
+        }
+        // The band's margin, a quantum each way, and the float rounding of the sums.
+        const double quantum = std::abs(a[0]) + std::abs(a[1]) + std::abs(a[2]);
+        slack[w] = float((w == 0   ? margin_columns
+                          : w == 1 ? margin_rows
+                                   : margin) +
+                         quantum + 1e-6 * reach);
+      }
+      GridCull cull;
+      for (int k = 0; k < 3; ++k) {
+        cull.positive[k] = _mm_load_ps(positive[k]);
+        cull.negative[k] = _mm_load_ps(negative[k]);
+      }
+      cull.w0 = _mm_load_ps(w0);
+      cull.margin = _mm_load_ps(slack);
+      cull.limit = _mm_setr_ps(float(cols - 1), float(rows - 1), length, 0.0f);
+      ForEachTriangleOverGrid(target, cull, [&](int part, int triangle) {
+        Eigen::Vector3f corners[3];
+        Corners(target, part, triangle, corners);
+        double u_min = kHuge, u_max = -kHuge, v_min = kHuge, v_max = -kHuge;
+        double s_min = kHuge, s_max = -kHuge;
+        for (const Eigen::Vector3f& p : corners) {
+          const Eigen::Vector3d relative = p.cast<double>() - corner;
+          const double u = relative.dot(to_column), v = relative.dot(to_row);
+          const double s = relative.dot(direction);
+          u_min = std::min(u_min, u), u_max = std::max(u_max, u);
+          v_min = std::min(v_min, v), v_max = std::max(v_max, v);
+          s_min = std::min(s_min, s), s_max = std::max(s_max, s);
+        }
+        if (s_max < -margin || s_min > double(length) + margin) return;
+        const double c0 = std::max(0.0, std::ceil(u_min - margin_columns));
+        const double c1 = std::min(cols - 1.0, std::floor(u_max + margin_columns));
+        const double r0 = std::max(0.0, std::ceil(v_min - margin_rows));
+        const double r1 = std::min(rows - 1.0, std::floor(v_max + margin_rows));
+        if (c0 > c1 || r0 > r1) return;
+        HitGridCells(corners, target.body, int(r0), int(r1), int(c0), int(c1),
+                     float(s_min - margin), &band);
+      });
+    }
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::size_t r = first + i;
+      hits->distance_m[r] = band.t_max[i];
+      hits->body[r] = band.body[i];
+      if (band.body[i] != RayHits::kNoHit) {
+        const Eigen::Vector3f normal = band.normal[i].normalized();
+        hits->normal_W[r] = normal.dot(d) > 0.0f ? -normal : normal;
+      } else {
+        hits->normal_W[r].setZero();
+      }
+    }
+  };
+  RunParallel(static_cast<int>(bands.size()), job);
+#endif
 }
 
 }  // namespace sandbox::sensors
