@@ -150,6 +150,7 @@ void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
   // The rays and hits keep their memory from scan to scan (no allocation a tick).
   thread_local RayBatch rays;
   thread_local RayHits hits;
+  hits.with_normals = false;
   rays.origin_W = X_WS.translation();
   rays.start.clear(), rays.direction.clear(), rays.length_m.clear();
   thread_local std::vector<RayGrid> grids;

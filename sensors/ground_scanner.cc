@@ -42,6 +42,7 @@ void GroundScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
     }
   }
   RayHits hits;
+  hits.with_normals = false;
   caster.Cast(world, rays, filter, &hits);
   map->n = n_;
   map->resolution_m = res;

@@ -75,6 +75,7 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
   }
   const RayBatch rays = Rays(X_WS_start, X_WS_end);
   RayHits hits;
+  hits.with_normals = false;
   caster.Cast(world, rays, filter, &hits);
   const std::size_t n = rays.size();
   scan->channels = config_.channels();

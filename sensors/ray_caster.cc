@@ -230,6 +230,21 @@ bool WalkTarget(const Target& target, const Eigen::Vector3f& o_B, const Eigen::V
   return hit;
 }
 
+// Ray r's result: its distance, the body hit and, when asked for, the unit
+// normal facing the ray (zero without a hit).
+inline void WriteHit(std::size_t r, float t, int body, const Eigen::Vector3f& normal,
+                     const Eigen::Vector3f& direction, RayHits* hits) {
+  hits->distance_m[r] = t;
+  hits->body[r] = body;
+  if (!hits->with_normals) return;
+  if (body == RayHits::kNoHit) {
+    hits->normal_W[r].setZero();
+    return;
+  }
+  const Eigen::Vector3f unit = normal.normalized();
+  hits->normal_W[r] = unit.dot(direction) > 0.0f ? -unit : unit;
+}
+
 // Whether the ray enters an axis-aligned box before t_max.
 inline bool RayMeetsBox(const Eigen::Vector3f& o, const Eigen::Vector3f& inverse_d,
                         const Eigen::Vector3f& lo, const Eigen::Vector3f& hi, float t_max) {
@@ -293,20 +308,19 @@ inline __m128 L1(const Vec4& a) { return Add(Add(Abs(a.x), Abs(a.y)), Abs(a.z));
 inline __m128 Select(__m128 mask, __m128 a, __m128 b) {
   return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
 }
-// MeetsCornerBox, per lane.
-inline __m128 MeetsCornerBox4(const Eigen::Vector3f corner[3], const Vec4& o, const Vec4& d,
+// MeetsCornerBox, per lane, for the boxes [low, high] around each lane's corners.
+inline __m128 MeetsCornerBox4(const Vec4& low, const Vec4& high, const Vec4& o, const Vec4& d,
                               __m128 t) {
   const __m128 origin[3] = {o.x, o.y, o.z}, direction[3] = {d.x, d.y, d.z};
+  const __m128 lo[3] = {low.x, low.y, low.z}, hi[3] = {high.x, high.y, high.z};
   __m128 t_enter = _mm_setzero_ps(), t_exit = t;
   for (int k = 0; k < 3; ++k) {
-    const float lo = std::min({corner[0][k], corner[1][k], corner[2][k]});
-    const float hi = std::max({corner[0][k], corner[1][k], corner[2][k]});
     // A zero component counts as an infinitesimally positive one.
     const __m128 zero = _mm_cmpeq_ps(direction[k], _mm_setzero_ps());
     const __m128 inverse =
         Select(zero, _mm_set1_ps(kHuge), _mm_div_ps(_mm_set1_ps(1.0f), direction[k]));
-    const __m128 t1 = Mul(Sub(_mm_set1_ps(lo), origin[k]), inverse);
-    const __m128 t2 = Mul(Sub(_mm_set1_ps(hi), origin[k]), inverse);
+    const __m128 t1 = Mul(Sub(lo[k], origin[k]), inverse);
+    const __m128 t2 = Mul(Sub(hi[k], origin[k]), inverse);
     t_enter = _mm_max_ps(t_enter, _mm_min_ps(t1, t2));
     t_exit = _mm_min_ps(t_exit, _mm_max_ps(t1, t2));
   }
@@ -324,6 +338,29 @@ struct GridBand {
   std::vector<float> ox, oy, oz, t_max;
   std::vector<int> body;
   std::vector<Eigen::Vector3f> normal;
+  // Triangle-ray pairs waiting for a test (HitPairs), in lanes' order.
+  struct Pairs {
+    static constexpr int kCapacity = 64;
+    int count{0};
+    alignas(16) float corner[9][kCapacity];  // x, y, z of corner 0, 1, 2
+    alignas(16) float near[kCapacity];
+    int cell[kCapacity], body[kCapacity];
+  } pairs;
+
+  // Queues the triangle with these corners against ray `cell`; tests the
+  // queue when full (test: HitPairs of the kernel in use).
+  template <typename Test>
+  void Add(const Eigen::Vector3f corner[3], int body_id, int cell_index, float near_depth,
+           Test test) {
+    const int k = pairs.count++;
+    for (int j = 0; j < 3; ++j) {
+      for (int a = 0; a < 3; ++a) pairs.corner[3 * j + a][k] = corner[j][a];
+    }
+    pairs.near[k] = near_depth;
+    pairs.cell[k] = cell_index;
+    pairs.body[k] = body_id;
+    if (pairs.count == Pairs::kCapacity) test(this);
+  }
 };
 
 // The packet's BVH walk and triangle test (sensors/packet_walk.inc), compiled twice:
@@ -379,14 +416,70 @@ inline void WalkTarget4(const Target& target, Packet* packet) {
   }
 }
 
-inline void HitGridCells(const Eigen::Vector3f corner[3], int body_id, int r0, int r1, int c0,
-                         int c1, float near, GridBand* band) {
+inline void HitPairs(GridBand* band) {
   if (kHasFma) {
-    fma_kernel::HitGridCells(corner, body_id, r0, r1, c0, c1, near, band);
+    fma_kernel::HitPairs(band);
   } else {
-    sse2_kernel::HitGridCells(corner, body_id, r0, r1, c0, c1, near, band);
+    sse2_kernel::HitPairs(band);
   }
 }
+
+// The span [from, to] of columns that the triangle with corners at columns
+// u[k], rows v[k] covers within `margin` rows of row y: the extent of its
+// intersection with the strip [y - margin, y + margin]. False when it misses it.
+inline bool RowSpan(const float u[3], const float v[3], float y, float margin, float* from,
+                    float* to) {
+  const float low = y - margin, high = y + margin;
+  float lo = kHuge, hi = -kHuge;
+  for (int i = 0; i < 3; ++i) {
+    if (v[i] >= low && v[i] <= high) lo = std::min(lo, u[i]), hi = std::max(hi, u[i]);
+    const int j = i == 2 ? 0 : i + 1;
+    if (v[i] == v[j]) continue;
+    for (const float line : {low, high}) {
+      if ((line - v[i]) * (line - v[j]) > 0.0f) continue;  // the edge does not cross it
+      const float t = std::clamp((line - v[i]) / (v[j] - v[i]), 0.0f, 1.0f);
+      const float x = u[i] + t * (u[j] - u[i]);
+      lo = std::min(lo, x), hi = std::max(hi, x);
+    }
+  }
+  *from = lo, *to = hi;
+  return lo <= hi;
+}
+
+// The least whole number >= x and >= 0 (at most `cap`), and the greatest
+// <= x and <= top (-1 below 0): float to int without libm.
+inline int CeilNotBelowZero(float x, int cap) {
+  if (!(x > 0.0f)) return 0;
+  if (x >= float(cap)) return cap;
+  const int whole = int(x);
+  return whole + (float(whole) < x ? 1 : 0);
+}
+inline int FloorNotAbove(float x, int top) {
+  if (!(x >= 0.0f)) return -1;
+  return x >= float(top) ? top : int(x);
+}
+
+// A band's grid coordinates of Bullet-frame points, in float: columns, rows
+// and depth along the rays of p - corner; margins in metres and in cells.
+struct BandFrame {
+  BandFrame(const Eigen::Vector3d& corner_B, const Eigen::Vector3d& to_column,
+            const Eigen::Vector3d& to_row, const Eigen::Vector3d& direction, double margin_m,
+            double columns_m, double rows_m)
+      : margin(float(margin_m)), margin_columns(float(columns_m)), margin_rows(float(rows_m)) {
+    const Eigen::Vector3d* axes[3] = {&to_column, &to_row, &direction};
+    for (int k = 0; k < 3; ++k) {
+      corner[k] = _mm_set1_ps(float(corner_B[k]));
+      for (int w = 0; w < 3; ++w) axis[w][k] = _mm_set1_ps(float((*axes[w])[k]));
+    }
+  }
+  // Coordinate w (0 column, 1 row, 2 depth) of the points x, y, z (relative to corner).
+  __m128 Along(int w, __m128 x, __m128 y, __m128 z) const {
+    return Add(Add(Mul(x, axis[w][0]), Mul(y, axis[w][1])), Mul(z, axis[w][2]));
+  }
+  __m128 corner[3];
+  __m128 axis[3][3];
+  float margin, margin_columns, margin_rows;
+};
 
 // A band's grid as seen from one object's quantized BVH: a node box [lo, hi]
 // (quantized) spans columns, rows and depths (u, v, s) of at most
@@ -562,7 +655,7 @@ void RayCaster::Cast(const scene::CollisionWorld& world, const RayBatch& rays,
   const std::size_t n = rays.size();
   rays_cast_ += std::int64_t(n);
   hits->distance_m.resize(n);
-  hits->normal_W.resize(n);
+  hits->normal_W.resize(hits->with_normals ? n : 0);
   hits->body.resize(n);
   if (n == 0) return;
   // The batch in Bullet's frame (world minus the floating origin).
@@ -649,14 +742,7 @@ void RayCaster::Cast(const scene::CollisionWorld& world, const RayBatch& rays,
       _mm_store_ps(t_max, packet.t_max);
       for (int l = 0; l < 4 && i + std::size_t(l) < end; ++l) {
         const std::size_t r = i + std::size_t(l);
-        hits->distance_m[r] = t_max[l];
-        hits->body[r] = packet.body[l];
-        if (packet.body[l] != RayHits::kNoHit) {
-          const Eigen::Vector3f normal = packet.normal[l].normalized();
-          hits->normal_W[r] = normal.dot(rays.direction[r]) > 0.0f ? -normal : normal;
-        } else {
-          hits->normal_W[r].setZero();
-        }
+        WriteHit(r, t_max[l], packet.body[l], packet.normal[l], rays.direction[r], hits);
       }
     }
 #endif
@@ -673,14 +759,7 @@ void RayCaster::Cast(const scene::CollisionWorld& world, const RayBatch& rays,
         if (!RayMeetsBox(o, inverse_d, target.aabb_min, target.aabb_max, t_max)) continue;
         if (WalkTarget(target, o, d, &t_max, &normal)) body = target.body;
       }
-      hits->distance_m[i] = t_max;
-      hits->body[i] = body;
-      if (body != RayHits::kNoHit) {
-        normal.normalize();
-        hits->normal_W[i] = normal.dot(d) > 0.0f ? -normal : normal;
-      } else {
-        hits->normal_W[i].setZero();
-      }
+      WriteHit(i, t_max, body, normal, d, hits);
     }
   };
   RunParallel(static_cast<int>((n + kRaysPerChunk - 1) / kRaysPerChunk), job);
@@ -715,7 +794,7 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
 #else
   rays_cast_ += std::int64_t(n);
   hits->distance_m.resize(n);
-  hits->normal_W.resize(n);
+  hits->normal_W.resize(hits->with_normals ? n : 0);
   hits->body.resize(n);
   if (n == 0) return;
   const Eigen::Vector3f origin_B = (rays.origin_W - world.origin()).cast<float>();
@@ -726,14 +805,17 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
            !(filter.ignore_actor >= 0 && t.body == filter.ignore_actor) &&
            !(filter.ignore_robot >= 0 && t.body == num_actors + filter.ignore_robot);
   };
-  // Bands of rows: eight a block (a face), at least four rows each.
+  // Bands of rows, each a chunk of work: four a thread over all blocks
+  // (each band walks the BVH from its root), at least four rows each.
   struct Band {
     const RayGrid* grid;
     int row_begin, row_end;
   };
   std::vector<Band> bands;
+  const int bands_per_block =
+      (4 * threads() + int(grids.size()) - 1) / std::max(1, int(grids.size()));
   for (const RayGrid& grid : grids) {
-    const int rows_per_band = std::max(4, (grid.rows + 7) / 8);
+    const int rows_per_band = std::max(4, (grid.rows + bands_per_block - 1) / bands_per_block);
     for (int r = 0; r < grid.rows; r += rows_per_band) {
       bands.push_back({&grid, r, std::min(grid.rows, r + rows_per_band)});
     }
@@ -754,6 +836,7 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
     for (auto* values : {&band.ox, &band.oy, &band.oz, &band.t_max})
       values->assign(count + 4, 0.0f);
     band.body.assign(count + 4, RayHits::kNoHit);
+    band.pairs.count = 0;
     band.normal.resize(count + 4);
     for (std::size_t i = 0; i < count; ++i) {
       const Eigen::Vector3f o = origin_B + rays.start[first + i];  // as Cast() forms it
@@ -772,6 +855,8 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
     const double margin =
         1e-5 * (corner.norm() + cols * step_u + rows * step_v + double(length)) + 1e-5;
     const double margin_columns = margin / step_u, margin_rows = margin / step_v;
+    const BandFrame frame(corner, to_column, to_row, direction, margin, margin_columns,
+                          margin_rows);
     Eigen::AlignedBox3d box;
     for (const double u : {-margin_columns, cols - 1 + margin_columns}) {
       for (const double v : {-margin_rows, rows - 1 + margin_rows}) {
@@ -826,36 +911,51 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
       ForEachTriangleOverGrid(target, cull, [&](int part, int triangle) {
         Eigen::Vector3f corners[3];
         Corners(target, part, triangle, corners);
-        double u_min = kHuge, u_max = -kHuge, v_min = kHuge, v_max = -kHuge;
-        double s_min = kHuge, s_max = -kHuge;
-        for (const Eigen::Vector3f& p : corners) {
-          const Eigen::Vector3d relative = p.cast<double>() - corner;
-          const double u = relative.dot(to_column), v = relative.dot(to_row);
-          const double s = relative.dot(direction);
-          u_min = std::min(u_min, u), u_max = std::max(u_max, u);
-          v_min = std::min(v_min, v), v_max = std::max(v_max, v);
-          s_min = std::min(s_min, s), s_max = std::max(s_max, s);
+        // Columns u, rows v and depths s of the corners (SSE, a lane each).
+        const __m128 x =
+            Sub(_mm_setr_ps(corners[0].x(), corners[1].x(), corners[2].x(), corners[2].x()),
+                frame.corner[0]);
+        const __m128 y =
+            Sub(_mm_setr_ps(corners[0].y(), corners[1].y(), corners[2].y(), corners[2].y()),
+                frame.corner[1]);
+        const __m128 z =
+            Sub(_mm_setr_ps(corners[0].z(), corners[1].z(), corners[2].z(), corners[2].z()),
+                frame.corner[2]);
+        alignas(16) float u[4], v[4], s[4];
+        _mm_store_ps(u, frame.Along(0, x, y, z));
+        _mm_store_ps(v, frame.Along(1, x, y, z));
+        _mm_store_ps(s, frame.Along(2, x, y, z));
+        const float s_min = std::min({s[0], s[1], s[2]}), s_max = std::max({s[0], s[1], s[2]});
+        if (s_max < -frame.margin || s_min > length + frame.margin) return;
+        const int r0 = CeilNotBelowZero(std::min({v[0], v[1], v[2]}) - frame.margin_rows, rows);
+        const int r1 = FloorNotAbove(std::max({v[0], v[1], v[2]}) + frame.margin_rows, rows - 1);
+        const int c0 = CeilNotBelowZero(std::min({u[0], u[1], u[2]}) - frame.margin_columns, cols);
+        const int c1 = FloorNotAbove(std::max({u[0], u[1], u[2]}) + frame.margin_columns, cols - 1);
+        if (r0 > r1 || c0 > c1) return;
+        const float near = s_min - frame.margin;
+        auto add = [&](int r, int c) {
+          band.Add(corners, target.body, r * cols + c, near, HitPairs);
+        };
+        if ((r1 - r0 + 1) * (c1 - c0 + 1) <= 4) {  // the box's few cells
+          for (int r = r0; r <= r1; ++r) {
+            for (int c = c0; c <= c1; ++c) add(r, c);
+          }
+          return;
         }
-        if (s_max < -margin || s_min > double(length) + margin) return;
-        const double c0 = std::max(0.0, std::ceil(u_min - margin_columns));
-        const double c1 = std::min(cols - 1.0, std::floor(u_max + margin_columns));
-        const double r0 = std::max(0.0, std::ceil(v_min - margin_rows));
-        const double r1 = std::min(rows - 1.0, std::floor(v_max + margin_rows));
-        if (c0 > c1 || r0 > r1) return;
-        HitGridCells(corners, target.body, int(r0), int(r1), int(c0), int(c1),
-                     float(s_min - margin), &band);
+        // Row by row, the cells within the triangle's span.
+        for (int r = r0; r <= r1; ++r) {
+          float from, to;
+          if (!RowSpan(u, v, float(r), frame.margin_rows, &from, &to)) continue;
+          const int first_column =
+              std::max(c0, CeilNotBelowZero(from - frame.margin_columns, cols));
+          const int last_column = std::min(c1, FloorNotAbove(to + frame.margin_columns, cols - 1));
+          for (int c = first_column; c <= last_column; ++c) add(r, c);
+        }
       });
     }
+    HitPairs(&band);
     for (std::size_t i = 0; i < count; ++i) {
-      const std::size_t r = first + i;
-      hits->distance_m[r] = band.t_max[i];
-      hits->body[r] = band.body[i];
-      if (band.body[i] != RayHits::kNoHit) {
-        const Eigen::Vector3f normal = band.normal[i].normalized();
-        hits->normal_W[r] = normal.dot(d) > 0.0f ? -normal : normal;
-      } else {
-        hits->normal_W[r].setZero();
-      }
+      WriteHit(first + i, band.t_max[i], band.body[i], band.normal[i], d, hits);
     }
   };
   RunParallel(static_cast<int>(bands.size()), job);

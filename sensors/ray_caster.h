@@ -63,6 +63,9 @@ struct RayHits {
   std::vector<float> distance_m;
   std::vector<Eigen::Vector3f> normal_W;  // unit, facing the ray; zero without a hit
   std::vector<std::int32_t> body;         // actor index, or num_actors + robot index
+  // False: normal_W is left empty (a caller that needs no normals, such as
+  // the face scanner, saves a square root and a division a hit).
+  bool with_normals{true};
 
   std::size_t size() const { return body.size(); }
 };
