@@ -334,10 +334,13 @@ inline __m128 MeetsCornerBox4(const Vec4& low, const Vec4& high, const Vec4& o, 
 // packet's width.
 struct GridBand {
   int cols{0};
-  __m128 dx, dy, dz;  // the block's direction
-  std::vector<float> ox, oy, oz, t_max;
-  std::vector<int> body;
-  std::vector<Eigen::Vector3f> normal;
+  __m128 dx, dy, dz;     // the block's direction
+  __m128 ox, oy, oz;     // the batch origin (a ray starts at it plus its start)
+  const Eigen::Vector3f* start{nullptr};  // the band's rays' starts
+  float* t_max{nullptr};                  // its entries of RayHits::distance_m
+  std::int32_t* body{nullptr};            // of RayHits::body
+  Eigen::Vector3f* normal{nullptr};       // unnormalised, or null: none asked for
+  std::vector<Eigen::Vector3f> normals;   // their storage
   // Triangle-ray pairs waiting for a test (HitPairs), in lanes' order.
   struct Pairs {
     static constexpr int kCapacity = 64;
@@ -833,16 +836,19 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
     thread_local GridBand band;
     band.cols = cols;
     band.dx = _mm_set1_ps(d.x()), band.dy = _mm_set1_ps(d.y()), band.dz = _mm_set1_ps(d.z());
-    for (auto* values : {&band.ox, &band.oy, &band.oz, &band.t_max})
-      values->assign(count + 4, 0.0f);
-    band.body.assign(count + 4, RayHits::kNoHit);
-    band.pairs.count = 0;
-    band.normal.resize(count + 4);
-    for (std::size_t i = 0; i < count; ++i) {
-      const Eigen::Vector3f o = origin_B + rays.start[first + i];  // as Cast() forms it
-      band.ox[i] = o.x(), band.oy[i] = o.y(), band.oz[i] = o.z();
-      band.t_max[i] = length;
+    band.ox = _mm_set1_ps(origin_B.x()), band.oy = _mm_set1_ps(origin_B.y());
+    band.oz = _mm_set1_ps(origin_B.z());
+    band.start = rays.start.data() + first;
+    band.t_max = hits->distance_m.data() + first;
+    band.body = hits->body.data() + first;
+    std::fill(band.t_max, band.t_max + count, length);
+    std::fill(band.body, band.body + count, RayHits::kNoHit);
+    band.normal = nullptr;
+    if (hits->with_normals) {
+      band.normals.resize(count);
+      band.normal = band.normals.data();
     }
+    band.pairs.count = 0;
     // The band's grid in the Bullet frame, in double: a point's column is
     // (p - corner) . to_column, its row (p - corner) . to_row, its depth
     // along the rays (p - corner) . direction. The margin covers the float
@@ -954,8 +960,10 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
       });
     }
     HitPairs(&band);
-    for (std::size_t i = 0; i < count; ++i) {
-      WriteHit(first + i, band.t_max[i], band.body[i], band.normal[i], d, hits);
+    if (band.normal != nullptr) {
+      for (std::size_t i = 0; i < count; ++i) {
+        WriteHit(first + i, band.t_max[i], band.body[i], band.normal[i], d, hits);
+      }
     }
   };
   RunParallel(static_cast<int>(bands.size()), job);
