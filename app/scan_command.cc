@@ -148,6 +148,7 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       config.resolution_m = res;
       config.half_extent_m = extent;
       config.refresh = sensors::Refresh::kFull;
+      config.sample_budget = 1e7;  // a one-off scan may be finer than a sensor of the loop
       config.alignment = aligned == "body" ? sensors::Alignment::kBody : sensors::Alignment::kWorld;
       const sensors::FaceScanner scanner(config);
       sensors::FaceScan scan = scanner.EmptyScan();

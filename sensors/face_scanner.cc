@@ -21,6 +21,7 @@ void FaceFrame(int face, Eigen::Vector3d* u, Eigen::Vector3d* v) {
 
 std::string Format(double value) {
   std::ostringstream out;
+  out.precision(12);
   out << value;
   return out.str();
 }
@@ -40,10 +41,17 @@ void FaceScannerConfig::ValidateOrThrow() const {
   if (!(std::isfinite(half_extent_m) && half_extent_m > 0.0)) {
     throw std::invalid_argument("half_extent_m must be positive, got " + Format(half_extent_m));
   }
+  if (!(sample_budget >= 6.0 && sample_budget <= 1e9)) {
+    throw std::invalid_argument("sample_budget must be 6 to 1e9, got " + Format(sample_budget));
+  }
   const double steps = 2.0 * half_extent_m / resolution_m;
-  if (steps > 1e5 || 6.0 * (steps + 1.0) * (steps + 1.0) > 1e7) {
+  const double samples = 6.0 * (steps + 1.0) * (steps + 1.0);
+  if (samples > sample_budget) {
+    const std::string n = Format(std::floor(steps + 1.5));
     throw std::invalid_argument("half_extent_m " + Format(half_extent_m) + " at resolution_m " +
-                                Format(resolution_m) + " makes more than 10 million rays");
+                                Format(resolution_m) + " makes 6 x " + n + " x " + n + " = " +
+                                Format(std::floor(samples + 0.5)) +
+                                " samples a scan, over sample_budget " + Format(sample_budget));
   }
   if (std::abs(steps - std::round(steps)) > 1e-6) {
     throw std::invalid_argument("half_extent_m (" + Format(half_extent_m) +
@@ -182,6 +190,7 @@ FaceScannerConfig FaceScannerConfig::Read(scene::SettingsReader& read) {
   FaceScannerConfig face;
   face.resolution_m = read.Number("resolution_m", face.resolution_m);
   face.half_extent_m = read.Number("half_extent_m", face.half_extent_m);
+  face.sample_budget = read.Number("sample_budget", face.sample_budget);
   const std::string refresh = read.Text("refresh", "six_stage");
   if (refresh == "full") {
     face.refresh = Refresh::kFull;

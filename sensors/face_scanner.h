@@ -39,10 +39,13 @@ struct FaceScannerConfig {
   double half_extent_m{25.0};
   Refresh refresh{Refresh::kSixStage};
   Alignment alignment{Alignment::kBody};
+  // The most samples (6 n^2) a scan may have: a finer or larger grid is
+  // refused at load. The default admits 6 x 501 x 501 (25 m at 0.1 m).
+  double sample_budget{2e6};
 
   // Throws std::invalid_argument naming the field and its value: a resolution
   // or half extent that is not positive and finite, a half extent that is not
-  // a whole number of resolutions, or more than 10 million rays a scan.
+  // a whole number of resolutions, or more samples a scan than sample_budget.
   void ValidateOrThrow() const;
   int points_per_side() const;  // n
 

@@ -334,8 +334,8 @@ inline __m128 MeetsCornerBox4(const Vec4& low, const Vec4& high, const Vec4& o, 
 // packet's width.
 struct GridBand {
   int cols{0};
-  __m128 dx, dy, dz;     // the block's direction
-  __m128 ox, oy, oz;     // the batch origin (a ray starts at it plus its start)
+  __m128 dx, dy, dz;                      // the block's direction
+  __m128 ox, oy, oz;                      // the batch origin (a ray starts at it plus its start)
   const Eigen::Vector3f* start{nullptr};  // the band's rays' starts
   float* t_max{nullptr};                  // its entries of RayHits::distance_m
   std::int32_t* body{nullptr};            // of RayHits::body

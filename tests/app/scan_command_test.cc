@@ -86,9 +86,9 @@ TEST(ScanCommandTest, BadArgumentsAreOneClearMessage) {
   EXPECT_EQ(run.out, "sandbox scan: --at: 'nan' is not a finite number\n");
   run = RunSandbox("scan --at 0,0,30 --resolution 0.01 --half-extent 100" + out);
   EXPECT_EQ(run.exit_code, 2);
-  EXPECT_EQ(
-      run.out,
-      "sandbox scan: half_extent_m 100 at resolution_m 0.01 makes more than 10 million rays\n");
+  EXPECT_EQ(run.out,
+            "sandbox scan: half_extent_m 100 at resolution_m 0.01 makes 6 x 20001 x 20001 = "
+            "2400240006 samples a scan, over sample_budget 10000000\n");
   EXPECT_EQ(RunSandbox("scan --at 0,0,30 --sensor sonar" + out).exit_code, 2);
   EXPECT_EQ(RunSandbox("scan --out x.csv").exit_code, 2);
 }

@@ -228,7 +228,21 @@ TEST(FaceScannerTest, BadConfigsNameTheField) {
   config.resolution_m = 0.01;
   config.half_extent_m = 100;
   EXPECT_EQ(message(config),
-            "half_extent_m 100 at resolution_m 0.01 makes more than 10 million rays");
+            "half_extent_m 100 at resolution_m 0.01 makes 6 x 20001 x 20001 = 2400240006 "
+            "samples a scan, over sample_budget 2000000");
+  // 25 m at 0.1 m (6 x 501 x 501) is within the default budget; at 0.05 m it
+  // needs a larger one, which admits it.
+  config.half_extent_m = 25;
+  config.resolution_m = 0.1;
+  EXPECT_EQ(message(config), "no error");
+  config.resolution_m = 0.05;
+  EXPECT_EQ(message(config),
+            "half_extent_m 25 at resolution_m 0.05 makes 6 x 1001 x 1001 = 6012006 samples a "
+            "scan, over sample_budget 2000000");
+  config.sample_budget = 6012006;
+  EXPECT_EQ(message(config), "no error");
+  config.sample_budget = 0;
+  EXPECT_EQ(message(config), "sample_budget must be 6 to 1e9, got 0");
   config = FaceScannerConfig();
   config.half_extent_m = 25.3;
   EXPECT_NE(message(config).find("must be a whole number"), std::string::npos);

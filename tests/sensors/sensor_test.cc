@@ -203,9 +203,11 @@ TEST(SensorTest, MistakesNameTheSensorAndField) {
             "level.toml:6: sensor 's': resolution_m must be positive, got 0");
   EXPECT_EQ(Error("type = \"face\"\nresolution_m = -0.5\n"),
             "level.toml:6: sensor 's': resolution_m must be positive, got -0.5");
-  EXPECT_EQ(Error("type = \"face\"\nresolution_m = 0.01\nhalf_extent_m = 100\n"),
-            "level.toml:6: sensor 's': half_extent_m 100 at resolution_m 0.01 makes more than 10 "
-            "million rays");
+  EXPECT_EQ(Error("type = \"face\"\nresolution_m = 0.05\n"),
+            "level.toml:6: sensor 's': half_extent_m 25 at resolution_m 0.05 makes 6 x 1001 x "
+            "1001 = 6012006 samples a scan, over sample_budget 2000000");
+  // The budget is the level's to raise.
+  EXPECT_EQ(Error("type = \"face\"\nresolution_m = 0.05\nsample_budget = 6100000\n"), "no error");
   EXPECT_EQ(Error("type = \"face\"\nresolutoin_m = 0.5\n"),
             "level.toml:9: sensor 's': unknown key 'resolutoin_m' for a face sensor");
   EXPECT_EQ(Error("type = \"face\"\nrefresh = 6\n"),
