@@ -2,8 +2,11 @@
 // own BVH) and of Embree on the same triangles, same rays, same thread count,
 // run in the same process; plus hit/miss mismatches and the largest hit-point
 // difference between the two. Scenes: the sample level and a generated
-// 1M-triangle level. Ray sets: a full face scan (15,606 rays), lidar sweeps of
-// 16 x 1024 and 64 x 2048.
+// 1M-triangle level and, where ../shared/assets is, its Quake 3 map. Ray
+// sets: a full face scan (15,606 rays) cast as a bag of rays and by the
+// structured kernel ("face, grid": RayCaster::CastGrids), lidar sweeps of
+// 16 x 1024 and 64 x 2048; and on the sample level the high-resolution face
+// scan (6 x 501 x 501 at 0.1 m) with the face scanner's whole scans a second.
 //
 //   bench_rays [--seconds S]   (time per measurement, default 0.3)
 
@@ -421,6 +424,38 @@ void RunLevel(const char* name, const fs::path& file, const Eigen::Isometry3d& X
   Compare(name, "lidar 64x2048", world, embree, lidar64.Rays(X_WS, X_WS), seconds, show);
 }
 
+// The high-resolution face scan (six faces of 501 x 501 at 0.1 m, 1.5 million
+// samples) on the sample level: both kernels against Embree, then whole scans
+// a second by the face scanner (kernel, occupancy and world points) on 1 and 2
+// threads.
+void RunHighResolution(const fs::path& file, const Eigen::Isometry3d& X_WS, double seconds) {
+  const scene::Level level = scene::LoadLevel(file);
+  const scene::CollisionWorld world(level);
+  const EmbreeScene fast(world, false), watertight(world, true);
+  sensors::FaceScannerConfig config;
+  config.refresh = sensors::Refresh::kFull;
+  config.resolution_m = 0.1;
+  const sensors::FaceScanner face(config);
+  sensors::RayBatch rays;
+  std::vector<sensors::RayGrid> grids;
+  rays.origin_W = X_WS.translation();
+  for (const auto& part : face.DueAt(0)) {
+    grids.push_back(face.GridOf(part, X_WS, rays.size()));
+    face.AppendRays(part, X_WS, &rays);
+  }
+  Compare("sample", "face 501^2", world, {fast, watertight}, rays, seconds, 0);
+  Compare("sample", "501^2, grid", world, {fast, watertight}, rays, seconds, 0, &grids);
+  for (const int threads : {1, 2}) {
+    sensors::RayCaster caster(threads);
+    sensors::FaceScan scan;
+    const double rate =
+        CallsPerSecond(seconds, [&] { face.Scan(world, caster, {}, X_WS, 0, &scan); });
+    std::printf(
+        "face scanner, 6 x 501 x 501 full scans, %d thread%s: %.1f scans/s (%.0f Msample/s)\n",
+        threads, threads == 1 ? "" : "s", rate, rate * double(rays.size()) / 1e6);
+  }
+}
+
 // "x,y,z[,yaw_deg]" as a pose.
 bool ParsePose(const char* text, Eigen::Isometry3d* X_WS) {
   double v[4] = {0, 0, 0, 0};
@@ -484,14 +519,24 @@ int main(int argc, char** argv) {
       const std::string name = fs::path(level).stem().string().substr(0, 12);
       RunLevel(name.c_str(), level, X_WS, face_case, seconds, show);
     } else {
-      RunLevel("sample", fs::path(SANDBOX_SOURCE_DIR) / "assets/sample/level.toml",
-               Eigen::Translation3d(20, -25, 22) * Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()),
-               face_case, seconds, show);
+      const fs::path sample = fs::path(SANDBOX_SOURCE_DIR) / "assets/sample/level.toml";
+      const Eigen::Isometry3d over_valley(Eigen::Translation3d(20, -25, 22) *
+                                          Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()));
+      RunLevel("sample", sample, over_valley, face_case, seconds, show);
+      RunHighResolution(sample, over_valley, std::max(seconds, 1.0));
       const fs::path dir = fs::temp_directory_path() / "sandbox-bench-rays";
       const fs::path million = bench::WriteMillionTriangleLevel(dir);
       RunLevel("1M-triangle", million, Eigen::Isometry3d(Eigen::Translation3d(500, 250, 8)),
                face_case, seconds, show);
       fs::remove_all(dir);
+      // The Quake 3 map of ../shared/assets (beside the repository on the
+      // development machines), scanned from the middle of its box.
+      const fs::path q3 = fs::path(SANDBOX_SHARED_ASSETS) / "q3-de4th-run1/de4th_run1.pk3";
+      if (fs::exists(q3)) {
+        const Eigen::Vector3d middle = scene::LoadLevel(q3).bounds_W().center();
+        RunLevel("quake3-map", q3, Eigen::Isometry3d(Eigen::Translation3d(middle)), face_case,
+                 seconds, show);
+      }
     }
   } catch (const std::exception& error) {
     std::fprintf(stderr, "bench_rays: %s\n", error.what());
