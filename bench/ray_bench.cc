@@ -393,11 +393,7 @@ void RunLevel(const char* name, const fs::path& file, const Eigen::Isometry3d& X
   const sensors::FaceScanner face(face_config);
   sensors::RayBatch face_rays;
   std::vector<sensors::RayGrid> face_grids;
-  face_rays.origin_W = X_WS.translation();
-  for (const auto& part : face.DueAt(0)) {
-    face_grids.push_back(face.GridOf(part, X_WS, face_rays.size()));
-    face.AppendRays(part, X_WS, &face_rays);
-  }
+  face.GridRays(0, X_WS, &face_rays, &face_grids);
   if (std::getenv("PROF_GRID")) {
     sensors::RayCaster caster(1);
     sensors::RayHits ours;
@@ -438,11 +434,7 @@ void RunHighResolution(const fs::path& file, const Eigen::Isometry3d& X_WS, doub
   const sensors::FaceScanner face(config);
   sensors::RayBatch rays;
   std::vector<sensors::RayGrid> grids;
-  rays.origin_W = X_WS.translation();
-  for (const auto& part : face.DueAt(0)) {
-    grids.push_back(face.GridOf(part, X_WS, rays.size()));
-    face.AppendRays(part, X_WS, &rays);
-  }
+  face.GridRays(0, X_WS, &rays, &grids);
   Compare("sample", "face 501^2", world, {fast, watertight}, rays, seconds, 0);
   Compare("sample", "501^2, grid", world, {fast, watertight}, rays, seconds, 0, &grids);
   for (const int threads : {1, 2}) {

@@ -148,6 +148,17 @@ RayGrid FaceScanner::GridOf(const Part& part, const Eigen::Isometry3d& X_WS,
   return grid;
 }
 
+void FaceScanner::GridRays(std::int64_t tick, const Eigen::Isometry3d& X_WS, RayBatch* rays,
+                           std::vector<RayGrid>* grids) const {
+  rays->origin_W = X_WS.translation();
+  rays->start.clear(), rays->direction.clear(), rays->length_m.clear();
+  grids->clear();
+  for (const Part& part : DueAt(tick)) {
+    grids->push_back(GridOf(part, X_WS, rays->size()));
+    AppendRays(part, X_WS, rays);
+  }
+}
+
 void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
                        const RayFilter& filter, const Eigen::Isometry3d& X_WS, std::int64_t tick,
                        FaceScan* scan) const {
@@ -159,14 +170,8 @@ void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
   thread_local RayBatch rays;
   thread_local RayHits hits;
   hits.with_normals = false;
-  rays.origin_W = X_WS.translation();
-  rays.start.clear(), rays.direction.clear(), rays.length_m.clear();
   thread_local std::vector<RayGrid> grids;
-  grids.clear();
-  for (const Part& part : parts) {
-    grids.push_back(GridOf(part, X_WS, rays.size()));
-    AppendRays(part, X_WS, &rays);
-  }
+  GridRays(tick, X_WS, &rays, &grids);
   caster.CastGrids(world, rays, grids, filter, &hits);
   // Write each part's results back into its face.
   std::size_t i = 0;

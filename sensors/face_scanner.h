@@ -119,6 +119,10 @@ class FaceScanner {
   // The grid those rays form (RayCaster::CastGrids), `first` being the index
   // of the part's first ray in the batch.
   RayGrid GridOf(const Part& part, const Eigen::Isometry3d& X_WS, std::size_t first) const;
+  // The rays of every part due at `tick` from X_WS (a fresh batch at the
+  // sensor position) and their grids.
+  void GridRays(std::int64_t tick, const Eigen::Isometry3d& X_WS, RayBatch* rays,
+                std::vector<RayGrid>* grids) const;
 
  private:
   FaceScannerConfig config_;

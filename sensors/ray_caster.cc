@@ -230,6 +230,24 @@ bool WalkTarget(const Target& target, const Eigen::Vector3f& o_B, const Eigen::V
   return hit;
 }
 
+// Sizes `hits` for n rays (normals only when asked for).
+void SizeHits(std::size_t n, RayHits* hits) {
+  hits->distance_m.resize(n);
+  hits->normal_W.resize(hits->with_normals ? n : 0);
+  hits->body.resize(n);
+}
+
+// Whether a filter lets rays see an object.
+struct Visible {
+  const RayFilter& filter;
+  int num_actors;
+  bool operator()(const Target& t) const {
+    return (t.group & filter.group_mask) != 0 &&
+           !(filter.ignore_actor >= 0 && t.body == filter.ignore_actor) &&
+           !(filter.ignore_robot >= 0 && t.body == num_actors + filter.ignore_robot);
+  }
+};
+
 // Ray r's result: its distance, the body hit and, when asked for, the unit
 // normal facing the ray (zero without a hit).
 inline void WriteHit(std::size_t r, float t, int body, const Eigen::Vector3f& normal,
@@ -657,19 +675,12 @@ void RayCaster::Cast(const scene::CollisionWorld& world, const RayBatch& rays,
                      const RayFilter& filter, RayHits* hits) {
   const std::size_t n = rays.size();
   rays_cast_ += std::int64_t(n);
-  hits->distance_m.resize(n);
-  hits->normal_W.resize(hits->with_normals ? n : 0);
-  hits->body.resize(n);
+  SizeHits(n, hits);
   if (n == 0) return;
   // The batch in Bullet's frame (world minus the floating origin).
   const Eigen::Vector3f origin_B = (rays.origin_W - world.origin()).cast<float>();
   const std::vector<Target>& all_targets = TargetsOf(world).all;
-  const int num_actors = world.internals().num_actors;
-  auto wanted = [&filter, num_actors](const Target& t) {
-    return (t.group & filter.group_mask) != 0 &&
-           !(filter.ignore_actor >= 0 && t.body == filter.ignore_actor) &&
-           !(filter.ignore_robot >= 0 && t.body == num_actors + filter.ignore_robot);
-  };
+  const Visible wanted{filter, world.internals().num_actors};
 
   const std::function<void(int)> job = [&](int chunk) {
     const std::size_t first = std::size_t(chunk) * kRaysPerChunk;
@@ -796,18 +807,11 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
   Cast(world, rays, filter, hits);
 #else
   rays_cast_ += std::int64_t(n);
-  hits->distance_m.resize(n);
-  hits->normal_W.resize(hits->with_normals ? n : 0);
-  hits->body.resize(n);
+  SizeHits(n, hits);
   if (n == 0) return;
   const Eigen::Vector3f origin_B = (rays.origin_W - world.origin()).cast<float>();
   const std::vector<Target>& all_targets = TargetsOf(world).all;
-  const int num_actors = world.internals().num_actors;
-  auto wanted = [&filter, num_actors](const Target& t) {
-    return (t.group & filter.group_mask) != 0 &&
-           !(filter.ignore_actor >= 0 && t.body == filter.ignore_actor) &&
-           !(filter.ignore_robot >= 0 && t.body == num_actors + filter.ignore_robot);
-  };
+  const Visible wanted{filter, world.internals().num_actors};
   // Bands of rows, each a chunk of work: four a thread over all blocks
   // (each band walks the BVH from its root), at least four rows each.
   struct Band {

@@ -51,11 +51,7 @@ TEST(StructuredScanSharedAssetsTest, SameHitsAsTheGeneralCasterInEveryModel) {
           q.normalized();
       RayBatch rays;
       std::vector<RayGrid> grids;
-      rays.origin_W = X_WS.translation();
-      for (const FaceScanner::Part& part : scanner.DueAt(0)) {
-        grids.push_back(scanner.GridOf(part, X_WS, rays.size()));
-        scanner.AppendRays(part, X_WS, &rays);
-      }
+      scanner.GridRays(0, X_WS, &rays, &grids);
       RayCaster caster(2);
       RayHits general, structured;
       caster.Cast(world, rays, {}, &general);

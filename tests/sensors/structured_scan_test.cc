@@ -34,11 +34,7 @@ Difference CompareKernels(const scene::CollisionWorld& world, const FaceScannerC
   const FaceScanner scanner(full);
   RayBatch rays;
   std::vector<RayGrid> grids;
-  rays.origin_W = X_WS.translation();
-  for (const FaceScanner::Part& part : scanner.DueAt(0)) {
-    grids.push_back(scanner.GridOf(part, X_WS, rays.size()));
-    scanner.AppendRays(part, X_WS, &rays);
-  }
+  scanner.GridRays(0, X_WS, &rays, &grids);
   RayCaster caster(2);
   RayHits general, structured;
   caster.Cast(world, rays, filter, &general);
