@@ -11,6 +11,7 @@
 #include "sandbox_msgs/range_t.hpp"
 #include "sandbox_msgs/robot_pose_t.hpp"
 #include "sandbox_msgs/robot_state_t.hpp"
+#include "sandbox_msgs/scan_face_compact_t.hpp"
 #include "sandbox_msgs/scan_face_t.hpp"
 #include "sandbox_msgs/status_t.hpp"
 #include "sandbox_msgs/wrench_t.hpp"
@@ -155,6 +156,12 @@ void Layout(const scan_face_t*, WireReader& r) {
   r.Array(r.Count("num_xyz"), 4, "xyz");
 }
 
+void Layout(const scan_face_compact_t*, WireReader& r) {
+  r.Fixed(8 * 5 + 1 + 4 + 8 * 13 + 1, "the header");
+  r.Array(r.Count("num_mm"), 2, "distance_mm");
+  r.Array(r.Count("num_m"), 4, "distance_m");
+}
+
 void Layout(const status_t*, WireReader& r) {
   r.Fixed(8 * 5, "the header");
   const std::int64_t channels = r.Count("num_channels");
@@ -204,6 +211,7 @@ SANDBOX_CHECKED_DECODE(range_t)
 SANDBOX_CHECKED_DECODE(robot_pose_t)
 SANDBOX_CHECKED_DECODE(robot_state_t)
 SANDBOX_CHECKED_DECODE(scan_face_t)
+SANDBOX_CHECKED_DECODE(scan_face_compact_t)
 SANDBOX_CHECKED_DECODE(status_t)
 SANDBOX_CHECKED_DECODE(wrench_t)
 

@@ -3,10 +3,12 @@
 #include <map>
 #include <variant>
 
+#include "bridge/face_points.h"
 #include "sandbox_msgs/ground_map_t.hpp"
 #include "sandbox_msgs/lidar_scan_t.hpp"
 #include "sandbox_msgs/range_t.hpp"
 #include "sandbox_msgs/robot_state_t.hpp"
+#include "sandbox_msgs/scan_face_compact_t.hpp"
 #include "sandbox_msgs/scan_face_t.hpp"
 #include "sandbox_msgs/status_t.hpp"
 
@@ -89,6 +91,14 @@ void PublishOutput(const sensors::FaceScan& scan, const Header& header, Send&& s
   for (int f = 0; f < 6; ++f) {
     const sensors::ScanFace& face = scan.faces[std::size_t(f)];
     if (face.tick != header.tick) continue;  // only the faces this tick refreshed
+    if (scan.encoding != sensors::FaceEncoding::kPoints) {
+      sandbox_msgs::scan_face_compact_t message{};
+      header.Stamp(&message);
+      message.tick = header.tick;
+      EncodeCompactFace(scan, f, &message);
+      send(message);
+      continue;
+    }
     sandbox_msgs::scan_face_t message{};
     header.Stamp(&message);
     message.tick = header.tick;

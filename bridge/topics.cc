@@ -15,6 +15,7 @@
 #include "sandbox_msgs/range_t.hpp"
 #include "sandbox_msgs/robot_pose_t.hpp"
 #include "sandbox_msgs/robot_state_t.hpp"
+#include "sandbox_msgs/scan_face_compact_t.hpp"
 #include "sandbox_msgs/scan_face_t.hpp"
 #include "sandbox_msgs/status_t.hpp"
 #include "sandbox_msgs/wrench_t.hpp"
@@ -34,6 +35,7 @@ std::string TypeOf(const std::uint8_t* data, std::uint32_t size) {
       {actor_placements_t::getHash(), "actor_placements_t"},
       {camera_command_t::getHash(), "camera_command_t"},
       {scan_face_t::getHash(), "scan_face_t"},
+      {scan_face_compact_t::getHash(), "scan_face_compact_t"},
       {ground_map_t::getHash(), "ground_map_t"},
       {lidar_scan_t::getHash(), "lidar_scan_t"},
       {range_t::getHash(), "range_t"},

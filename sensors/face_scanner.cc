@@ -8,17 +8,6 @@
 namespace sandbox::sensors {
 namespace {
 
-// In-plane axes (u, v) of each face, in the sensor frame.
-void FaceFrame(int face, Eigen::Vector3d* u, Eigen::Vector3d* v) {
-  if (face < 2) {
-    *u = Eigen::Vector3d::UnitY(), *v = Eigen::Vector3d::UnitZ();
-  } else if (face < 4) {
-    *u = Eigen::Vector3d::UnitX(), *v = Eigen::Vector3d::UnitZ();
-  } else {
-    *u = Eigen::Vector3d::UnitX(), *v = Eigen::Vector3d::UnitY();
-  }
-}
-
 std::string Format(double value) {
   std::ostringstream out;
   out.precision(12);
@@ -27,6 +16,16 @@ std::string Format(double value) {
 }
 
 }  // namespace
+
+void FaceGridAxes(int face, Eigen::Vector3d* u, Eigen::Vector3d* v) {
+  if (face < 2) {
+    *u = Eigen::Vector3d::UnitY(), *v = Eigen::Vector3d::UnitZ();
+  } else if (face < 4) {
+    *u = Eigen::Vector3d::UnitX(), *v = Eigen::Vector3d::UnitZ();
+  } else {
+    *u = Eigen::Vector3d::UnitX(), *v = Eigen::Vector3d::UnitY();
+  }
+}
 
 Eigen::Vector3d FaceAxis(int face) {
   Eigen::Vector3d axis = Eigen::Vector3d::Zero();
@@ -72,10 +71,14 @@ FaceScanner::FaceScanner(const FaceScannerConfig& config) : config_(config) {
 FaceScan FaceScanner::EmptyScan() const {
   FaceScan scan;
   scan.n = n_;
+  scan.resolution_m = config_.resolution_m;
+  scan.half_extent_m = config_.half_extent_m;
+  scan.encoding = config_.encoding;
   const Eigen::Vector3d nan = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   for (ScanFace& face : scan.faces) {
     face.occupancy.assign(std::size_t(n_) * std::size_t(n_), kUnvisited);
     face.points_W.assign(std::size_t(n_) * std::size_t(n_), nan);
+    face.distance_m.assign(std::size_t(n_) * std::size_t(n_), nan.x());
   }
   return scan;
 }
@@ -108,7 +111,7 @@ void FaceScanner::AppendRays(const Part& part, const Eigen::Isometry3d& X_WS,
                                    ? Eigen::Matrix3d(X_WS.linear())
                                    : Eigen::Matrix3d::Identity();
   Eigen::Vector3d u, v;
-  FaceFrame(part.face, &u, &v);
+  FaceGridAxes(part.face, &u, &v);
   const Eigen::Vector3f axis_W = (R_WS * FaceAxis(part.face)).cast<float>();
   const Eigen::Vector3d u_W = R_WS * u, v_W = R_WS * v;
   const double E = config_.half_extent_m, res = config_.resolution_m;
@@ -136,7 +139,7 @@ RayGrid FaceScanner::GridOf(const Part& part, const Eigen::Isometry3d& X_WS,
                                    ? Eigen::Matrix3d(X_WS.linear())
                                    : Eigen::Matrix3d::Identity();
   Eigen::Vector3d u, v;
-  FaceFrame(part.face, &u, &v);
+  FaceGridAxes(part.face, &u, &v);
   const double E = config_.half_extent_m, res = config_.resolution_m;
   RayGrid grid;
   grid.first = first;
@@ -184,6 +187,7 @@ void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
       for (int c = 0; c < n_; ++c, ++i) {
         const std::size_t k = std::size_t(r) * std::size_t(n_) + std::size_t(c);
         face.occupancy[k] = hits.body[i] == RayHits::kNoHit ? kFree : kOccupied;
+        face.distance_m[k] = hits.distance_m[i];
         face.points_W[k] =
             rays.origin_W + (rays.start[i] + hits.distance_m[i] * rays.direction[i]).cast<double>();
       }
@@ -212,6 +216,16 @@ FaceScannerConfig FaceScannerConfig::Read(scene::SettingsReader& read) {
     read.Fail("aligned", "'aligned' must be body or world, got '" + aligned + "'");
   }
   face.alignment = aligned == "body" ? Alignment::kBody : Alignment::kWorld;
+  const std::string encoding = read.Text("encoding", "points");
+  if (encoding == "points") {
+    face.encoding = FaceEncoding::kPoints;
+  } else if (encoding == "mm") {
+    face.encoding = FaceEncoding::kMillimetres;
+  } else if (encoding == "float") {
+    face.encoding = FaceEncoding::kFloat;
+  } else {
+    read.Fail("encoding", "'encoding' must be points, mm or float, got '" + encoding + "'");
+  }
   return face;
 }
 
@@ -219,6 +233,8 @@ std::string FaceScannerConfig::Summary() const {
   std::ostringstream out;
   const int n = points_per_side();
   out << n << "x" << n << "x6 at " << resolution_m << " m";
+  if (encoding == FaceEncoding::kMillimetres) out << ", compact in mm";
+  if (encoding == FaceEncoding::kFloat) out << ", compact in float";
   return out.str();
 }
 

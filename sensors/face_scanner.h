@@ -34,6 +34,11 @@ enum class Alignment {
   kWorld,  // the box keeps the world axes (only the sensor position counts)
 };
 
+// How a face scanner's faces are published (docs/bridge.md): as points
+// (scan_face_t, three floats a sample) or compact (scan_face_compact_t, a
+// distance a grid cell, in 16-bit millimetres or float metres).
+enum class FaceEncoding { kPoints, kMillimetres, kFloat };
+
 struct FaceScannerConfig {
   double resolution_m{1.0};
   double half_extent_m{25.0};
@@ -42,6 +47,7 @@ struct FaceScannerConfig {
   // The most samples (6 n^2) a scan may have: a finer or larger grid is
   // refused at load. The default admits 6 x 501 x 501 (25 m at 0.1 m).
   double sample_budget{2e6};
+  FaceEncoding encoding{FaceEncoding::kPoints};
 
   // Throws std::invalid_argument naming the field and its value: a resolution
   // or half extent that is not positive and finite, a half extent that is not
@@ -64,11 +70,15 @@ struct ScanFace {
   Eigen::Isometry3d X_WB{Eigen::Isometry3d::Identity()};  // the box of that scan (BoxFrame)
   std::vector<std::int8_t> occupancy;                     // n * n, Occupancy
   std::vector<Eigen::Vector3d> points_W;  // n * n: the hit, or the ray's end when free
+  std::vector<float> distance_m;  // n * n: from the ray's start along the face axis; NaN unvisited
 };
 
 struct FaceScan {
   int n{0};
   std::array<ScanFace, 6> faces;
+  // The grid and how it is to be published (the scanner's config).
+  double resolution_m{1.0}, half_extent_m{25.0};
+  FaceEncoding encoding{FaceEncoding::kPoints};
 };
 
 // Face f's frame in the world: the box it was last scanned in.
@@ -131,5 +141,7 @@ class FaceScanner {
 
 // Face axes in the sensor frame, in face order.
 Eigen::Vector3d FaceAxis(int face);
+// Face f's grid axes (u: columns, v: rows) in the box frame.
+void FaceGridAxes(int face, Eigen::Vector3d* u, Eigen::Vector3d* v);
 
 }  // namespace sandbox::sensors

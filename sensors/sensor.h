@@ -82,7 +82,7 @@ struct MountedSensor {
 
 // Every robot's sensors. Throws scene::LevelError naming the manifest, the line,
 // the sensor and the setting: an unknown type or key, a wrong type, a value its
-// config rejects (zero or negative resolution, more than 10 million rays, ...).
+// config rejects (zero or negative resolution, a grid over its sample budget, ...).
 std::vector<MountedSensor> MakeRobotSensors(const scene::Level& level);
 
 // One sensor, made once; Run fills its output in place (a face scan keeps the

@@ -21,6 +21,7 @@
 #include "sandbox_msgs/range_t.hpp"
 #include "sandbox_msgs/robot_pose_t.hpp"
 #include "sandbox_msgs/robot_state_t.hpp"
+#include "sandbox_msgs/scan_face_compact_t.hpp"
 #include "sandbox_msgs/scan_face_t.hpp"
 #include "sandbox_msgs/status_t.hpp"
 #include "sandbox_msgs/wrench_t.hpp"
@@ -95,6 +96,9 @@ struct Samples {
     face.n = 2, face.num_points = 4, face.occupancy = {-1, 0, 1, 1};
     face.num_xyz = 12, face.xyz.assign(12, 2.0f);
     Add("scan_face_t", face);
+    scan_face_compact_t compact{};
+    compact.n = 2, compact.encoding = 1, compact.num_mm = 4, compact.distance_mm = {1, -1, -2, 7};
+    Add("scan_face_compact_t", compact);
     status_t status{};
     status.num_channels = 2;
     status.channels = {"ELAHA/POSE", "ELAHA/BONES"};
@@ -140,6 +144,7 @@ Decoded Decode(const std::string& type, const std::uint8_t* data, std::size_t si
       {"range_t", DecodeAs<range_t>},
       {"robot_state_t", DecodeAs<robot_state_t>},
       {"scan_face_t", DecodeAs<scan_face_t>},
+      {"scan_face_compact_t", DecodeAs<scan_face_compact_t>},
       {"status_t", DecodeAs<status_t>},
       {"wrench_t", DecodeAs<wrench_t>}};
   return decoders.at(type)(data, size);

@@ -6,12 +6,18 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
 
+#include "bridge/face_points.h"
 #include "bridge/lcm_link.h"
 #include "sandbox_msgs/ground_map_t.hpp"
 #include "sandbox_msgs/lidar_scan_t.hpp"
 #include "sandbox_msgs/range_t.hpp"
 #include "sandbox_msgs/robot_state_t.hpp"
+#include "sandbox_msgs/scan_face_compact_t.hpp"
 #include "sandbox_msgs/scan_face_t.hpp"
 #include "scene/collision_world.h"
 #include "scene/level.h"
@@ -242,6 +248,157 @@ TEST(RobotOutputsTest, ChannelMistakesAreNamed) {
         std::string(error.what()).find("'channel' must be a name without spaces, got 'MY SCAN'"),
         std::string::npos)
         << error.what();
+  }
+}
+
+}  // namespace
+}  // namespace sandbox::bridge
+
+namespace sandbox::bridge {
+namespace {
+
+// A full scan of the sample level from above the valley, in `encoding`.
+sensors::FaceScan SampleScan(sensors::FaceEncoding encoding, double resolution_m,
+                             double half_extent_m, const Eigen::Isometry3d& X_WS) {
+  const scene::Level level = scene::LoadLevel(testing::SampleLevel());
+  const scene::CollisionWorld world(level);
+  sensors::FaceScannerConfig config;
+  config.refresh = sensors::Refresh::kFull;
+  config.resolution_m = resolution_m;
+  config.half_extent_m = half_extent_m;
+  config.encoding = encoding;
+  const sensors::FaceScanner scanner(config);
+  sensors::RayCaster caster(1);
+  sensors::FaceScan scan = scanner.EmptyScan();
+  scanner.Scan(world, caster, {}, X_WS, 7, &scan);
+  return scan;
+}
+
+TEST(CompactFaceTest, DecodedPointsAreTheScannersPoints) {
+  const Eigen::Isometry3d X_WS(Eigen::Translation3d(20, -25, 22) *
+                               Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()) *
+                               Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX()));
+  for (const auto& [encoding, tolerance_m] :
+       {std::pair{sensors::FaceEncoding::kMillimetres, 0.5e-3 + 1e-5},
+        std::pair{sensors::FaceEncoding::kFloat, 1e-5}}) {
+    const sensors::FaceScan scan = SampleScan(encoding, 0.5, 25.0, X_WS);
+    int occupied = 0, free = 0;
+    double worst_m = 0.0;
+    for (int f = 0; f < 6; ++f) {
+      sandbox_msgs::scan_face_compact_t message{};
+      EncodeCompactFace(scan, f, &message);
+      const FacePoints decoded = DecodeCompactFace(message);
+      const sensors::ScanFace& face = scan.faces[std::size_t(f)];
+      ASSERT_EQ(decoded.occupancy, face.occupancy) << "face " << f;
+      for (std::size_t k = 0; k < face.points_W.size(); ++k) {
+        worst_m = std::max(worst_m, (decoded.points_W[k] - face.points_W[k]).norm());
+        occupied += face.occupancy[k] == sensors::kOccupied;
+        free += face.occupancy[k] == sensors::kFree;
+      }
+    }
+    EXPECT_LE(worst_m, tolerance_m);
+    EXPECT_GT(occupied, 5000);  // the valley below and beside
+    EXPECT_GT(free, 5000);      // the sky
+  }
+}
+
+TEST(CompactFaceTest, DistancesBeyondTheMillimetreRangeAreMarkedNeverWrapped) {
+  // 90 m above the ground with a 100 m box: the ground below is beyond 65.532 m.
+  const sensors::FaceScan scan = SampleScan(sensors::FaceEncoding::kMillimetres, 10.0, 100.0,
+                                            Eigen::Isometry3d(Eigen::Translation3d(0, 0, 100)));
+  sandbox_msgs::scan_face_compact_t message{};
+  EncodeCompactFace(scan, 5, &message);  // -Z
+  const sensors::ScanFace& face = scan.faces[5];
+  int beyond = 0;
+  for (std::size_t k = 0; k < face.distance_m.size(); ++k) {
+    const auto code = std::uint16_t(message.distance_mm[k]);
+    if (face.occupancy[k] != sensors::kOccupied) continue;
+    if (face.distance_m[k] > 65.5325f) {
+      EXPECT_EQ(code, kBeyondMm) << k;
+      ++beyond;
+    } else {
+      EXPECT_NEAR(1e-3 * code, face.distance_m[k], 0.5e-3) << k;
+    }
+  }
+  EXPECT_GT(beyond, 100);
+  const FacePoints decoded = DecodeCompactFace(message);
+  for (std::size_t k = 0; k < face.distance_m.size(); ++k) {
+    if (std::uint16_t(message.distance_mm[k]) != kBeyondMm) continue;
+    EXPECT_EQ(decoded.occupancy[k], sensors::kOccupied);
+    EXPECT_TRUE(std::isnan(decoded.points_W[k].x()));
+  }
+}
+
+TEST(CompactFaceTest, AScannerWithACompactEncodingPublishesCompactFaces) {
+  LcmLink link("memq://");
+  LatestInput subscriber(link, "W/SCAN_FACE");
+  RobotOutputs outputs(link, "W");
+  const sensors::FaceScan scan = SampleScan(sensors::FaceEncoding::kFloat, 1.0, 25.0,
+                                            Eigen::Isometry3d(Eigen::Translation3d(20, -25, 22)));
+  outputs.Publish(scan, {"scanner", "SCAN_FACE"}, 7, InputTag{9, 900}, 1000);
+  link.Drain();
+  EXPECT_EQ(outputs.published(), 6);
+  sandbox_msgs::scan_face_compact_t message;
+  ASSERT_TRUE(Newest(subscriber, &message));
+  EXPECT_EQ(message.face, 5);
+  EXPECT_EQ(message.tick, 7);
+  EXPECT_EQ(message.input_seq, 9);
+  EXPECT_EQ(message.encoding, 2);
+  EXPECT_EQ(message.num_mm, 0);
+  ASSERT_EQ(message.num_m, 51 * 51);
+  EXPECT_EQ(message.resolution_m, 1.0);
+  EXPECT_EQ(message.half_extent_m, 25.0);
+  // 51 x 51 floats and a header: under a third of the points message's 13
+  // bytes a sample (in millimetres: under a sixth).
+  EXPECT_LT(message.getEncodedSize(), 51 * 51 * 13 / 3);
+}
+
+// examples/scan_face_points.m, run by Octave on a message the sandbox
+// encoded, gives the scanner's own points (and occupancy).
+TEST(CompactFaceTest, TheOctaveFunctionGivesTheScannersPoints) {
+  if (std::system("command -v octave > /dev/null 2>&1") != 0) GTEST_SKIP() << "no octave";
+  if (!std::filesystem::exists(SANDBOX_MSGS_JAR)) GTEST_SKIP() << "no " << SANDBOX_MSGS_JAR;
+  testing::TempDir dir;
+  const sensors::FaceScan scan = SampleScan(sensors::FaceEncoding::kMillimetres, 2.0, 20.0,
+                                            Eigen::Translation3d(-30, 10, 18) *
+                                                Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()) *
+                                                Eigen::AngleAxisd(-0.3, Eigen::Vector3d::UnitY()));
+  for (const int f : {0, 3, 5}) {
+    sandbox_msgs::scan_face_compact_t message{};
+    EncodeCompactFace(scan, f, &message);
+    std::vector<std::uint8_t> bytes(std::size_t(message.getEncodedSize()));
+    message.encode(bytes.data(), 0, int(bytes.size()));
+    const auto in = dir.path() / "face.lcm", out = dir.path() / "points.txt";
+    std::ofstream(in, std::ios::binary)
+        .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    const std::string script =
+        "javaaddpath('/usr/share/java/lcm.jar'); javaaddpath('" SANDBOX_MSGS_JAR
+        "'); "
+        "addpath('" SANDBOX_SOURCE_DIR
+        "/examples'); "
+        "msg = javaObject('sandbox_msgs.scan_face_compact_t', javaObject("
+        "'java.io.DataInputStream', javaObject('java.io.FileInputStream', '" +
+        in.string() + "'))); [p, o] = scan_face_points(msg); dlmwrite('" + out.string() +
+        "', [p, o], 'precision', '%.9g');";
+    ASSERT_EQ(std::system(("octave --no-gui --quiet --eval \"" + script + "\" > " +
+                           (dir.path() / "octave.log").string() + " 2>&1")
+                              .c_str()),
+              0)
+        << "face " << f << ": see " << (dir.path() / "octave.log");
+    const sensors::ScanFace& face = scan.faces[std::size_t(f)];
+    std::ifstream rows(out);
+    std::string line;
+    std::size_t k = 0;
+    double worst_m = 0.0;
+    while (std::getline(rows, line) && k < face.points_W.size()) {
+      double x, y, z, occupancy;
+      ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf", &x, &y, &z, &occupancy), 4) << line;
+      EXPECT_EQ(int(occupancy), int(face.occupancy[k])) << "face " << f << ", point " << k;
+      worst_m = std::max(worst_m, (Eigen::Vector3d(x, y, z) - face.points_W[k]).norm());
+      ++k;
+    }
+    EXPECT_EQ(k, face.points_W.size()) << "face " << f;
+    EXPECT_LE(worst_m, 0.5e-3 + 1e-5) << "face " << f;
   }
 }
 

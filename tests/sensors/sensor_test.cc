@@ -206,6 +206,8 @@ TEST(SensorTest, MistakesNameTheSensorAndField) {
   EXPECT_EQ(Error("type = \"face\"\nresolution_m = 0.05\n"),
             "level.toml:6: sensor 's': half_extent_m 25 at resolution_m 0.05 makes 6 x 1001 x "
             "1001 = 6012006 samples a scan, over sample_budget 2000000");
+  EXPECT_EQ(Error("type = \"face\"\nencoding = \"mm16\"\n"),
+            "level.toml:9: sensor 's': 'encoding' must be points, mm or float, got 'mm16'");
   // The budget is the level's to raise.
   EXPECT_EQ(Error("type = \"face\"\nresolution_m = 0.05\nsample_budget = 6100000\n"), "no error");
   EXPECT_EQ(Error("type = \"face\"\nresolutoin_m = 0.5\n"),

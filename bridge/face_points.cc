@@ -1,0 +1,104 @@
+#include "bridge/face_points.h"
+
+#include <cmath>
+#include <limits>
+
+namespace sandbox::bridge {
+namespace {
+
+void Quaternion(const Eigen::Matrix3d& R, double wxyz[4]) {
+  const Eigen::Quaterniond q(R);
+  wxyz[0] = q.w(), wxyz[1] = q.x(), wxyz[2] = q.y(), wxyz[3] = q.z();
+}
+
+}  // namespace
+
+void EncodeCompactFace(const sensors::FaceScan& scan, int f,
+                       sandbox_msgs::scan_face_compact_t* message) {
+  const sensors::ScanFace& face = scan.faces[std::size_t(f)];
+  message->face = std::int8_t(f);
+  message->n = scan.n;
+  message->resolution_m = scan.resolution_m;
+  message->half_extent_m = scan.half_extent_m;
+  for (int k = 0; k < 3; ++k) message->sensor_position[k] = face.X_WS.translation()[k];
+  Quaternion(face.X_WS.linear(), message->sensor_orientation);
+  Quaternion(face.X_WB.linear(), message->box_orientation);
+  const std::size_t cells = face.distance_m.size();
+  message->num_mm = 0, message->num_m = 0;
+  message->distance_mm.clear(), message->distance_m.clear();
+  if (scan.encoding == sensors::FaceEncoding::kFloat) {
+    message->encoding = 2;
+    message->num_m = int(cells);
+    message->distance_m.resize(cells);
+    for (std::size_t k = 0; k < cells; ++k) {
+      const std::int8_t occupancy = face.occupancy[k];
+      message->distance_m[k] = occupancy == sensors::kOccupied ? face.distance_m[k]
+                               : occupancy == sensors::kFree
+                                   ? std::numeric_limits<float>::infinity()
+                                   : std::numeric_limits<float>::quiet_NaN();
+    }
+    return;
+  }
+  message->encoding = 1;
+  message->num_mm = int(cells);
+  message->distance_mm.resize(cells);
+  for (std::size_t k = 0; k < cells; ++k) {
+    std::uint16_t code = kUnvisitedMm;
+    if (face.occupancy[k] == sensors::kFree) {
+      code = kFreeMm;
+    } else if (face.occupancy[k] == sensors::kOccupied) {
+      const double mm = std::round(1e3 * double(face.distance_m[k]));
+      code = mm < double(kBeyondMm) ? std::uint16_t(std::max(0.0, mm)) : kBeyondMm;
+    }
+    message->distance_mm[k] = std::int16_t(code);  // LCM has no unsigned types: the bits
+  }
+}
+
+FacePoints DecodeCompactFace(const sandbox_msgs::scan_face_compact_t& message) {
+  const int n = message.n;
+  const double E = message.half_extent_m, res = message.resolution_m;
+  const Eigen::Vector3d p(message.sensor_position[0], message.sensor_position[1],
+                          message.sensor_position[2]);
+  const Eigen::Matrix3d R =
+      Eigen::Quaterniond(message.box_orientation[0], message.box_orientation[1],
+                         message.box_orientation[2], message.box_orientation[3])
+          .normalized()
+          .toRotationMatrix();
+  Eigen::Vector3d u, v;
+  sensors::FaceGridAxes(message.face, &u, &v);
+  const Eigen::Vector3d axis_W = R * sensors::FaceAxis(message.face);
+  const Eigen::Vector3d u_W = R * u, v_W = R * v;
+  const bool millimetres = message.encoding == 1;
+  const std::size_t cells = std::size_t(n) * std::size_t(n);
+  FacePoints out;
+  out.points_W.assign(cells, Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
+  out.occupancy.assign(cells, sensors::kUnvisited);
+  if (std::size_t(millimetres ? message.num_mm : message.num_m) != cells) return out;
+  for (int r = 0; r < n; ++r) {
+    for (int c = 0; c < n; ++c) {
+      const std::size_t k = std::size_t(r) * std::size_t(n) + std::size_t(c);
+      double distance;
+      std::int8_t occupancy = sensors::kOccupied;
+      if (millimetres) {
+        const auto code = std::uint16_t(message.distance_mm[k]);
+        if (code == kUnvisitedMm) continue;
+        if (code == kBeyondMm) {
+          out.occupancy[k] = sensors::kOccupied;  // a hit, but where is not known
+          continue;
+        }
+        occupancy = code == kFreeMm ? sensors::kFree : sensors::kOccupied;
+        distance = code == kFreeMm ? E : 1e-3 * code;
+      } else {
+        const float d = message.distance_m[k];
+        if (std::isnan(d)) continue;
+        occupancy = std::isinf(d) ? sensors::kFree : sensors::kOccupied;
+        distance = std::isinf(d) ? E : double(d);
+      }
+      out.occupancy[k] = occupancy;
+      out.points_W[k] = p + u_W * (-E + c * res) + v_W * (-E + r * res) + axis_W * distance;
+    }
+  }
+  return out;
+}
+
+}  // namespace sandbox::bridge
