@@ -43,11 +43,12 @@ TEST(StructuredScanSharedAssetsTest, SameHitsAsTheGeneralCasterInEveryModel) {
     const FaceScanner scanner(config);
     int hits = 0;
     for (int k = 0; k < 3; ++k) {
-      const Eigen::Quaterniond q(unit(random) - 0.5, unit(random) - 0.5, unit(random) - 0.5,
-                                 unit(random) - 0.5);
+      double draw[7];  // in order: as arguments their order would vary by compiler
+      for (double& value : draw) value = unit(random);
+      const Eigen::Quaterniond q(draw[3] - 0.5, draw[4] - 0.5, draw[5] - 0.5, draw[6] - 0.5);
       const Eigen::Isometry3d X_WS =
-          Eigen::Translation3d(box.min() + box.sizes().cwiseProduct(Vector3d(
-                                               unit(random), unit(random), unit(random)))) *
+          Eigen::Translation3d(box.min() +
+                               box.sizes().cwiseProduct(Vector3d(draw[0], draw[1], draw[2]))) *
           q.normalized();
       RayBatch rays;
       std::vector<RayGrid> grids;
