@@ -23,7 +23,11 @@ for _ in $(seq 1200); do
   window=$(xdotool search --name "^sandbox: " 2> /dev/null | head -1) && [ -n "$window" ] && break
   sleep 0.1
 done
-[ -n "$window" ] || { echo "no window appeared"; kill "$pid"; cat "$out"; exit 1; }
+if [ -z "$window" ]; then
+  # The sandbox's own words (kill fails when it is gone already).
+  echo "no window appeared"; kill "$pid" 2> /dev/null || true; wait "$pid" || echo "exit status $?"
+  cat "$out"; exit 1
+fi
 sleep 1
 for key in c o q; do xdotool key --window "$window" "$key" 2> /dev/null; sleep 0.3; done
 wait "$pid"
