@@ -351,7 +351,6 @@ inline __m128 MeetsCornerBox4(const Vec4& low, const Vec4& high, const Vec4& o, 
 // reads them: origins in the Bullet frame and results, row by row, padded by a
 // packet's width.
 struct GridBand {
-  int cols{0};
   __m128 dx, dy, dz;                      // the block's direction
   __m128 ox, oy, oz;                      // the batch origin (a ray starts at it plus its start)
   const Eigen::Vector3f* start{nullptr};  // the band's rays' starts
@@ -838,7 +837,6 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
     const Eigen::Vector3f d = rays.direction[first];
     const float length = rays.length_m[first];
     thread_local GridBand band;
-    band.cols = cols;
     band.dx = _mm_set1_ps(d.x()), band.dy = _mm_set1_ps(d.y()), band.dz = _mm_set1_ps(d.z());
     band.ox = _mm_set1_ps(origin_B.x()), band.oy = _mm_set1_ps(origin_B.y());
     band.oz = _mm_set1_ps(origin_B.z());
