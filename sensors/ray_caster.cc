@@ -20,6 +20,9 @@ namespace sandbox::sensors {
 namespace {
 
 constexpr int kRaysPerChunk = 256;
+// A sweep's chunk of work: up to this many steps of up to this many channels.
+constexpr int kStepsPerTile = 16;
+constexpr int kChannelsPerTile = 16;
 constexpr int kStackInPlace = RayCaster::kStackInPlace;
 
 // One Bullet object as a ray sees it: where it is, its BVH nodes and triangles.
@@ -347,14 +350,16 @@ inline __m128 MeetsCornerBox4(const Vec4& low, const Vec4& high, const Vec4& o, 
                       Mul(t_exit, _mm_set1_ps(1.0f + slack)));
 }
 
-// The rays of a band of rows of one grid block (RayGrid) as the grid kernel
-// reads them: origins in the Bullet frame and results, row by row, padded by a
-// packet's width.
+// The rays of a band of rows of one grid block (RayGrid), or of a sector of a
+// sweep (RaySweep), as the structured kernels read them: origins in the Bullet
+// frame and results, indexed by cell (a band's ray from its first, a sector's
+// ray of the batch).
 struct GridBand {
-  __m128 dx, dy, dz;                      // the block's direction
+  __m128 dx, dy, dz;                          // the block's direction
+  const Eigen::Vector3f* direction{nullptr};  // or each cell's own (a sweep)
   __m128 ox, oy, oz;                      // the batch origin (a ray starts at it plus its start)
-  const Eigen::Vector3f* start{nullptr};  // the band's rays' starts
-  float* t_max{nullptr};                  // its entries of RayHits::distance_m
+  const Eigen::Vector3f* start{nullptr};  // the cells' rays' starts
+  float* t_max{nullptr};                  // their entries of RayHits::distance_m
   std::int32_t* body{nullptr};            // of RayHits::body
   Eigen::Vector3f* normal{nullptr};       // unnormalised, or null: none asked for
   std::vector<Eigen::Vector3f> normals;   // their storage
@@ -501,17 +506,62 @@ struct BandFrame {
   float margin, margin_columns, margin_rows;
 };
 
-// A band's grid as seen from one object's quantized BVH: a node box [lo, hi]
-// (quantized) spans columns, rows and depths (u, v, s) of at most
-// w0 + sum_k (q_k * a_k) over its corners; `margin` widens them, `limit`
-// is (columns - 1, rows - 1, ray length).
+// Up to four linear coordinates of points (a band's columns, rows and depths;
+// a sweep sector's slabs) as seen from one object's quantized BVH: over a node
+// box [lo, hi] (quantized), coordinate w spans w0 + sum_k (q_k * a_k) over its
+// corners; `margin` widens that, and it must meet [0, limit] (in a whole
+// number, in `integral` lanes).
 struct GridCull {
-  __m128 positive[3], negative[3];  // per axis k: the (u, v, s) weights a_k, split by sign
-  __m128 w0, margin, limit;
+  __m128 positive[3], negative[3];  // per axis k: the weights a_k, split by sign
+  __m128 w0, margin, limit, integral;
 };
 
+// The cull for coordinates w = (p - origin) . axes[w] (p in the Bullet frame)
+// that must lie in [0, limit[w]] to within margin[w]; lanes beyond `count`
+// always pass.
+GridCull CullFor(const Target& target, const Eigen::Vector3d& origin,
+                 const Eigen::Vector3d* const axes[], int count, const double limit[],
+                 const double margin[], bool integral_first_two) {
+  // w = (X_BL (q / quantization + bvh_min) - origin) . axis: linear in q.
+  const btTransform& X_BL = target.X_BL;
+  Eigen::Matrix3d R_BL;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) R_BL(r, c) = double(X_BL.getBasis()[r][c]);
+  }
+  const Eigen::Vector3d p_BL(X_BL.getOrigin().x(), X_BL.getOrigin().y(), X_BL.getOrigin().z());
+  const Eigen::Vector3d offset = R_BL * target.bvh_min.cast<double>() + p_BL - origin;
+  alignas(16) float positive[3][4] = {}, negative[3][4] = {}, w0[4] = {}, slack[4] = {};
+  alignas(16) float top[4] = {};
+  for (int w = 0; w < count; ++w) {
+    const Eigen::Vector3d a =
+        (R_BL.transpose() * *axes[w]).cwiseQuotient(target.quantization.cast<double>());
+    w0[w] = float(offset.dot(*axes[w]));
+    top[w] = float(limit[w]);
+    double reach = std::abs(w0[w]);
+    for (int k = 0; k < 3; ++k) {
+      positive[k][w] = float(std::max(a[k], 0.0));
+      negative[k][w] = float(std::min(a[k], 0.0));
+      reach += 65535.0 * std::abs(a[k]);
+    }
+    // The margin, a quantum each way, and the float rounding of the sums.
+    const double quantum = std::abs(a[0]) + std::abs(a[1]) + std::abs(a[2]);
+    slack[w] = float(margin[w] + quantum + 1e-6 * reach);
+  }
+  GridCull cull;
+  for (int k = 0; k < 3; ++k) {
+    cull.positive[k] = _mm_load_ps(positive[k]);
+    cull.negative[k] = _mm_load_ps(negative[k]);
+  }
+  cull.w0 = _mm_load_ps(w0);
+  cull.margin = _mm_load_ps(slack);
+  cull.limit = _mm_load_ps(top);
+  cull.integral =
+      _mm_castsi128_ps(integral_first_two ? _mm_setr_epi32(-1, -1, 0, 0) : _mm_setzero_si128());
+  return cull;
+}
+
 // Whether a node's box reaches a grid point in columns and rows and the rays'
-// span in depth.
+// span in depth (a sector's slabs: all four spans).
 inline bool NodeMeetsGrid(const btQuantizedBvhNode& node, const GridCull& cull) {
   __m128 low = cull.w0, high = cull.w0;
   for (int k = 0; k < 3; ++k) {
@@ -524,8 +574,7 @@ inline bool NodeMeetsGrid(const btQuantizedBvhNode& node, const GridCull& cull) 
   const __m128 to = _mm_min_ps(Add(high, cull.margin), cull.limit);
   // Columns and rows need a whole number in [from, to]; depth an overlap.
   const __m128 whole = _mm_cvtepi32_ps(_mm_cvttps_epi32(to));
-  const __m128 integral = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, 0, 0));
-  const __m128 top = Select(integral, whole, to);
+  const __m128 top = Select(cull.integral, whole, to);
   return _mm_movemask_ps(_mm_cmpge_ps(top, from)) == 0xF;
 }
 
@@ -545,6 +594,67 @@ void ForEachTriangleOverGrid(const Target& target, const GridCull& cull, Visit&&
       visit(packed >> 21, packed & ((1 << 21) - 1));
     }
     i += meets || leaf ? 1 : node.getEscapeIndex();
+  }
+}
+
+// The squared distance in metres from a point to a node's box (grown by a
+// quantum), both in one object's quantized coordinates.
+struct NodeDistance {
+  NodeDistance(const Eigen::Vector3f& q_point, const Eigen::Vector3f& quantization)
+      : point(_mm_setr_ps(q_point.x(), q_point.y(), q_point.z(), 0.0f)),
+        metres(_mm_setr_ps(1.0f / quantization.x(), 1.0f / quantization.y(),
+                           1.0f / quantization.z(), 0.0f)) {}
+  float operator()(const btQuantizedBvhNode& node) const {
+    const __m128 q_min = _mm_setr_ps(float(node.m_quantizedAabbMin[0]) - 1.0f,
+                                     float(node.m_quantizedAabbMin[1]) - 1.0f,
+                                     float(node.m_quantizedAabbMin[2]) - 1.0f, 0.0f);
+    const __m128 q_max = _mm_setr_ps(float(node.m_quantizedAabbMax[0]) + 1.0f,
+                                     float(node.m_quantizedAabbMax[1]) + 1.0f,
+                                     float(node.m_quantizedAabbMax[2]) + 1.0f, 0.0f);
+    const __m128 gap =
+        _mm_max_ps(_mm_max_ps(Sub(q_min, point), Sub(point, q_max)), _mm_setzero_ps());
+    const __m128 g = Mul(gap, metres);
+    alignas(16) float squared[4];
+    _mm_store_ps(squared, Mul(g, g));
+    return squared[0] + squared[1] + squared[2];
+  }
+  __m128 point, metres;
+};
+
+// Calls visit(part, triangle) for each triangle of `target` whose BVH leaf
+// box meets the cull (NodeMeetsGrid), nearest node first: a node whose
+// distance (squared, NodeDistance) is beyond(...) when its turn comes is
+// skipped with its subtree (visits shorten the reach).
+template <typename Beyond, typename Visit>
+void ForEachTriangleNearFirst(const Target& target, const GridCull& cull,
+                              const NodeDistance& distance, Beyond&& beyond, Visit&& visit) {
+  const btQuantizedBvhNode* nodes = target.nodes;
+  struct Entry {
+    int node;
+    float distance2;
+  };
+  WalkStack<Entry, kStackInPlace> stack;
+  if (NodeMeetsGrid(nodes[0], cull)) stack.Push({0, distance(nodes[0])});
+  while (!stack.empty()) {
+    const Entry entry = stack.Pop();
+    if (beyond(entry.distance2)) continue;
+    const btQuantizedBvhNode& node = nodes[entry.node];
+    if (node.isLeafNode()) {
+      const int packed = node.m_escapeIndexOrTriangleIndex;
+      visit(packed >> 21, packed & ((1 << 21) - 1));
+      continue;
+    }
+    const int left = entry.node + 1;
+    const int right = left + (nodes[left].isLeafNode() ? 1 : nodes[left].getEscapeIndex());
+    Entry child[2];
+    int children = 0;
+    for (const int index : {left, right}) {
+      if (!NodeMeetsGrid(nodes[index], cull)) continue;
+      const float d2 = distance(nodes[index]);
+      if (!beyond(d2)) child[children++] = {index, d2};
+    }
+    if (children == 2 && child[0].distance2 < child[1].distance2) std::swap(child[0], child[1]);
+    for (int c = 0; c < children; ++c) stack.Push(child[c]);  // the nearer last: popped first
   }
 }
 
@@ -845,6 +955,7 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
     band.body = hits->body.data() + first;
     std::fill(band.t_max, band.t_max + count, length);
     std::fill(band.body, band.body + count, RayHits::kNoHit);
+    band.direction = nullptr;
     band.normal = nullptr;
     if (hits->with_normals) {
       band.normals.resize(count);
@@ -880,42 +991,10 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
           (target.aabb_max.array() < box_min.array()).any()) {
         continue;
       }
-      // The grid's coordinates as linear functions of the object's quantized
-      // BVH coordinates: w = (X_BL (q / quantization + bvh_min) - corner) . axis.
-      const btTransform& X_BL = target.X_BL;
-      Eigen::Matrix3d R_BL;
-      for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 3; ++c) R_BL(r, c) = double(X_BL.getBasis()[r][c]);
-      }
-      const Eigen::Vector3d p_BL(X_BL.getOrigin().x(), X_BL.getOrigin().y(), X_BL.getOrigin().z());
-      const Eigen::Vector3d offset = R_BL * target.bvh_min.cast<double>() + p_BL - corner;
       const Eigen::Vector3d* axes[3] = {&to_column, &to_row, &direction};
-      alignas(16) float positive[3][4] = {}, negative[3][4] = {}, w0[4] = {}, slack[4] = {};
-      for (int w = 0; w < 3; ++w) {
-        const Eigen::Vector3d a =
-            (R_BL.transpose() * *axes[w]).cwiseQuotient(target.quantization.cast<double>());
-        w0[w] = float(offset.dot(*axes[w]));
-        double reach = std::abs(w0[w]);
-        for (int k = 0; k < 3; ++k) {
-          positive[k][w] = float(std::max(a[k], 0.0));
-          negative[k][w] = float(std::min(a[k], 0.0));
-          reach += 65535.0 * std::abs(a[k]);
-        }
-        // The band's margin, a quantum each way, and the float rounding of the sums.
-        const double quantum = std::abs(a[0]) + std::abs(a[1]) + std::abs(a[2]);
-        slack[w] = float((w == 0   ? margin_columns
-                          : w == 1 ? margin_rows
-                                   : margin) +
-                         quantum + 1e-6 * reach);
-      }
-      GridCull cull;
-      for (int k = 0; k < 3; ++k) {
-        cull.positive[k] = _mm_load_ps(positive[k]);
-        cull.negative[k] = _mm_load_ps(negative[k]);
-      }
-      cull.w0 = _mm_load_ps(w0);
-      cull.margin = _mm_load_ps(slack);
-      cull.limit = _mm_setr_ps(float(cols - 1), float(rows - 1), length, 0.0f);
+      const double limit[3] = {double(cols - 1), double(rows - 1), double(length)};
+      const double margins[3] = {margin_columns, margin_rows, margin};
+      const GridCull cull = CullFor(target, corner, axes, 3, limit, margins, true);
       ForEachTriangleOverGrid(target, cull, [&](int part, int triangle) {
         Eigen::Vector3f corners[3];
         Corners(target, part, triangle, corners);
@@ -969,6 +1048,337 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
     }
   };
   RunParallel(static_cast<int>(bands.size()), job);
+#endif
+}
+
+void RayCaster::CastSweep(const scene::CollisionWorld& world, const RayBatch& rays,
+                          const RaySweep& sweep, const RayFilter& filter, RayHits* hits) {
+  const int channels = sweep.channels(), steps = sweep.steps();
+  const std::size_t n = rays.size();
+  if (sweep.up_W.size() != sweep.forward_W.size() || std::size_t(channels) * steps != n) {
+    throw std::invalid_argument("RayCaster::CastSweep(): " + std::to_string(channels) +
+                                " channels x " + std::to_string(steps) + " steps for a batch of " +
+                                std::to_string(n) + " rays");
+  }
+  double lowest_cosine = 1.0;
+  for (const double e : sweep.elevations_rad) {
+    if (!std::isfinite(e))
+      throw std::invalid_argument("RayCaster::CastSweep(): elevation not finite");
+    lowest_cosine = std::min(lowest_cosine, std::cos(e));
+  }
+  for (int k = 0; k < steps; ++k) {
+    const Eigen::Vector3d& f = sweep.forward_W[std::size_t(k)];
+    const Eigen::Vector3d& u = sweep.up_W[std::size_t(k)];
+    if (!(std::abs(f.norm() - 1.0) < 1e-9 && std::abs(u.norm() - 1.0) < 1e-9 &&
+          std::abs(f.dot(u)) < 1e-9)) {
+      throw std::invalid_argument("RayCaster::CastSweep(): step " + std::to_string(k) +
+                                  "'s forward and up are not unit and perpendicular");
+    }
+  }
+  // Near the poles a step's half-plane no longer orders its rays: cast them
+  // as a bag of rays.
+  if (n == 0 || lowest_cosine < std::cos(85.0 * M_PI / 180.0)) {
+    // Cast() checks nothing of the sweep: check the batch the same way.
+    for (int c = 0; c < channels; ++c) {
+      for (int k = 0; k < steps; ++k) {
+        const std::size_t i = std::size_t(c) * std::size_t(steps) + std::size_t(k);
+        if (rays.start[i] != rays.start[std::size_t(k)] || rays.length_m[i] != rays.length_m[0]) {
+          throw std::invalid_argument("RayCaster::CastSweep(): ray " + std::to_string(i) +
+                                      " differs in start or length from its step's");
+        }
+      }
+    }
+    Cast(world, rays, filter, hits);
+    return;
+  }
+#if !defined(__SSE2__)
+  Cast(world, rays, filter, hits);
+#else
+  rays_cast_ += std::int64_t(n);
+  SizeHits(n, hits);
+  const Eigen::Vector3f origin_B = (rays.origin_W - world.origin()).cast<float>();
+  const std::vector<Target>& all_targets = TargetsOf(world).all;
+  const Visible wanted{filter, world.internals().num_actors};
+  const float length = rays.length_m[0];
+  // Channels in order of elevation, by the tangent (monotonic within +-90 degrees).
+  std::vector<int> order(static_cast<std::size_t>(channels), 0);
+  for (int c = 0; c < channels; ++c) order[std::size_t(c)] = c;
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return sweep.elevations_rad[std::size_t(a)] < sweep.elevations_rad[std::size_t(b)];
+  });
+  const std::size_t num_channels = std::size_t(channels);
+  std::vector<float> tangent(num_channels), cosine(num_channels), sine(num_channels);
+  for (int j = 0; j < channels; ++j) {
+    const double e = sweep.elevations_rad[std::size_t(order[std::size_t(j)])];
+    tangent[std::size_t(j)] = float(std::tan(e));
+  }
+  for (int c = 0; c < channels; ++c) {
+    cosine[std::size_t(c)] = float(std::cos(sweep.elevations_rad[std::size_t(c)]));
+    sine[std::size_t(c)] = float(std::sin(sweep.elevations_rad[std::size_t(c)]));
+  }
+  std::vector<Eigen::Vector3f> normals(hits->with_normals ? n : 0);
+  // Tiles of neighbouring steps and neighbouring channels (by elevation),
+  // each a chunk of work: about four a thread at least.
+  const int per_sector = std::clamp(steps / (4 * threads()), 1, kStepsPerTile);
+  const int sectors = (steps + per_sector - 1) / per_sector;
+  const int per_group = std::min(channels, kChannelsPerTile);
+  const int groups = (channels + per_group - 1) / per_group;
+  std::atomic<std::int64_t> bad_ray{-1};
+
+  const std::function<void(int)> job = [&](int tile) {
+    const int first_step = (tile / groups) * per_sector;
+    const int end_step = std::min(steps, first_step + per_sector);
+    const int j_begin = (tile % groups) * per_group;
+    const int j_end = std::min(channels, j_begin + per_group);
+    auto ray_of = [&](int j, int k) {
+      return std::size_t(order[std::size_t(j)]) * std::size_t(steps) + std::size_t(k);
+    };
+    thread_local GridBand band;
+    band.ox = _mm_set1_ps(origin_B.x()), band.oy = _mm_set1_ps(origin_B.y());
+    band.oz = _mm_set1_ps(origin_B.z());
+    band.direction = rays.direction.data();
+    band.start = rays.start.data();
+    band.t_max = hits->distance_m.data();
+    band.body = hits->body.data();
+    band.normal = normals.empty() ? nullptr : normals.data();
+    band.pairs.count = 0;
+    // Each step's half-plane in the Bullet frame: its rays' origin (as Cast()
+    // forms it), forward, up and normal.
+    struct Step {
+      Eigen::Vector3f o, f, u, n;
+    } step[kStepsPerTile];
+    // The tile's pyramid: between the first and the last step's half-planes,
+    // above the lowest channel's cone and below the highest's (as planes at
+    // the middle step), each bounded by the tile's rays' ends.
+    const std::size_t mid = std::size_t((first_step + end_step) / 2);
+    const Eigen::Vector3d& mid_f = sweep.forward_W[mid];
+    const Eigen::Vector3d& mid_u = sweep.up_W[mid];
+    const double e_low = sweep.elevations_rad[std::size_t(order[std::size_t(j_begin)])];
+    const double e_high = sweep.elevations_rad[std::size_t(order[std::size_t(j_end - 1)])];
+    const Eigen::Vector3d first_n =
+        sweep.forward_W[std::size_t(first_step)].cross(sweep.up_W[std::size_t(first_step)]);
+    const Eigen::Vector3d last_n =
+        sweep.forward_W[std::size_t(end_step - 1)].cross(sweep.up_W[std::size_t(end_step - 1)]);
+    const Eigen::Vector3d above = -std::sin(e_low) * mid_f + std::cos(e_low) * mid_u;
+    const Eigen::Vector3d below = std::sin(e_high) * mid_f - std::cos(e_high) * mid_u;
+    const Eigen::Vector3d* axes[4] = {&first_n, &last_n, &above, &below};
+    const Eigen::Vector3d anchor = (origin_B + rays.start[std::size_t(first_step)]).cast<double>();
+    double low[4], high[4];
+    for (int w = 0; w < 4; ++w) low[w] = std::numeric_limits<double>::max(), high[w] = -low[w];
+    Eigen::AlignedBox3d box;
+    double reach = 0.0, drift = 0.0;
+    for (int k = first_step; k < end_step; ++k) {
+      Step& s = step[k - first_step];
+      s.o = origin_B + rays.start[std::size_t(k)];
+      s.f = sweep.forward_W[std::size_t(k)].cast<float>();
+      s.u = sweep.up_W[std::size_t(k)].cast<float>();
+      s.n = s.f.cross(s.u);
+      const Eigen::Vector3d o = s.o.cast<double>();
+      reach = std::max(reach, o.norm());
+      drift = std::max(drift, (o - anchor).norm());
+      for (int j = j_begin; j < j_end; ++j) {
+        const std::size_t i = ray_of(j, k);
+        const std::size_t c = std::size_t(order[std::size_t(j)]);
+        const Eigen::Vector3f expected = cosine[c] * s.f + sine[c] * s.u;
+        if (rays.start[i] != rays.start[std::size_t(k)] || rays.length_m[i] != length ||
+            (rays.direction[i] - expected).cwiseAbs().maxCoeff() > 1e-6f) {
+          bad_ray = std::int64_t(i);
+          return;
+        }
+        hits->distance_m[i] = length;
+        hits->body[i] = RayHits::kNoHit;
+        // The tile's rays lie between the bounds of their ends on each axis.
+        const Eigen::Vector3d end = o + double(length) * rays.direction[i].cast<double>();
+        for (const Eigen::Vector3d& p : {o, end}) {
+          box.extend(p);
+          for (int w = 0; w < 4; ++w) {
+            const double along = (p - anchor).dot(*axes[w]);
+            low[w] = std::min(low[w], along), high[w] = std::max(high[w], along);
+          }
+        }
+      }
+    }
+    // Margin: float rounding of origins, directions (1e-6 checked above) and
+    // of the cuts below.
+    const double margin = 1e-5 * (reach + 2.0 * double(length)) + 1e-5;
+    const Eigen::Vector3f box_min = (box.min().array() - margin).cast<float>();
+    const Eigen::Vector3f box_max = (box.max().array() + margin).cast<float>();
+    double limit[4], margins[4] = {margin, margin, margin, margin};
+    for (int w = 0; w < 4; ++w) limit[w] = high[w] - low[w];
+    const int count = end_step - first_step;
+    // The steps' planes four at a time (n . p - n . o), for a first sort of
+    // the triangles; padding steps lie at infinity.
+    alignas(16) float plane[4][kStepsPerTile];
+    for (int k = 0; k < kStepsPerTile; ++k) {
+      const bool real = k < count;
+      for (int a = 0; a < 3; ++a) plane[a][k] = real ? step[k].n[a] : 0.0f;
+      plane[3][k] = real ? step[k].n.dot(step[k].o) : kHuge;
+    }
+    // The pyramid's bounds for single triangles: axis, low bound, extent.
+    __m128 pyramid[4][4], pyramid_limit[4];
+    for (int a = 0; a < 4; ++a) {
+      for (int k = 0; k < 3; ++k) pyramid[a][k] = _mm_set1_ps(float((*axes[a])[k]));
+      pyramid[a][3] = _mm_set1_ps(float(low[a]));
+      pyramid_limit[a] = _mm_set1_ps(float(limit[a] + margin));
+    }
+    // The farthest any of the tile's rays still reaches: nodes beyond it are
+    // skipped (after each test of the queued pairs).
+    float tile_reach = length;
+    auto test = [&](GridBand* b) {
+      HitPairs(b);
+      float farthest = 0.0f;
+      for (int j = j_begin; j < j_end; ++j) {
+        for (int k = first_step; k < end_step; ++k) {
+          farthest = std::max(farthest, hits->distance_m[ray_of(j, k)]);
+        }
+      }
+      tile_reach = farthest;
+    };
+    for (const Target& target : all_targets) {
+      if (!wanted(target) || (target.aabb_min.array() > box_max.array()).any() ||
+          (target.aabb_max.array() < box_min.array()).any()) {
+        continue;
+      }
+      // Coordinates shifted so that each bound starts at 0: w - low[w].
+      GridCull cull = CullFor(target, anchor, axes, 4, limit, margins, false);
+      alignas(16) float shift[4] = {float(low[0]), float(low[1]), float(low[2]), float(low[3])};
+      cull.w0 = Sub(cull.w0, _mm_load_ps(shift));
+      // The anchor in the object's quantized coordinates, for node distances.
+      const Eigen::Vector3f anchor_L = target.R_LB * anchor.cast<float>() + target.p_LB;
+      const Eigen::Vector3f q_anchor =
+          (anchor_L - target.bvh_min).cwiseProduct(target.quantization);
+      const NodeDistance distance(q_anchor, target.quantization);
+      const float slack = float(drift + margin) + 1e-6f * float(reach + length);
+      auto beyond = [&](float distance2) {
+        const float reach_now = tile_reach + slack;
+        return distance2 > reach_now * reach_now;
+      };
+      ForEachTriangleNearFirst(target, cull, distance, beyond, [&](int part, int triangle) {
+        Eigen::Vector3f corners[3];
+        Corners(target, part, triangle, corners);
+        const __m128 cx = _mm_setr_ps(corners[0].x(), corners[1].x(), corners[2].x(), 0.0f);
+        const __m128 cy = _mm_setr_ps(corners[0].y(), corners[1].y(), corners[2].y(), 0.0f);
+        const __m128 cz = _mm_setr_ps(corners[0].z(), corners[1].z(), corners[2].z(), 0.0f);
+        const float size =
+            ((corners[0] - step[0].o).cwiseAbs().sum() + (corners[1] - step[0].o).cwiseAbs().sum() +
+             (corners[2] - step[0].o).cwiseAbs().sum());
+        const float m = float(margin) + 1e-6f * size;
+        const float m_tangent = m / float(lowest_cosine);
+        const __m128 top_tangent = _mm_set1_ps(tangent[std::size_t(j_end - 1)]);
+        const __m128 bottom_tangent = _mm_set1_ps(tangent[std::size_t(j_begin)]);
+        // The steps whose slab |w| <= m the triangle may meet (w rounded
+        // differently here: a wider slack, in the corners' and origins' size).
+        const __m128 cut_slack = _mm_set1_ps(m + 1e-6f * (size + 3.0f * float(reach)));
+        const __m128 negative_slack = Sub(_mm_setzero_ps(), cut_slack);
+        // Outside the tile's pyramid (all corners beyond one of its bounds): no ray meets it.
+        {
+          const __m128 x = Sub(cx, _mm_set1_ps(float(anchor.x())));
+          const __m128 y = Sub(cy, _mm_set1_ps(float(anchor.y())));
+          const __m128 z = Sub(cz, _mm_set1_ps(float(anchor.z())));
+          for (int a = 0; a < 4; ++a) {
+            const __m128 w =
+                Sub(Add(Add(Mul(x, pyramid[a][0]), Mul(y, pyramid[a][1])), Mul(z, pyramid[a][2])),
+                    pyramid[a][3]);
+            const int under = _mm_movemask_ps(_mm_cmplt_ps(w, negative_slack));
+            const int over = _mm_movemask_ps(_mm_cmpgt_ps(w, Add(pyramid_limit[a], cut_slack)));
+            if ((under & 7) == 7 || (over & 7) == 7) return;
+          }
+        }
+        int candidates = 0;
+        for (int k = 0; k < count; k += 4) {
+          __m128 w_low = _mm_set1_ps(kHuge), w_high = _mm_set1_ps(-kHuge);
+          for (int i = 0; i < 3; ++i) {
+            const __m128 w =
+                Sub(Add(Add(Mul(_mm_load_ps(&plane[0][k]), _mm_set1_ps(corners[i].x())),
+                            Mul(_mm_load_ps(&plane[1][k]), _mm_set1_ps(corners[i].y()))),
+                        Mul(_mm_load_ps(&plane[2][k]), _mm_set1_ps(corners[i].z()))),
+                    _mm_load_ps(&plane[3][k]));
+            w_low = _mm_min_ps(w_low, w), w_high = _mm_max_ps(w_high, w);
+          }
+          candidates |= _mm_movemask_ps(_mm_and_ps(_mm_cmple_ps(w_low, cut_slack),
+                                                   _mm_cmpge_ps(w_high, negative_slack)))
+                        << k;
+        }
+        for (; candidates != 0; candidates &= candidates - 1) {
+          const int k = __builtin_ctz(unsigned(candidates));
+          const Step& s = step[k];
+          const __m128 x = Sub(cx, _mm_set1_ps(s.o.x()));
+          const __m128 y = Sub(cy, _mm_set1_ps(s.o.y()));
+          const __m128 z = Sub(cz, _mm_set1_ps(s.o.z()));
+          auto along = [&](const Eigen::Vector3f& a) {
+            return Add(Add(Mul(x, _mm_set1_ps(a.x())), Mul(y, _mm_set1_ps(a.y()))),
+                       Mul(z, _mm_set1_ps(a.z())));
+          };
+          alignas(16) float w[4], f[4], u[4];
+          _mm_store_ps(w, along(s.n));
+          if (std::min({w[0], w[1], w[2]}) > m || std::max({w[0], w[1], w[2]}) < -m) continue;
+          const __m128 forward = along(s.f), up = along(s.u);
+          // In front (beyond the margin) and all above the tile's highest
+          // channel or all below its lowest (lines in the step's plane): no
+          // ray of the tile meets the cut, a convex combination of corners.
+          if ((_mm_movemask_ps(_mm_cmpgt_ps(forward, _mm_set1_ps(m))) & 7) == 7) {
+            const __m128 over = Sub(up, Mul(top_tangent, forward));
+            const __m128 under = Sub(up, Mul(bottom_tangent, forward));
+            if ((_mm_movemask_ps(_mm_cmpgt_ps(over, _mm_set1_ps(m_tangent))) & 7) == 7 ||
+                (_mm_movemask_ps(_mm_cmplt_ps(under, _mm_set1_ps(-m_tangent))) & 7) == 7) {
+              continue;
+            }
+          }
+          _mm_store_ps(f, forward);
+          _mm_store_ps(u, up);
+          // The triangle's cut by the slab |w| <= m: its corners in the slab
+          // and its edges' crossings of the slab's faces, as (forward, up).
+          float f_min = kHuge, f_max = -kHuge, lo = kHuge, hi = -kHuge;
+          auto point = [&](float pf, float pu) {
+            f_min = std::min(f_min, pf), f_max = std::max(f_max, pf);
+            if (pf > 0.0f) {
+              const float inverse = 1.0f / pf;
+              lo = std::min(lo, (pu - m_tangent) * inverse);
+              hi = std::max(hi, (pu + m_tangent) * inverse);
+            }
+          };
+          for (int i = 0; i < 3; ++i) {
+            if (std::abs(w[i]) <= m) point(f[i], u[i]);
+            const int j = i == 2 ? 0 : i + 1;
+            if (w[i] == w[j]) continue;
+            for (const float face : {-m, m}) {
+              if ((face - w[i]) * (face - w[j]) > 0.0f) continue;
+              const float t = std::clamp((face - w[i]) / (w[j] - w[i]), 0.0f, 1.0f);
+              point(f[i] + t * (f[j] - f[i]), u[i] + t * (u[j] - u[i]));
+            }
+          }
+          if (f_max < -m) continue;  // behind the step's rays
+          // Channels whose elevation's tangent lies in [lo, hi]; all the
+          // tile's when the cut comes within the margin of the origin.
+          int j0 = j_begin, j1 = j_end;
+          if (f_min > m) {
+            const auto first = tangent.begin() + j_begin, last = tangent.begin() + j_end;
+            j0 = int(std::lower_bound(first, last, lo) - tangent.begin());
+            j1 = int(std::upper_bound(first, last, hi) - tangent.begin());
+          }
+          const float near = f_min - m;
+          for (int j = j0; j < j1; ++j) {
+            band.Add(corners, target.body, int(ray_of(j, first_step + k)), near, test);
+          }
+        }
+      });
+    }
+    test(&band);
+    if (band.normal != nullptr) {
+      for (int j = j_begin; j < j_end; ++j) {
+        for (int k = first_step; k < end_step; ++k) {
+          const std::size_t i = ray_of(j, k);
+          WriteHit(i, hits->distance_m[i], hits->body[i], normals[i], rays.direction[i], hits);
+        }
+      }
+    }
+  };
+  RunParallel(sectors * groups, job);
+  if (bad_ray >= 0) {
+    throw std::invalid_argument("RayCaster::CastSweep(): ray " + std::to_string(bad_ray.load()) +
+                                " is not its channel's ray of its step (start, direction or "
+                                "length)");
+  }
 #endif
 }
 
