@@ -105,6 +105,18 @@ Isometry3d RandomPose(std::mt19937& random, const Eigen::AlignedBox3d& box) {
   return Eigen::Translation3d(p) * q.normalized();
 }
 
+// The sample level's wing at (10, 20, 40), its joints bent 0.3 rad at most.
+bool BendTheWing(const scene::Level& level, scene::CollisionWorld* world) {
+  scene::RobotState wing(level.robots[0]);
+  if (!wing.SetPose(Isometry3d(Eigen::Translation3d(10, 20, 40)))) return false;
+  std::vector<double> bones = wing.bone_values();
+  for (std::size_t b = 0; b < bones.size(); ++b) bones[b] = 0.3 * std::sin(double(b) + 1.0);
+  if (!wing.SetBones(bones)) return false;
+  wing.Update();
+  world->UpdateRobot(0, wing);
+  return true;
+}
+
 TEST(StructuredScanTest, SameHitsAsTheGeneralCasterOnTheSampleLevelFromRandomPoses) {
   const scene::Level level = scene::LoadLevel(testing::SampleLevel());
   const scene::CollisionWorld world(level);
@@ -125,15 +137,9 @@ TEST(StructuredScanTest, SameHitsAsTheGeneralCasterOnTheSampleLevelFromRandomPos
 }
 
 TEST(StructuredScanTest, SameHitsOnABentRobotSeenFromBesideIt) {
-  scene::Level level = scene::LoadLevel(testing::SampleLevel());
+  const scene::Level level = scene::LoadLevel(testing::SampleLevel());
   scene::CollisionWorld world(level);
-  scene::RobotState wing(level.robots[0]);
-  ASSERT_TRUE(wing.SetPose(Isometry3d(Eigen::Translation3d(10, 20, 40))));
-  std::vector<double> bones = wing.bone_values();
-  for (std::size_t b = 0; b < bones.size(); ++b) bones[b] = 0.3 * std::sin(double(b) + 1.0);
-  ASSERT_TRUE(wing.SetBones(bones));
-  wing.Update();
-  world.UpdateRobot(0, wing);
+  ASSERT_TRUE(BendTheWing(level, &world));
   FaceScannerConfig config;
   config.resolution_m = 0.2;
   config.half_extent_m = 15.0;
@@ -252,15 +258,9 @@ TEST(StructuredSweepTest, SameHitsAsTheGeneralCasterOnTheSampleLevelFromRandomMo
 }
 
 TEST(StructuredSweepTest, SameHitsOnABentRobotSweptFromBesideIt) {
-  scene::Level level = scene::LoadLevel(testing::SampleLevel());
+  const scene::Level level = scene::LoadLevel(testing::SampleLevel());
   scene::CollisionWorld world(level);
-  scene::RobotState wing(level.robots[0]);
-  ASSERT_TRUE(wing.SetPose(Isometry3d(Eigen::Translation3d(10, 20, 40))));
-  std::vector<double> bones = wing.bone_values();
-  for (std::size_t b = 0; b < bones.size(); ++b) bones[b] = 0.3 * std::sin(double(b) + 1.0);
-  ASSERT_TRUE(wing.SetBones(bones));
-  wing.Update();
-  world.UpdateRobot(0, wing);
+  ASSERT_TRUE(BendTheWing(level, &world));
   const LidarConfig config = LidarConfig::Uniform(32, -40, 40, 1024, 50.0);
   std::mt19937 random(8);
   const Eigen::AlignedBox3d near_wing(Vector3d(0, 14, 36), Vector3d(20, 26, 44));
