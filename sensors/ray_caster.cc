@@ -578,6 +578,55 @@ inline bool NodeMeetsGrid(const btQuantizedBvhNode& node, const GridCull& cull) 
   return _mm_movemask_ps(_mm_cmpge_ps(top, from)) == 0xF;
 }
 
+// The spans [low, high] of a cull's coordinates over a node's box (widened
+// by the cull's margins), a coordinate a lane.
+inline void NodeSpans(const btQuantizedBvhNode& node, const GridCull& cull, __m128* low,
+                      __m128* high) {
+  __m128 from = cull.w0, to = cull.w0;
+  for (int k = 0; k < 3; ++k) {
+    const __m128 q_min = _mm_set1_ps(float(node.m_quantizedAabbMin[k]));
+    const __m128 q_max = _mm_set1_ps(float(node.m_quantizedAabbMax[k]));
+    from = Add(from, Add(Mul(q_min, cull.positive[k]), Mul(q_max, cull.negative[k])));
+    to = Add(to, Add(Mul(q_max, cull.positive[k]), Mul(q_min, cull.negative[k])));
+  }
+  *low = Sub(from, cull.margin), *high = Add(to, cull.margin);
+}
+
+// A sweep tile's channels as elevation bands about its anchor: a region
+// whose elevations (seen from the anchor, in the middle step's frame) meet
+// none of them holds no point its rays can reach. The bands are each
+// channel's elevation widened by the tile's tilt (the steps' up directions
+// against the middle one's) and the rays' rounding; a region's elevations
+// are widened by the origins' drift from the anchor (and the margin) over
+// its forward distance.
+struct ChannelBands {
+  alignas(16) float low[kChannelsPerTile], high[kChannelsPerTile];  // tangents; padding never meets
+  float drift{0.0f};  // the origins' drift from the anchor plus the margin, metres
+
+  // Whether points with forward distances [f_low, f_high], up [u_low,
+  // u_high] and |sideways| <= side (the middle step's frame, from the anchor)
+  // may lie on a channel's band.
+  bool MayMeet(float f_low, float f_high, float u_low, float u_high, float side) const {
+    if (!(f_low > 20.0f * drift)) return true;  // near or behind the anchor: keep
+    const float h_high = std::sqrt(f_high * f_high + side * side);
+    float from = u_low > 0.0f ? u_low / h_high : u_low / f_low;
+    float to = u_high > 0.0f ? u_high / f_low : u_high / h_high;
+    // The origins' drift: at most drift / f_low radians (< 0.05, its tangent
+    // at most 1.001 times that), added as tan(x - a) = (t - tan a) / (1 + t tan a).
+    const float turn = 1.001f * 1.001f * drift / f_low;
+    const float below = 1.0f + from * turn, above = 1.0f - to * turn;
+    from = below > 0.0f ? (from - turn) / below : -kHuge;
+    to = above > 0.0f ? (to + turn) / above : kHuge;
+    const __m128 lo = _mm_set1_ps(from), hi = _mm_set1_ps(to);
+    for (int q = 0; q < kChannelsPerTile; q += 4) {
+      const __m128 meets = _mm_and_ps(_mm_cmpge_ps(_mm_load_ps(&high[q]), lo),
+                                      _mm_cmple_ps(_mm_load_ps(&low[q]), hi));
+      if (_mm_movemask_ps(meets) != 0) return true;
+    }
+    return false;
+  }
+};
+
 // Calls visit(part, triangle) for each triangle of `target` whose BVH
 // leaf box meets the grid (NodeMeetsGrid): a stackless walk of the node array
 // that skips every subtree whose box falls between grid points.
@@ -622,19 +671,19 @@ struct NodeDistance {
 };
 
 // Calls visit(part, triangle) for each triangle of `target` whose BVH leaf
-// box meets the cull (NodeMeetsGrid), nearest node first: a node whose
+// box meets(node) (and every box above it), nearest node first: a node whose
 // distance (squared, NodeDistance) is beyond(...) when its turn comes is
 // skipped with its subtree (visits shorten the reach).
-template <typename Beyond, typename Visit>
-void ForEachTriangleNearFirst(const Target& target, const GridCull& cull,
-                              const NodeDistance& distance, Beyond&& beyond, Visit&& visit) {
+template <typename Meets, typename Beyond, typename Visit>
+void ForEachTriangleNearFirst(const Target& target, Meets&& meets, const NodeDistance& distance,
+                              Beyond&& beyond, Visit&& visit) {
   const btQuantizedBvhNode* nodes = target.nodes;
   struct Entry {
     int node;
     float distance2;
   };
   WalkStack<Entry, kStackInPlace> stack;
-  if (NodeMeetsGrid(nodes[0], cull)) stack.Push({0, distance(nodes[0])});
+  if (meets(nodes[0])) stack.Push({0, distance(nodes[0])});
   while (!stack.empty()) {
     const Entry entry = stack.Pop();
     if (beyond(entry.distance2)) continue;
@@ -649,7 +698,7 @@ void ForEachTriangleNearFirst(const Target& target, const GridCull& cull,
     Entry child[2];
     int children = 0;
     for (const int index : {left, right}) {
-      if (!NodeMeetsGrid(nodes[index], cull)) continue;
+      if (!meets(nodes[index])) continue;
       const float d2 = distance(nodes[index]);
       if (!beyond(d2)) child[children++] = {index, d2};
     }
@@ -672,6 +721,55 @@ inline int PacketMeetsBox(const Packet& packet, const __m128 inverse[3],
   return _mm_movemask_ps(_mm_and_ps(packet.active, _mm_cmple_ps(t_enter, t_exit)));
 }
 #endif
+
+// The cut of a triangle (Bullet-frame corners) by a sweep step's slab
+// |w| <= m (its corners in the slab and its edges' crossings of the slab's
+// faces, as forward f and up u): narrows the channels [*j0, *j1) (of the
+// tile's, from j_begin, their tangents in `tangents`) to those whose elevation's
+// tangent lies within the cut's (widened by m_tangent / f), and raises *near
+// to the cut's nearest forward distance. False when no ray can meet it.
+// Bits set in a four-lane mask (a table: without -mpopcnt, __builtin_popcount
+// is a library call).
+constexpr int kBitsSet[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
+
+struct SweepStep {
+  Eigen::Vector3f o, f, u, n;  // the rays' origin, forward, up, normal
+};
+inline bool Cut(const Eigen::Vector3f corners[3], const SweepStep& s, float m, float m_tangent,
+                int j_begin, const float* tangents, int* j0, int* j1, float* near) {
+  float w[3], f[3], u[3];
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3f p = corners[i] - s.o;
+    w[i] = p.dot(s.n), f[i] = p.dot(s.f), u[i] = p.dot(s.u);
+  }
+  float f_min = kHuge, f_max = -kHuge, lo = kHuge, hi = -kHuge;
+  auto point = [&](float pf, float pu) {
+    f_min = std::min(f_min, pf), f_max = std::max(f_max, pf);
+    if (pf > 0.0f) {
+      const float inverse = 1.0f / pf;
+      lo = std::min(lo, (pu - m_tangent) * inverse);
+      hi = std::max(hi, (pu + m_tangent) * inverse);
+    }
+  };
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(w[i]) <= m) point(f[i], u[i]);
+    const int j = i == 2 ? 0 : i + 1;
+    if (w[i] == w[j]) continue;
+    for (const float face : {-m, m}) {
+      if ((face - w[i]) * (face - w[j]) > 0.0f) continue;
+      const float t = std::clamp((face - w[i]) / (w[j] - w[i]), 0.0f, 1.0f);
+      point(f[i] + t * (f[j] - f[i]), u[i] + t * (u[j] - u[i]));
+    }
+  }
+  if (f_max < -m || f_min == kHuge) return false;  // behind the rays, or no cut
+  *near = std::max(*near, f_min - m);
+  if (f_min <= m) return true;  // within the margin of the origin: keep all
+  const float* first = tangents + (*j0 - j_begin);
+  const float* last = tangents + (*j1 - j_begin);
+  *j0 = j_begin + int(std::lower_bound(first, last, lo) - tangents);
+  *j1 = j_begin + int(std::upper_bound(first, last, hi) - tangents);
+  return *j0 < *j1;
+}
 
 }  // namespace
 
@@ -1144,9 +1242,7 @@ void RayCaster::CastSweep(const scene::CollisionWorld& world, const RayBatch& ra
     band.pairs.count = 0;
     // Each step's half-plane in the Bullet frame: its rays' origin (as Cast()
     // forms it), forward, up and normal.
-    struct Step {
-      Eigen::Vector3f o, f, u, n;
-    } step[kStepsPerTile];
+    SweepStep step[kStepsPerTile];
     // The tile's pyramid: between the first and the last step's half-planes,
     // above the lowest channel's cone and below the highest's (as planes at
     // the middle step), each bounded by the tile's rays' ends.
@@ -1168,7 +1264,7 @@ void RayCaster::CastSweep(const scene::CollisionWorld& world, const RayBatch& ra
     Eigen::AlignedBox3d box;
     double reach = 0.0, drift = 0.0;
     for (int k = first_step; k < end_step; ++k) {
-      Step& s = step[k - first_step];
+      SweepStep& s = step[k - first_step];
       s.o = origin_B + rays.start[std::size_t(k)];
       s.f = sweep.forward_W[std::size_t(k)].cast<float>();
       s.u = sweep.up_W[std::size_t(k)].cast<float>();
@@ -1206,14 +1302,45 @@ void RayCaster::CastSweep(const scene::CollisionWorld& world, const RayBatch& ra
     double limit[4], margins[4] = {margin, margin, margin, margin};
     for (int w = 0; w < 4; ++w) limit[w] = high[w] - low[w];
     const int count = end_step - first_step;
-    // The steps' planes four at a time (n . p - n . o), for a first sort of
-    // the triangles; padding steps lie at infinity.
-    alignas(16) float plane[4][kStepsPerTile];
+    // Each step's normal, forward and up as linear functions of a point
+    // (a . p - a . o), four steps a vector; padding steps see nothing.
+    alignas(16) float frame[3][4][kStepsPerTile];
     for (int k = 0; k < kStepsPerTile; ++k) {
       const bool real = k < count;
-      for (int a = 0; a < 3; ++a) plane[a][k] = real ? step[k].n[a] : 0.0f;
-      plane[3][k] = real ? step[k].n.dot(step[k].o) : kHuge;
+      const SweepStep& s = step[std::min(k, count - 1)];
+      const Eigen::Vector3f* along[3] = {&s.n, &s.f, &s.u};
+      for (int a = 0; a < 3; ++a) {
+        for (int c = 0; c < 3; ++c) frame[a][c][k] = real ? (*along[a])[c] : 0.0f;
+        frame[a][3][k] = real ? along[a]->dot(s.o) : kHuge;
+      }
     }
+    // The tile's channels' tangents, padded with +inf to 16.
+    alignas(16) float tile_tangent[kChannelsPerTile];
+    for (int j = 0; j < kChannelsPerTile; ++j) {
+      tile_tangent[j] = j_begin + j < j_end ? tangent[std::size_t(j_begin + j)] : kHuge;
+    }
+    const float tangent_slack = float(2e-6 / (lowest_cosine * lowest_cosine));
+    // The channels as elevation bands seen from the anchor in the middle
+    // step's frame (ChannelBands).
+    const Eigen::Vector3d mid_n = mid_f.cross(mid_u);
+    double tilt = 0.0;
+    for (int k = first_step; k < end_step; ++k) {
+      tilt =
+          std::max(tilt, std::acos(std::clamp(sweep.up_W[std::size_t(k)].dot(mid_u), -1.0, 1.0)));
+    }
+    tilt += 1e-5;  // the directions' rounding
+    ChannelBands bands;
+    bands.drift = float(drift + margin);
+    for (int j = 0; j < kChannelsPerTile; ++j) {
+      bands.low[j] = kHuge, bands.high[j] = -kHuge;
+      if (j_begin + j >= j_end) continue;
+      const double e = sweep.elevations_rad[std::size_t(order[std::size_t(j_begin + j)])];
+      constexpr double kSteep = 89.0 * M_PI / 180.0;
+      bands.low[j] = e - tilt > -kSteep ? float(std::tan(e - tilt)) : -kHuge;
+      bands.high[j] = e + tilt < kSteep ? float(std::tan(e + tilt)) : kHuge;
+    }
+    const Eigen::Vector3d* frame_axes[3] = {&mid_f, &mid_u, &mid_n};
+    const double frame_limit[3] = {0.0, 0.0, 0.0}, frame_margin[3] = {margin, margin, margin};
     // The pyramid's bounds for single triangles: axis, low bound, extent.
     __m128 pyramid[4][4], pyramid_limit[4];
     for (int a = 0; a < 4; ++a) {
@@ -1248,12 +1375,23 @@ void RayCaster::CastSweep(const scene::CollisionWorld& world, const RayBatch& ra
       const Eigen::Vector3f q_anchor =
           (anchor_L - target.bvh_min).cwiseProduct(target.quantization);
       const NodeDistance distance(q_anchor, target.quantization);
-      const float slack = float(drift + margin) + 1e-6f * float(reach + length);
+      const float reach_slack = float(drift + margin) + 1e-6f * float(reach + length);
       auto beyond = [&](float distance2) {
-        const float reach_now = tile_reach + slack;
+        const float reach_now = tile_reach + reach_slack;
         return distance2 > reach_now * reach_now;
       };
-      ForEachTriangleNearFirst(target, cull, distance, beyond, [&](int part, int triangle) {
+      // A node is entered if it meets the tile's pyramid and a channel's band.
+      const GridCull frame_cull =
+          CullFor(target, anchor, frame_axes, 3, frame_limit, frame_margin, false);
+      auto meets = [&](const btQuantizedBvhNode& node) {
+        if (!NodeMeetsGrid(node, cull)) return false;
+        __m128 from, to;
+        NodeSpans(node, frame_cull, &from, &to);
+        alignas(16) float lo[4], hi[4];
+        _mm_store_ps(lo, from), _mm_store_ps(hi, to);
+        return bands.MayMeet(lo[0], hi[0], lo[1], hi[1], std::max(-lo[2], hi[2]));
+      };
+      ForEachTriangleNearFirst(target, meets, distance, beyond, [&](int part, int triangle) {
         Eigen::Vector3f corners[3];
         Corners(target, part, triangle, corners);
         const __m128 cx = _mm_setr_ps(corners[0].x(), corners[1].x(), corners[2].x(), 0.0f);
@@ -1262,14 +1400,13 @@ void RayCaster::CastSweep(const scene::CollisionWorld& world, const RayBatch& ra
         const float size =
             ((corners[0] - step[0].o).cwiseAbs().sum() + (corners[1] - step[0].o).cwiseAbs().sum() +
              (corners[2] - step[0].o).cwiseAbs().sum());
-        const float m = float(margin) + 1e-6f * size;
-        const float m_tangent = m / float(lowest_cosine);
-        const __m128 top_tangent = _mm_set1_ps(tangent[std::size_t(j_end - 1)]);
-        const __m128 bottom_tangent = _mm_set1_ps(tangent[std::size_t(j_begin)]);
-        // The steps whose slab |w| <= m the triangle may meet (w rounded
-        // differently here: a wider slack, in the corners' and origins' size).
-        const __m128 cut_slack = _mm_set1_ps(m + 1e-6f * (size + 3.0f * float(reach)));
-        const __m128 negative_slack = Sub(_mm_setzero_ps(), cut_slack);
+        (void)cz;
+        // The margin: the rays' rounding (margin) and the rounding of the
+        // coordinates below, in the corners' and origins' size.
+        const float m = float(margin) + 1e-6f * (size + 3.0f * float(reach));
+        const __m128 slack = _mm_set1_ps(m), negative_slack = _mm_set1_ps(-m);
+        const float m_cut_tangent = m / float(lowest_cosine);
+        const __m128 m_tangent = _mm_set1_ps(m_cut_tangent);
         // Outside the tile's pyramid (all corners beyond one of its bounds): no ray meets it.
         {
           const __m128 x = Sub(cx, _mm_set1_ps(float(anchor.x())));
@@ -1280,85 +1417,93 @@ void RayCaster::CastSweep(const scene::CollisionWorld& world, const RayBatch& ra
                 Sub(Add(Add(Mul(x, pyramid[a][0]), Mul(y, pyramid[a][1])), Mul(z, pyramid[a][2])),
                     pyramid[a][3]);
             const int under = _mm_movemask_ps(_mm_cmplt_ps(w, negative_slack));
-            const int over = _mm_movemask_ps(_mm_cmpgt_ps(w, Add(pyramid_limit[a], cut_slack)));
+            const int over = _mm_movemask_ps(_mm_cmpgt_ps(w, Add(pyramid_limit[a], slack)));
             if ((under & 7) == 7 || (over & 7) == 7) return;
           }
+          // Between the channels' bands: no ray meets it.
+          auto span = [&](const Eigen::Vector3d& axis, float* lo, float* hi) {
+            alignas(16) float v[4];
+            _mm_store_ps(v, Add(Add(Mul(x, _mm_set1_ps(float(axis.x()))),
+                                    Mul(y, _mm_set1_ps(float(axis.y())))),
+                                Mul(z, _mm_set1_ps(float(axis.z())))));
+            *lo = std::min({v[0], v[1], v[2]}) - m, *hi = std::max({v[0], v[1], v[2]}) + m;
+          };
+          float f_lo, f_hi, u_lo, u_hi, w_lo, w_hi;
+          span(mid_f, &f_lo, &f_hi), span(mid_u, &u_lo, &u_hi), span(mid_n, &w_lo, &w_hi);
+          if (!bands.MayMeet(f_lo, f_hi, u_lo, u_hi, std::max(-w_lo, w_hi))) return;
         }
-        int candidates = 0;
+        // Four steps at a time, a step a lane: the corners' distances w from
+        // the step's plane, forward f and up u. The triangle may meet the
+        // step's rays if it reaches the slab |w| <= m in front; the rays'
+        // elevations there have tangents u / f within those of the corners
+        // (a ratio of linear functions has its extremes at the corners when
+        // f > 0 throughout).
+        __m128 corner_x[3], corner_y[3], corner_z[3];
+        for (int i = 0; i < 3; ++i) {
+          corner_x[i] = _mm_set1_ps(corners[i].x()), corner_y[i] = _mm_set1_ps(corners[i].y());
+          corner_z[i] = _mm_set1_ps(corners[i].z());
+        }
+        auto along = [&](int a, int k, int i) {
+          return Sub(Add(Add(Mul(_mm_load_ps(&frame[a][0][k]), corner_x[i]),
+                             Mul(_mm_load_ps(&frame[a][1][k]), corner_y[i])),
+                         Mul(_mm_load_ps(&frame[a][2][k]), corner_z[i])),
+                     _mm_load_ps(&frame[a][3][k]));
+        };
         for (int k = 0; k < count; k += 4) {
+          // First the slab: most groups of steps miss the triangle.
           __m128 w_low = _mm_set1_ps(kHuge), w_high = _mm_set1_ps(-kHuge);
           for (int i = 0; i < 3; ++i) {
-            const __m128 w =
-                Sub(Add(Add(Mul(_mm_load_ps(&plane[0][k]), _mm_set1_ps(corners[i].x())),
-                            Mul(_mm_load_ps(&plane[1][k]), _mm_set1_ps(corners[i].y()))),
-                        Mul(_mm_load_ps(&plane[2][k]), _mm_set1_ps(corners[i].z()))),
-                    _mm_load_ps(&plane[3][k]));
+            const __m128 w = along(0, k, i);
             w_low = _mm_min_ps(w_low, w), w_high = _mm_max_ps(w_high, w);
           }
-          candidates |= _mm_movemask_ps(_mm_and_ps(_mm_cmple_ps(w_low, cut_slack),
-                                                   _mm_cmpge_ps(w_high, negative_slack)))
-                        << k;
-        }
-        for (; candidates != 0; candidates &= candidates - 1) {
-          const int k = __builtin_ctz(unsigned(candidates));
-          const Step& s = step[k];
-          const __m128 x = Sub(cx, _mm_set1_ps(s.o.x()));
-          const __m128 y = Sub(cy, _mm_set1_ps(s.o.y()));
-          const __m128 z = Sub(cz, _mm_set1_ps(s.o.z()));
-          auto along = [&](const Eigen::Vector3f& a) {
-            return Add(Add(Mul(x, _mm_set1_ps(a.x())), Mul(y, _mm_set1_ps(a.y()))),
-                       Mul(z, _mm_set1_ps(a.z())));
-          };
-          alignas(16) float w[4], f[4], u[4];
-          _mm_store_ps(w, along(s.n));
-          if (std::min({w[0], w[1], w[2]}) > m || std::max({w[0], w[1], w[2]}) < -m) continue;
-          const __m128 forward = along(s.f), up = along(s.u);
-          // In front (beyond the margin) and all above the tile's highest
-          // channel or all below its lowest (lines in the step's plane): no
-          // ray of the tile meets the cut, a convex combination of corners.
-          if ((_mm_movemask_ps(_mm_cmpgt_ps(forward, _mm_set1_ps(m))) & 7) == 7) {
-            const __m128 over = Sub(up, Mul(top_tangent, forward));
-            const __m128 under = Sub(up, Mul(bottom_tangent, forward));
-            if ((_mm_movemask_ps(_mm_cmpgt_ps(over, _mm_set1_ps(m_tangent))) & 7) == 7 ||
-                (_mm_movemask_ps(_mm_cmplt_ps(under, _mm_set1_ps(-m_tangent))) & 7) == 7) {
+          int step_meets = _mm_movemask_ps(
+              _mm_and_ps(_mm_cmple_ps(w_low, slack), _mm_cmpge_ps(w_high, negative_slack)));
+          if (step_meets == 0) continue;
+          __m128 f_low = _mm_set1_ps(kHuge), f_high = _mm_set1_ps(-kHuge);
+          __m128 t_low = f_low, t_high = f_high;
+          for (int i = 0; i < 3; ++i) {
+            const __m128 f = along(1, k, i), u = along(2, k, i);
+            f_low = _mm_min_ps(f_low, f), f_high = _mm_max_ps(f_high, f);
+            const __m128 inverse = _mm_div_ps(_mm_set1_ps(1.0f), f);
+            t_low = _mm_min_ps(t_low, Mul(Sub(u, m_tangent), inverse));
+            t_high = _mm_max_ps(t_high, Mul(Add(u, m_tangent), inverse));
+          }
+          step_meets &= _mm_movemask_ps(_mm_cmpge_ps(f_high, negative_slack));
+          if (step_meets == 0) continue;
+          const int in_front = _mm_movemask_ps(_mm_cmpgt_ps(f_low, slack));
+          // The direction's own rounding, in tangents.
+          const __m128 spread = Mul(_mm_set1_ps(tangent_slack),
+                                    Add(_mm_set1_ps(1.0f), _mm_max_ps(Abs(t_low), Abs(t_high))));
+          t_low = Sub(t_low, spread), t_high = Add(t_high, spread);
+          alignas(16) float lows[4], highs[4], nears[4];
+          _mm_store_ps(lows, t_low), _mm_store_ps(highs, t_high);
+          _mm_store_ps(nears, Sub(f_low, slack));
+          for (int lane = 0; lane < 4; ++lane) {
+            if (!(step_meets & (1 << lane))) continue;
+            // The tile's channels whose tangent lies in [low, high]; all of
+            // them when the triangle comes within the margin of the origin.
+            int j0 = j_begin, j1 = j_end;
+            if (in_front & (1 << lane)) {
+              const __m128 from = _mm_set1_ps(lows[lane]), to = _mm_set1_ps(highs[lane]);
+              int under = 0, up_to = 0;
+              for (int q = 0; q < kChannelsPerTile; q += 4) {
+                const __m128 t = _mm_load_ps(&tile_tangent[q]);
+                under += kBitsSet[_mm_movemask_ps(_mm_cmplt_ps(t, from))];
+                up_to += kBitsSet[_mm_movemask_ps(_mm_cmple_ps(t, to))];
+              }
+              j0 = j_begin + under, j1 = j_begin + up_to;
+            }
+            float near = nears[lane];
+            // Several channels: the cut by the step's slab, often narrower
+            // than the whole triangle, tells which.
+            if (j1 - j0 > 1 && !Cut(corners, step[k + lane], m, m_cut_tangent, j_begin,
+                                    tile_tangent, &j0, &j1, &near)) {
               continue;
             }
-          }
-          _mm_store_ps(f, forward);
-          _mm_store_ps(u, up);
-          // The triangle's cut by the slab |w| <= m: its corners in the slab
-          // and its edges' crossings of the slab's faces, as (forward, up).
-          float f_min = kHuge, f_max = -kHuge, lo = kHuge, hi = -kHuge;
-          auto point = [&](float pf, float pu) {
-            f_min = std::min(f_min, pf), f_max = std::max(f_max, pf);
-            if (pf > 0.0f) {
-              const float inverse = 1.0f / pf;
-              lo = std::min(lo, (pu - m_tangent) * inverse);
-              hi = std::max(hi, (pu + m_tangent) * inverse);
+            const int ray_step = first_step + k + lane;
+            for (int j = j0; j < j1; ++j) {
+              band.Add(corners, target.body, int(ray_of(j, ray_step)), near, test);
             }
-          };
-          for (int i = 0; i < 3; ++i) {
-            if (std::abs(w[i]) <= m) point(f[i], u[i]);
-            const int j = i == 2 ? 0 : i + 1;
-            if (w[i] == w[j]) continue;
-            for (const float face : {-m, m}) {
-              if ((face - w[i]) * (face - w[j]) > 0.0f) continue;
-              const float t = std::clamp((face - w[i]) / (w[j] - w[i]), 0.0f, 1.0f);
-              point(f[i] + t * (f[j] - f[i]), u[i] + t * (u[j] - u[i]));
-            }
-          }
-          if (f_max < -m) continue;  // behind the step's rays
-          // Channels whose elevation's tangent lies in [lo, hi]; all the
-          // tile's when the cut comes within the margin of the origin.
-          int j0 = j_begin, j1 = j_end;
-          if (f_min > m) {
-            const auto first = tangent.begin() + j_begin, last = tangent.begin() + j_end;
-            j0 = int(std::lower_bound(first, last, lo) - tangent.begin());
-            j1 = int(std::upper_bound(first, last, hi) - tangent.begin());
-          }
-          const float near = f_min - m;
-          for (int j = j0; j < j1; ++j) {
-            band.Add(corners, target.body, int(ray_of(j, first_step + k)), near, test);
           }
         }
       });
