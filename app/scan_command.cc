@@ -170,7 +170,7 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
           samples.push_back({std::to_string(f) + "," + std::to_string(k / scan.n) + "," +
                                  std::to_string(k % scan.n) + "," + std::to_string(occupancy) + ",",
                              occupancy == sensors::kOccupied,
-                             scan.faces[std::size_t(f)].points_W[std::size_t(k)], ""});
+                             scan.PointW(f, std::size_t(k)), ""});
         }
       }
     } else if (sensor == "ground") {

@@ -21,10 +21,11 @@ void WriteFaceScanPly(const sensors::FaceScan& scan, const std::string& path) {
       << "\nproperty double x\nproperty double y\nproperty double z\nproperty uchar red\n"
          "property uchar green\nproperty uchar blue\nend_header\n"
       << std::setprecision(10);
-  for (const sensors::ScanFace& face : scan.faces) {
-    for (std::size_t i = 0; i < face.occupancy.size() && i < face.points_W.size(); ++i) {
+  for (int f = 0; f < 6; ++f) {
+    const sensors::ScanFace& face = scan.faces[std::size_t(f)];
+    for (std::size_t i = 0; i < face.occupancy.size() && i < face.distance_m.size(); ++i) {
       if (face.occupancy[i] == sensors::kUnvisited) continue;
-      const Eigen::Vector3d& p = face.points_W[i];
+      const Eigen::Vector3d p = scan.PointW(f, i);
       out << p.x() << ' ' << p.y() << ' ' << p.z() << ' '
           << (face.occupancy[i] == sensors::kOccupied ? "255 0 0" : "0 255 0") << '\n';
     }

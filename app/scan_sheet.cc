@@ -56,14 +56,12 @@ ScanSheet DrawFaceScanSheet(const sensors::FaceScan& scan, double half_extent_m,
                          side);
     sheet.panels[std::size_t(f)] = panel;
     const sensors::ScanFace& face = scan.faces[std::size_t(f)];
-    const Eigen::Isometry3d X_BW = face.X_WB.inverse();
-    const Eigen::Vector3d axis = sensors::FaceAxis(f);
     for (int r = 0; r < n; ++r) {
       for (int c = 0; c < n; ++c) {
         const std::size_t k = std::size_t(r) * std::size_t(n) + std::size_t(c);
         cv::Vec3b colour(kUnvisitedSampleGrey, kUnvisitedSampleGrey, kUnvisitedSampleGrey);
         if (k < face.occupancy.size() && face.occupancy[k] == sensors::kOccupied) {
-          colour = DistanceColour(axis.dot(X_BW * face.points_W[k]), half_extent_m);
+          colour = DistanceColour(face.distance_m[k], half_extent_m);
         } else if (k < face.occupancy.size() && face.occupancy[k] == sensors::kFree) {
           colour = cv::Vec3b(kFreeSampleGrey, kFreeSampleGrey, kFreeSampleGrey);
         }

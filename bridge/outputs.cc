@@ -111,7 +111,7 @@ void PublishOutput(const sensors::FaceScan& scan, const Header& header, Send&& s
     message.num_points = int(n);
     message.occupancy = face.occupancy;
     message.num_xyz = int(3 * n);
-    Offsets(face.points_W, p, &message.xyz);
+    Offsets(scan.PointsW(f), p, &message.xyz);
     send(message);
   }
 }

@@ -1,5 +1,6 @@
 #include "sensors/face_scanner.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -77,7 +78,6 @@ FaceScan FaceScanner::EmptyScan() const {
   const Eigen::Vector3d nan = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   for (ScanFace& face : scan.faces) {
     face.occupancy.assign(std::size_t(n_) * std::size_t(n_), kUnvisited);
-    face.points_W.assign(std::size_t(n_) * std::size_t(n_), nan);
     face.distance_m.assign(std::size_t(n_) * std::size_t(n_), nan.x());
   }
   return scan;
@@ -107,6 +107,17 @@ std::vector<FaceScanner::Part> FaceScanner::DueAt(std::int64_t tick) const {
 
 void FaceScanner::AppendRays(const Part& part, const Eigen::Isometry3d& X_WS,
                              RayBatch* rays) const {
+  const std::size_t first = rays->start.size();
+  const std::size_t count = std::size_t(part.row_end - part.row_begin) * std::size_t(n_);
+  rays->start.resize(first + count);
+  rays->direction.resize(first + count);
+  rays->length_m.resize(first + count);
+  FillRays(part, X_WS, rays->origin_W, rays, first, false);
+}
+
+void FaceScanner::FillRays(const Part& part, const Eigen::Isometry3d& X_WS,
+                           const Eigen::Vector3d& origin_W, RayBatch* rays, std::size_t first,
+                           bool starts_only) const {
   const Eigen::Matrix3d R_WS = config_.alignment == Alignment::kBody
                                    ? Eigen::Matrix3d(X_WS.linear())
                                    : Eigen::Matrix3d::Identity();
@@ -115,17 +126,17 @@ void FaceScanner::AppendRays(const Part& part, const Eigen::Isometry3d& X_WS,
   const Eigen::Vector3f axis_W = (R_WS * FaceAxis(part.face)).cast<float>();
   const Eigen::Vector3d u_W = R_WS * u, v_W = R_WS * v;
   const double E = config_.half_extent_m, res = config_.resolution_m;
-  const Eigen::Vector3d offset = X_WS.translation() - rays->origin_W;
+  const Eigen::Vector3d offset = X_WS.translation() - origin_W;
   // Start c, r = offset + u (-E + c res) + v (-E + r res), summed in that
   // order; the columns' first two terms are the same on every row.
   thread_local std::vector<Eigen::Vector3d> columns;
   columns.resize(std::size_t(n_));
   for (int c = 0; c < n_; ++c) columns[std::size_t(c)] = offset + u_W * (-E + c * res);
-  const std::size_t first = rays->start.size();
   const std::size_t count = std::size_t(part.row_end - part.row_begin) * std::size_t(n_);
-  rays->start.resize(first + count);
-  rays->direction.resize(first + count, axis_W);
-  rays->length_m.resize(first + count, static_cast<float>(E));
+  if (!starts_only) {
+    std::fill_n(rays->direction.begin() + std::ptrdiff_t(first), count, axis_W);
+    std::fill_n(rays->length_m.begin() + std::ptrdiff_t(first), count, static_cast<float>(E));
+  }
   Eigen::Vector3f* start = rays->start.data() + first;
   for (int r = part.row_begin; r < part.row_end; ++r) {
     const Eigen::Vector3d row = v_W * (-E + r * res);
@@ -148,6 +159,9 @@ RayGrid FaceScanner::GridOf(const Part& part, const Eigen::Isometry3d& X_WS,
   grid.corner_W = X_WS.translation() + R_WS * (u * -E + v * (-E + part.row_begin * res));
   grid.step_u_W = R_WS * u * res;
   grid.step_v_W = R_WS * v * res;
+  // As FillRays gives them to the batch's rays.
+  grid.direction = (R_WS * FaceAxis(part.face)).cast<float>();
+  grid.length_m = static_cast<float>(E);
   return grid;
 }
 
@@ -174,25 +188,71 @@ void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
   thread_local RayHits hits;
   hits.with_normals = false;
   thread_local std::vector<RayGrid> grids;
-  GridRays(tick, X_WS, &rays, &grids);
-  caster.CastGrids(world, rays, grids, filter, &hits);
-  // Write each part's results back into its face.
-  std::size_t i = 0;
+  // The rays of GridRays, made in pieces of rows on the caster's threads:
+  // their starts only (the structured kernel takes the direction and the
+  // length from the grids).
+  grids.clear();
+  std::size_t total = 0;
   for (const Part& part : parts) {
+    grids.push_back(GridOf(part, X_WS, total));
+    total += std::size_t(part.row_end - part.row_begin) * std::size_t(n_);
+  }
+  // (The jobs reach this thread's thread_local batch and grids through
+  // references: in a job, `rays` would be the job thread's own.)
+  RayBatch& batch = rays;
+  const std::vector<RayGrid>& blocks = grids;
+  batch.origin_W = X_WS.translation();
+  batch.Resize(total);
+  constexpr int kPiecesPerPart = 8;
+  caster.RunParallel(int(parts.size()) * kPiecesPerPart, [&](int job) {
+    const Part& part = parts[std::size_t(job / kPiecesPerPart)];
+    const int piece = job % kPiecesPerPart, rows = part.row_end - part.row_begin;
+    const Part rows_of{part.face, part.row_begin + rows * piece / kPiecesPerPart,
+                       part.row_begin + rows * (piece + 1) / kPiecesPerPart};
+    const std::size_t first = blocks[std::size_t(job / kPiecesPerPart)].first +
+                              std::size_t(rows_of.row_begin - part.row_begin) * std::size_t(n_);
+    FillRays(rows_of, X_WS, batch.origin_W, &batch, first, true);
+  });
+  caster.CastGrids(world, rays, grids, filter, &hits);
+  // Write each part's results back into its face (a part a job; through a
+  // reference, as above).
+  const RayHits& cast = hits;
+  std::vector<std::size_t> first(parts.size(), 0);
+  for (std::size_t p = 1; p < parts.size(); ++p) {
+    first[p] =
+        first[p - 1] + std::size_t(parts[p - 1].row_end - parts[p - 1].row_begin) * std::size_t(n_);
+  }
+  caster.RunParallel(int(parts.size()), [&](int p) {
+    const Part& part = parts[std::size_t(p)];
     ScanFace& face = scan->faces[std::size_t(part.face)];
     face.tick = tick;
     face.X_WS = X_WS;
     face.X_WB = BoxFrame(X_WS);
-    for (int r = part.row_begin; r < part.row_end; ++r) {
-      for (int c = 0; c < n_; ++c, ++i) {
-        const std::size_t k = std::size_t(r) * std::size_t(n_) + std::size_t(c);
-        face.occupancy[k] = hits.body[i] == RayHits::kNoHit ? kFree : kOccupied;
-        face.distance_m[k] = hits.distance_m[i];
-        face.points_W[k] =
-            rays.origin_W + (rays.start[i] + hits.distance_m[i] * rays.direction[i]).cast<double>();
-      }
+    const std::size_t k0 = std::size_t(part.row_begin) * std::size_t(n_);
+    const std::size_t count = std::size_t(part.row_end - part.row_begin) * std::size_t(n_);
+    const std::size_t i0 = first[std::size_t(p)];
+    for (std::size_t j = 0; j < count; ++j) {
+      face.occupancy[k0 + j] = cast.body[i0 + j] == RayHits::kNoHit ? kFree : kOccupied;
     }
-  }
+    std::copy(cast.distance_m.begin() + std::ptrdiff_t(i0),
+              cast.distance_m.begin() + std::ptrdiff_t(i0 + count),
+              face.distance_m.begin() + std::ptrdiff_t(k0));
+  });
+}
+
+Eigen::Vector3d FaceScan::PointW(int face, std::size_t k) const {
+  const ScanFace& f = faces[std::size_t(face)];
+  Eigen::Vector3d u, v;
+  FaceGridAxes(face, &u, &v);
+  const double E = half_extent_m, res = resolution_m;
+  const int r = int(k / std::size_t(n)), c = int(k % std::size_t(n));
+  return f.X_WB * (u * (-E + c * res) + v * (-E + r * res) + FaceAxis(face) * f.distance_m[k]);
+}
+
+std::vector<Eigen::Vector3d> FaceScan::PointsW(int face) const {
+  std::vector<Eigen::Vector3d> points(faces[std::size_t(face)].distance_m.size());
+  for (std::size_t k = 0; k < points.size(); ++k) points[k] = PointW(face, k);
+  return points;
 }
 
 FaceScannerConfig FaceScannerConfig::Read(scene::SettingsReader& read) {

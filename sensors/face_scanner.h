@@ -69,7 +69,6 @@ struct ScanFace {
   Eigen::Isometry3d X_WS{Eigen::Isometry3d::Identity()};  // sensor pose of that scan
   Eigen::Isometry3d X_WB{Eigen::Isometry3d::Identity()};  // the box of that scan (BoxFrame)
   std::vector<std::int8_t> occupancy;                     // n * n, Occupancy
-  std::vector<Eigen::Vector3d> points_W;  // n * n: the hit, or the ray's end when free
   std::vector<float> distance_m;  // n * n: from the ray's start along the face axis; NaN unvisited
 };
 
@@ -79,6 +78,13 @@ struct FaceScan {
   // The grid and how it is to be published (the scanner's config).
   double resolution_m{1.0}, half_extent_m{25.0};
   FaceEncoding encoding{FaceEncoding::kPoints};
+
+  // Sample k of face f in the world, from its distance and its box: the hit,
+  // or the ray's end when free; NaN when unvisited. Computed on demand (a
+  // scan keeps one distance a sample, not three doubles).
+  Eigen::Vector3d PointW(int face, std::size_t k) const;
+  // All of face f's samples so, in grid order.
+  std::vector<Eigen::Vector3d> PointsW(int face) const;
 };
 
 // Face f's frame in the world: the box it was last scanned in.
@@ -126,6 +132,11 @@ class FaceScanner {
   // Appends the rays of `part` from pose X_WS to `rays` (origin_W must be the
   // sensor position).
   void AppendRays(const Part& part, const Eigen::Isometry3d& X_WS, RayBatch* rays) const;
+  // The same rays written into rays[first ...] of a batch already sized,
+  // whose origin is origin_W; with starts_only, their starts alone (enough
+  // for RayCaster::CastGrids, which takes directions and lengths from GridOf).
+  void FillRays(const Part& part, const Eigen::Isometry3d& X_WS, const Eigen::Vector3d& origin_W,
+                RayBatch* rays, std::size_t first, bool starts_only) const;
   // The grid those rays form (RayCaster::CastGrids), `first` being the index
   // of the part's first ray in the batch.
   RayGrid GridOf(const Part& part, const Eigen::Isometry3d& X_WS, std::size_t first) const;

@@ -998,12 +998,10 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
                                   std::to_string(n) + " rays in order");
     }
     next = grid.first + std::size_t(grid.rows) * std::size_t(grid.cols);
-    for (std::size_t i = grid.first + 1; i < next; ++i) {
-      if (rays.direction[i] != rays.direction[grid.first] ||
-          rays.length_m[i] != rays.length_m[grid.first]) {
-        throw std::invalid_argument("RayCaster::CastGrids(): ray " + std::to_string(i) +
-                                    " differs in direction or length from its block's first");
-      }
+    if (!(std::abs(grid.direction.norm() - 1.0f) < 1e-5f) ||
+        !(std::isfinite(grid.length_m) && grid.length_m > 0.0f)) {
+      throw std::invalid_argument(
+          "RayCaster::CastGrids(): a block's direction must be unit and its length positive");
     }
   }
   if (next != n) {
@@ -1011,6 +1009,15 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
                                 " of the batch's " + std::to_string(n) + " rays");
   }
 #if !defined(__SSE2__)
+  // Cast() reads the batch's directions and lengths: they must be the blocks'.
+  for (const RayGrid& grid : grids) {
+    for (std::size_t i = grid.first; i < grid.first + std::size_t(grid.rows) * grid.cols; ++i) {
+      if (rays.direction[i] != grid.direction || rays.length_m[i] != grid.length_m) {
+        throw std::invalid_argument("RayCaster::CastGrids(): ray " + std::to_string(i) +
+                                    " differs in direction or length from its block");
+      }
+    }
+  }
   Cast(world, rays, filter, hits);
 #else
   rays_cast_ += std::int64_t(n);
@@ -1042,8 +1049,8 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
     const int rows = this_band.row_end - row_begin, cols = grid.cols;
     const std::size_t first = grid.first + std::size_t(row_begin) * std::size_t(cols);
     const std::size_t count = std::size_t(rows) * std::size_t(cols);
-    const Eigen::Vector3f d = rays.direction[first];
-    const float length = rays.length_m[first];
+    const Eigen::Vector3f d = grid.direction;
+    const float length = grid.length_m;
     thread_local GridBand band;
     band.dx = _mm_set1_ps(d.x()), band.dy = _mm_set1_ps(d.y()), band.dz = _mm_set1_ps(d.z());
     band.ox = _mm_set1_ps(origin_B.x()), band.oy = _mm_set1_ps(origin_B.y());

@@ -39,14 +39,19 @@ struct RayBatch {
 
 // A block of a batch whose rays run parallel and start on a regular grid (a
 // face scan's face): ray (r, c), r < rows, c < cols, is the batch's ray
-// first + r * cols + c; it starts at corner_W + c * step_u_W + r * step_v_W
-// (to float rounding) and runs along the block's one direction for its one
-// length. The steps are perpendicular to the direction.
+// first + r * cols + c; it starts at the batch's origin plus its start, which
+// is corner_W + c * step_u_W + r * step_v_W (to float rounding), and runs
+// along the block's one direction for its one length (the block's own: the
+// structured kernel does not read the batch's direction and length of these
+// rays, so a caller may leave them unset). The steps are perpendicular to the
+// direction.
 struct RayGrid {
   std::size_t first{0};
   int rows{0}, cols{0};
   Eigen::Vector3d corner_W{Eigen::Vector3d::Zero()};
   Eigen::Vector3d step_u_W{Eigen::Vector3d::UnitX()}, step_v_W{Eigen::Vector3d::UnitY()};
+  Eigen::Vector3f direction{Eigen::Vector3f::UnitZ()};  // unit
+  float length_m{1.0f};
 };
 
 // A lidar sweep as a batch of channels x steps rays: ray (c, k) is the
@@ -101,9 +106,10 @@ class RayCaster {
   // are found once and each is tested against exactly the rays its shadow on
   // the grid covers, with Cast()'s own per-ray test. Same hits as Cast():
   // the same rays hit, at the same distances (Cast()'s arithmetic; see
-  // docs/sensors.md for the one difference a tie can make). Throws
+  // docs/sensors.md for the one difference a tie can make) when the batch's
+  // rays run along their block's direction for its length. Throws
   // std::invalid_argument when the blocks do not cover the batch in order or
-  // a block's rays differ in direction or length.
+  // a block's direction is not unit or its length not positive.
   void CastGrids(const scene::CollisionWorld& world, const RayBatch& rays,
                  const std::vector<RayGrid>& grids, const RayFilter& filter, RayHits* hits);
 

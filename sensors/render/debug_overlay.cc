@@ -4,13 +4,14 @@ namespace sandbox::render {
 
 void AddFaceScan(const sensors::FaceScan& scan, double stub_m, Overlay* overlay) {
   const Eigen::Vector3f red(1.f, 0.1f, 0.1f), green(0.1f, 0.9f, 0.1f);
-  for (const sensors::ScanFace& face : scan.faces) {
+  for (int f = 0; f < 6; ++f) {
+    const sensors::ScanFace& face = scan.faces[std::size_t(f)];
     if (face.tick < 0) continue;
     const Eigen::Vector3d origin_W = face.X_WS.translation();
-    for (std::size_t i = 0; i < face.points_W.size() && i < face.occupancy.size(); ++i) {
+    for (std::size_t i = 0; i < face.distance_m.size() && i < face.occupancy.size(); ++i) {
       if (face.occupancy[i] == sensors::kUnvisited) continue;
       const Eigen::Vector3f& rgb = face.occupancy[i] == sensors::kOccupied ? red : green;
-      const Eigen::Vector3d& p_W = face.points_W[i];
+      const Eigen::Vector3d p_W = scan.PointW(f, i);
       if (stub_m <= 0.0) {
         overlay->AddPoint(p_W, rgb);
         continue;

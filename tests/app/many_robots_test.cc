@@ -179,7 +179,7 @@ void Compare(const sandbox_msgs::scan_face_t& message, const scene::CollisionWor
                                                        message.xyz[std::size_t(3 * k + 1)],
                                                        message.xyz[std::size_t(3 * k + 2)])
                                            .cast<double>();
-    result->errors_m.push_back((p - face.points_W[std::size_t(k)]).norm());
+    result->errors_m.push_back((p - scan.PointW(message.face, std::size_t(k))).norm());
   }
 }
 

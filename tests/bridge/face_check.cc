@@ -50,7 +50,7 @@ struct Checker {
       const Eigen::Vector3d p = origin + Eigen::Vector3d(message->xyz[std::size_t(3 * k)],
                                                          message->xyz[std::size_t(3 * k + 1)],
                                                          message->xyz[std::size_t(3 * k + 2)]);
-      const double diff = (p - face.points_W[std::size_t(k)]).norm();
+      const double diff = (p - scan.PointW(message->face, std::size_t(k))).norm();
       worst_m = std::max(worst_m, diff);
       if (message->occupancy[std::size_t(k)] != face.occupancy[std::size_t(k)] || diff > 1e-4) {
         ++mismatched_points;

@@ -86,9 +86,11 @@ TEST(RobotOutputsTest, AnyKindOfOutputGoesOutThroughOneCall) {
   std::vector<sensors::SensorOutput> all(sensors::kSensorKinds.size());
   sensors::FaceScan scan;
   scan.n = 1;
-  scan.faces[4].tick = 3;  // the +Z face, scanned at tick 3
+  scan.half_extent_m = 0.0;  // one sample, on the box's axis
+  scan.faces[4].tick = 3;    // the +Z face, scanned at tick 3
   scan.faces[4].occupancy = {sensors::kOccupied};
-  scan.faces[4].points_W = {Eigen::Vector3d(1, 2, 3)};
+  scan.faces[4].X_WS = scan.faces[4].X_WB = Eigen::Isometry3d(Eigen::Translation3d(1, 2, 0));
+  scan.faces[4].distance_m = {3.0f};  // the point (1, 2, 3)
   all[std::size_t(sensors::SensorKind::kFace)] = scan;
   sensors::HeightMap map;
   map.n = 1;
@@ -116,6 +118,7 @@ TEST(RobotOutputsTest, AnyKindOfOutputGoesOutThroughOneCall) {
   EXPECT_EQ(f.face, 4);
   EXPECT_EQ(f.tick, 3);
   EXPECT_EQ(f.occupancy, std::vector<std::int8_t>{sensors::kOccupied});
+  EXPECT_EQ(f.xyz, (std::vector<float>{0.0f, 0.0f, 3.0f}));  // from the sensor at (1, 2, 0)
   sandbox_msgs::ground_map_t g;
   ASSERT_TRUE(Newest(ground, &g));
   EXPECT_EQ(g.height, std::vector<float>{7.5f});
@@ -223,7 +226,7 @@ TEST(RobotOutputsTest, TwoSensorsOfATypeNeedTheirOwnChannels) {
   scan.n = 1;
   scan.faces[2].tick = 5;
   scan.faces[2].occupancy = {sensors::kFree};
-  scan.faces[2].points_W = {Eigen::Vector3d(1, 2, 3)};
+  scan.faces[2].distance_m = {25.0f};
   outputs.Publish(scan, {"tail", sensors::OutputChannel(level.robots[0].sensors[1])}, 5, {}, 0);
   link.Drain();
   EXPECT_NE(own.TakeNewest(), nullptr);
@@ -290,8 +293,8 @@ TEST(CompactFaceTest, DecodedPointsAreTheScannersPoints) {
       const FacePoints decoded = DecodeCompactFace(message);
       const sensors::ScanFace& face = scan.faces[std::size_t(f)];
       ASSERT_EQ(decoded.occupancy, face.occupancy) << "face " << f;
-      for (std::size_t k = 0; k < face.points_W.size(); ++k) {
-        worst_m = std::max(worst_m, (decoded.points_W[k] - face.points_W[k]).norm());
+      for (std::size_t k = 0; k < face.distance_m.size(); ++k) {
+        worst_m = std::max(worst_m, (decoded.points_W[k] - scan.PointW(f, k)).norm());
         occupied += face.occupancy[k] == sensors::kOccupied;
         free += face.occupancy[k] == sensors::kFree;
       }
@@ -390,14 +393,14 @@ TEST(CompactFaceTest, TheOctaveFunctionGivesTheScannersPoints) {
     std::string line;
     std::size_t k = 0;
     double worst_m = 0.0;
-    while (std::getline(rows, line) && k < face.points_W.size()) {
+    while (std::getline(rows, line) && k < face.distance_m.size()) {
       double x, y, z, occupancy;
       ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf", &x, &y, &z, &occupancy), 4) << line;
       EXPECT_EQ(int(occupancy), int(face.occupancy[k])) << "face " << f << ", point " << k;
-      worst_m = std::max(worst_m, (Eigen::Vector3d(x, y, z) - face.points_W[k]).norm());
+      worst_m = std::max(worst_m, (Eigen::Vector3d(x, y, z) - scan.PointW(f, k)).norm());
       ++k;
     }
-    EXPECT_EQ(k, face.points_W.size()) << "face " << f;
+    EXPECT_EQ(k, face.distance_m.size()) << "face " << f;
     EXPECT_LE(worst_m, 0.5e-3 + 1e-5) << "face " << f;
   }
 }

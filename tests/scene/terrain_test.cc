@@ -155,7 +155,7 @@ double WorstDownwardError(const sensors::FaceScan& scan, const Isometry3d& X_WS,
       for (const Triangle& tri : triangles)
         t = std::min(t, Intersect(o, down, tri.a, tri.b, tri.c));
       EXPECT_TRUE(std::isfinite(t)) << "ray " << r << ", " << c << " has no reference hit";
-      if (std::isfinite(t)) worst = std::max(worst, (face.points_W[k] - (o + t * down)).norm());
+      if (std::isfinite(t)) worst = std::max(worst, (scan.PointW(5, k) - (o + t * down)).norm());
     }
   }
   return worst;

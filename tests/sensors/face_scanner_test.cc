@@ -65,7 +65,7 @@ TEST(FaceScannerTest, PlaneBelowIsHitByEveryDownRayAndNothingElse) {
     const ScanFace& face = scan.faces[std::size_t(f)];
     EXPECT_EQ(face.tick, 7);
     for (std::size_t k = 0; k < face.occupancy.size(); ++k) {
-      const Vector3d& p = face.points_W[k];
+      const Vector3d p = scan.PointW(f, k);
       if (f == 5) {  // -Z: every ray meets the plane at z = 0 after h metres
         ASSERT_EQ(face.occupancy[k], kOccupied) << k;
         EXPECT_NEAR(p.z(), 0.0, 1e-3);
@@ -77,9 +77,9 @@ TEST(FaceScannerTest, PlaneBelowIsHitByEveryDownRayAndNothingElse) {
   // Row r, column c of -Z lies at u = -25 + c, v = -25 + r along the sensor's x and y.
   const Eigen::Matrix3d R = At(0, 0, 0, 0.3).linear();
   const Vector3d expected = Vector3d(3, 4, 0) + R * Vector3d(-25 + 7, -25 + 40, 0);
-  EXPECT_LT((scan.faces[5].points_W[40 * 51 + 7] - expected).norm(), 1e-3);
+  EXPECT_LT((scan.PointW(5, 40 * 51 + 7) - expected).norm(), 1e-3);
   // The +Z face ends 25 m above the sensor.
-  EXPECT_NEAR(scan.faces[4].points_W[0].z(), h + 25.0, 1e-4);
+  EXPECT_NEAR(scan.PointW(4, 0).z(), h + 25.0, 1e-4);
 }
 
 TEST(FaceScannerTest, ConeHitsFollowTheConeEquation) {
@@ -97,7 +97,7 @@ TEST(FaceScannerTest, ConeHitsFollowTheConeEquation) {
   int checked = 0;
   const ScanFace& down = scan.faces[5];
   for (std::size_t k = 0; k < down.occupancy.size(); ++k) {
-    const Vector3d& p = down.points_W[k];
+    const Vector3d p = scan.PointW(5, k);
     const double r = std::hypot(p.x(), p.y());
     if (r > radius + 0.01) {
       EXPECT_EQ(down.occupancy[k], kFree) << r;  // beyond the base: nothing within 25 m
@@ -131,13 +131,52 @@ TEST(FaceScannerTest, RaysStartingInsideABoxHitItsInnerWalls) {
         const bool outside = std::abs(-25 + r) > 5 || std::abs(-25 + c) > 5;
         if (inside) {
           ASSERT_EQ(face.occupancy[k], kOccupied);
-          EXPECT_NEAR(face.points_W[k].dot(FaceAxis(f)), 5.0, 1e-4);
+          EXPECT_NEAR(scan.PointW(f, k).dot(FaceAxis(f)), 5.0, 1e-4);
         } else if (outside) {
           ASSERT_EQ(face.occupancy[k], kFree);
         }
       }
     }
   }
+}
+
+// A scan keeps distances; its points, computed from them and the box, are
+// the rays' own ends: the batch's origin plus start plus distance along the
+// direction (float rays, as cast), in a world-aligned and a turned box.
+TEST(FaceScannerTest, PointsAreTheRaysEnds) {
+  const scene::Level level = scene::LoadLevel(testing::SampleLevel());
+  const scene::CollisionWorld world(level);
+  RayCaster caster(2);
+  for (const Alignment alignment : {Alignment::kWorld, Alignment::kBody}) {
+    FaceScannerConfig config;
+    config.refresh = Refresh::kFull;
+    config.alignment = alignment;
+    config.resolution_m = 0.5;
+    const FaceScanner scanner(config);
+    const Eigen::Isometry3d X_WS = At(20, -25, 22, 0.5);
+    FaceScan scan = scanner.EmptyScan();
+    scanner.Scan(world, caster, {}, X_WS, 0, &scan);
+    RayBatch rays;
+    std::vector<RayGrid> grids;
+    scanner.GridRays(0, X_WS, &rays, &grids);
+    RayHits hits;
+    caster.Cast(world, rays, {}, &hits);
+    double worst_m = 0.0;
+    int occupied = 0;
+    for (int f = 0; f < 6; ++f) {
+      for (std::size_t k = 0; k < scan.faces[std::size_t(f)].distance_m.size(); ++k) {
+        const std::size_t i = grids[std::size_t(f)].first + k;
+        const Vector3d end = rays.origin_W + (rays.start[i].cast<double>() +
+                                              double(hits.distance_m[i]) *
+                                                  rays.direction[i].cast<double>());
+        worst_m = std::max(worst_m, (scan.PointW(f, k) - end).norm());
+        occupied += scan.faces[std::size_t(f)].occupancy[k] == kOccupied;
+      }
+    }
+    EXPECT_LT(worst_m, 1e-4);  // float starts, 25 m from the sensor
+    EXPECT_GT(occupied, 1000);
+  }
+  EXPECT_TRUE(std::isnan(FaceScanner(FaceScannerConfig{}).EmptyScan().PointW(3, 17).x()));
 }
 
 TEST(FaceScannerTest, SixStageScansOneFaceATickInOrder) {
@@ -206,7 +245,7 @@ TEST(FaceScannerTest, OwnRobotAndCollisionOffActorsAreNeverSeen) {
   scanner.Scan(world, caster, own, At(-70, -60, 8), 1, &scan);
   for (std::size_t k = 0; k < scan.faces[5].occupancy.size(); ++k) {
     if (scan.faces[5].occupancy[k] == kOccupied) {
-      EXPECT_LT(scan.faces[5].points_W[k].z(), 6.0);
+      EXPECT_LT(scan.PointW(5, k).z(), 6.0);
     }
   }
 }

@@ -197,7 +197,7 @@ TEST(StructuredScanTest, SameHitsWhereRaysRunThroughVerticesAndAlongEdges) {
   EXPECT_GT(hits, 2 * 51 * 51);
 }
 
-TEST(StructuredScanTest, BlocksThatDoNotCoverTheBatchAreRefused) {
+TEST(StructuredScanTest, BadBlocksAreRefused) {
   const scene::Level level = scene::LoadLevel(testing::SampleLevel());
   const scene::CollisionWorld world(level);
   const FaceScanner scanner(FaceScannerConfig{});
@@ -210,8 +210,14 @@ TEST(StructuredScanTest, BlocksThatDoNotCoverTheBatchAreRefused) {
   grid.rows -= 1;
   EXPECT_THROW(caster.CastGrids(world, rays, {grid}, {}, &hits), std::invalid_argument);
   grid.rows += 1;
-  rays.direction[5] = -rays.direction[5];
+  grid.direction *= 2.0f;
   EXPECT_THROW(caster.CastGrids(world, rays, {grid}, {}, &hits), std::invalid_argument);
+  grid.direction /= 2.0f;
+  grid.length_m = -1.0f;
+  EXPECT_THROW(caster.CastGrids(world, rays, {grid}, {}, &hits), std::invalid_argument);
+  grid.length_m = rays.length_m[0];
+  caster.CastGrids(world, rays, {grid}, {}, &hits);  // restored: cast
+  EXPECT_EQ(hits.size(), rays.size());
 }
 
 // A sweep's end pose: the start moved up to `move_m` and turned up to `turn_rad`.

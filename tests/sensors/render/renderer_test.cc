@@ -227,8 +227,10 @@ TEST(DebugOverlayTest, ActorBoundsFollowTheActorAndStubsPointBackAlongTheRay) {
   scan.n = 1;
   scan.faces[0].tick = 3;
   scan.faces[0].X_WS = Isometry3d(Eigen::Translation3d(1, 2, 3));
+  scan.faces[0].X_WB = scan.faces[0].X_WS;
+  scan.half_extent_m = 0.0;  // one sample, on the box's +X axis: (11, 2, 3)
   scan.faces[0].occupancy = {sensors::kOccupied};
-  scan.faces[0].points_W = {Vector3d(11, 2, 3)};
+  scan.faces[0].distance_m = {10.0f};
   Overlay stubs;
   AddFaceScan(scan, 0.5, &stubs);
   ASSERT_EQ(stubs.lines_W.size(), 2u);
