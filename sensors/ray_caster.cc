@@ -350,9 +350,9 @@ inline __m128 MeetsCornerBox4(const Vec4& low, const Vec4& high, const Vec4& o, 
                       Mul(t_exit, _mm_set1_ps(1.0f + slack)));
 }
 
-// The rays of a band of rows of one grid block (RayGrid), or of a sector of a
+// The rays of a band of rows of one grid block (RayGrid), or of a tile of a
 // sweep (RaySweep), as the structured kernels read them: origins in the Bullet
-// frame and results, indexed by cell (a band's ray from its first, a sector's
+// frame and results, indexed by cell (a band's ray from its first, a tile's
 // ray of the batch).
 struct GridBand {
   __m128 dx, dy, dz;                          // the block's direction
@@ -507,7 +507,7 @@ struct BandFrame {
 };
 
 // Up to four linear coordinates of points (a band's columns, rows and depths;
-// a sweep sector's slabs) as seen from one object's quantized BVH: over a node
+// a sweep tile's slabs) as seen from one object's quantized BVH: over a node
 // box [lo, hi] (quantized), coordinate w spans w0 + sum_k (q_k * a_k) over its
 // corners; `margin` widens that, and it must meet [0, limit] (in a whole
 // number, in `integral` lanes).
@@ -560,24 +560,6 @@ GridCull CullFor(const Target& target, const Eigen::Vector3d& origin,
   return cull;
 }
 
-// Whether a node's box reaches a grid point in columns and rows and the rays'
-// span in depth (a sector's slabs: all four spans).
-inline bool NodeMeetsGrid(const btQuantizedBvhNode& node, const GridCull& cull) {
-  __m128 low = cull.w0, high = cull.w0;
-  for (int k = 0; k < 3; ++k) {
-    const __m128 q_min = _mm_set1_ps(float(node.m_quantizedAabbMin[k]));
-    const __m128 q_max = _mm_set1_ps(float(node.m_quantizedAabbMax[k]));
-    low = Add(low, Add(Mul(q_min, cull.positive[k]), Mul(q_max, cull.negative[k])));
-    high = Add(high, Add(Mul(q_max, cull.positive[k]), Mul(q_min, cull.negative[k])));
-  }
-  const __m128 from = _mm_max_ps(Sub(low, cull.margin), _mm_setzero_ps());
-  const __m128 to = _mm_min_ps(Add(high, cull.margin), cull.limit);
-  // Columns and rows need a whole number in [from, to]; depth an overlap.
-  const __m128 whole = _mm_cvtepi32_ps(_mm_cvttps_epi32(to));
-  const __m128 top = Select(cull.integral, whole, to);
-  return _mm_movemask_ps(_mm_cmpge_ps(top, from)) == 0xF;
-}
-
 // The spans [low, high] of a cull's coordinates over a node's box (widened
 // by the cull's margins), a coordinate a lane.
 inline void NodeSpans(const btQuantizedBvhNode& node, const GridCull& cull, __m128* low,
@@ -590,6 +572,19 @@ inline void NodeSpans(const btQuantizedBvhNode& node, const GridCull& cull, __m1
     to = Add(to, Add(Mul(q_max, cull.positive[k]), Mul(q_min, cull.negative[k])));
   }
   *low = Sub(from, cull.margin), *high = Add(to, cull.margin);
+}
+
+// Whether a node's box reaches a grid point in columns and rows and the rays'
+// span in depth (a sweep tile's slabs: all four spans).
+inline bool NodeMeetsGrid(const btQuantizedBvhNode& node, const GridCull& cull) {
+  __m128 low, high;
+  NodeSpans(node, cull, &low, &high);
+  const __m128 from = _mm_max_ps(low, _mm_setzero_ps());
+  const __m128 to = _mm_min_ps(high, cull.limit);
+  // Columns and rows need a whole number in [from, to]; depth an overlap.
+  const __m128 whole = _mm_cvtepi32_ps(_mm_cvttps_epi32(to));
+  const __m128 top = Select(cull.integral, whole, to);
+  return _mm_movemask_ps(_mm_cmpge_ps(top, from)) == 0xF;
 }
 
 // A sweep tile's channels as elevation bands about its anchor: a region
