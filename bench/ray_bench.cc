@@ -398,24 +398,6 @@ void RunLevel(const char* name, const fs::path& file, const Eigen::Isometry3d& X
   sensors::RayBatch face_rays;
   std::vector<sensors::RayGrid> face_grids;
   face.GridRays(0, X_WS, &face_rays, &face_grids);
-  if (std::getenv("PROF_GRID")) {
-    sensors::RayCaster caster(1);
-    sensors::RayHits ours;
-    double best_grid = 1e9, best_cast = 1e9;
-    for (int rep = 0; rep < 30; ++rep) {
-      auto t0 = Clock::now();
-      for (int i = 0; i < 50; ++i) caster.CastGrids(world, face_rays, face_grids, {}, &ours);
-      best_grid = std::min(
-          best_grid, std::chrono::duration<double, std::micro>(Clock::now() - t0).count() / 50);
-      t0 = Clock::now();
-      for (int i = 0; i < 10; ++i) caster.Cast(world, face_rays, {}, &ours);
-      best_cast = std::min(
-          best_cast, std::chrono::duration<double, std::micro>(Clock::now() - t0).count() / 10);
-    }
-    std::printf("%s min us: grid %.1f cast %.1f ratio %.2f\n", name, best_grid, best_cast,
-                best_cast / best_grid);
-    return;
-  }
   Compare(name, "face scan", world, embree, face_rays, seconds, show);
   Compare(name, "face, grid", world, embree, face_rays, seconds, show, &face_grids);
   sensors::RaySweep sweep;
