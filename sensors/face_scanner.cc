@@ -217,11 +217,6 @@ void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
   // Write each part's results back into its face (a part a job; through a
   // reference, as above).
   const RayHits& cast = hits;
-  std::vector<std::size_t> first(parts.size(), 0);
-  for (std::size_t p = 1; p < parts.size(); ++p) {
-    first[p] =
-        first[p - 1] + std::size_t(parts[p - 1].row_end - parts[p - 1].row_begin) * std::size_t(n_);
-  }
   caster.RunParallel(int(parts.size()), [&](int p) {
     const Part& part = parts[std::size_t(p)];
     ScanFace& face = scan->faces[std::size_t(part.face)];
@@ -230,7 +225,7 @@ void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
     face.X_WB = BoxFrame(X_WS);
     const std::size_t k0 = std::size_t(part.row_begin) * std::size_t(n_);
     const std::size_t count = std::size_t(part.row_end - part.row_begin) * std::size_t(n_);
-    const std::size_t i0 = first[std::size_t(p)];
+    const std::size_t i0 = blocks[std::size_t(p)].first;  // the part's first ray
     for (std::size_t j = 0; j < count; ++j) {
       face.occupancy[k0 + j] = cast.body[i0 + j] == RayHits::kNoHit ? kFree : kOccupied;
     }

@@ -1402,7 +1402,6 @@ void RayCaster::CastSweep(const scene::CollisionWorld& world, const RayBatch& ra
         const float size =
             ((corners[0] - step[0].o).cwiseAbs().sum() + (corners[1] - step[0].o).cwiseAbs().sum() +
              (corners[2] - step[0].o).cwiseAbs().sum());
-        (void)cz;
         // The margin: the rays' rounding (margin) and the rounding of the
         // coordinates below, in the corners' and origins' size.
         const float m = float(margin) + 1e-6f * (size + 3.0f * float(reach));
