@@ -17,6 +17,7 @@
 #include <tuple>
 
 #include "sensors/render/detail_textures.h"
+#include "sensors/render/mesh_lods.h"
 #include "sensors/render/segmentation.h"
 #include "sensors/render/shaders.h"
 #include "sensors/render/shadow_cascades.h"
@@ -92,7 +93,13 @@ void FlipRows(RgbaImage* image) {
 struct GpuMesh {
   GLuint vao{0}, positions{0}, normals{0}, uvs{0}, lightmap_uvs{0}, colors{0}, segments{0},
       indices{0};
-  GLsizei index_count{0};
+  GLsizei index_count{0};  // of the mesh as given (level 0)
+  std::vector<MeshLods::Level> lods;  // its levels of detail in `indices`; empty: level 0 only
+  // What moves (robots, movable actors) takes one level a frame for every
+  // pass, shadows too (its own shadow then falls on the surface drawn);
+  // what stays, its last level in colour.
+  bool moving{false};
+  mutable std::size_t level{0};
   int material{-1};
   int surface{-1};  // a scene::Surface over the material's, -1: the material's
   std::uint32_t segment_base{0};
@@ -108,12 +115,15 @@ struct MeshData {
   const std::vector<Eigen::Vector4f>* colors{nullptr};
   const std::vector<std::uint32_t>* vertex_segments{nullptr};
   const std::vector<std::uint32_t>* indices{nullptr};
+  const MeshLods* lods{nullptr};  // instead of `indices`: the levels of detail
 };
 
 GpuMesh Upload(const MeshData& data, int material, GLenum usage) {
   GpuMesh mesh;
   mesh.material = material;
-  mesh.index_count = GLsizei(data.indices->size());
+  const std::vector<std::uint32_t>& indices = data.lods ? data.lods->indices : *data.indices;
+  mesh.index_count = GLsizei(data.lods ? data.lods->levels[0].count : indices.size());
+  if (data.lods != nullptr && data.lods->levels.size() > 1) mesh.lods = data.lods->levels;
   const std::size_t n = data.positions->size();
   glGenVertexArrays(1, &mesh.vao);
   glBindVertexArray(mesh.vao);
@@ -153,7 +163,7 @@ GpuMesh Upload(const MeshData& data, int material, GLenum usage) {
   }
   glGenBuffers(1, &mesh.indices);
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, mesh.indices);
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(data.indices->size() * 4), data.indices->data(),
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * 4), indices.data(),
                GL_STATIC_DRAW);
   glBindVertexArray(0);
   return mesh;
@@ -167,6 +177,24 @@ void Free(const GpuMesh& m) {
   }
   if (m.triangle_segments != 0) glDeleteTextures(1, &m.triangle_segments);
   glDeleteVertexArrays(1, &m.vao);
+}
+
+// `indices` with vertices equal in every attribute (and `ids`) joined, for
+// the simplifier (an attribute not given per vertex does not count).
+std::vector<std::uint32_t> WeldedIndices(const std::vector<Eigen::Vector3f>& positions,
+                                         const std::vector<Eigen::Vector3f>& normals,
+                                         const std::vector<Eigen::Vector2f>& uvs,
+                                         const std::vector<Eigen::Vector2f>& lightmap_uvs,
+                                         const std::vector<Eigen::Vector4f>& colors,
+                                         const std::vector<std::uint32_t>* ids,
+                                         const std::vector<std::uint32_t>& indices) {
+  const std::size_t n = positions.size();
+  auto stream = [n](const auto& values) {
+    return VertexStream{values.size() == n ? values.data() : nullptr, sizeof(values[0])};
+  };
+  return WeldIdentical(indices, n,
+                       {stream(positions), stream(normals), stream(uvs), stream(lightmap_uvs),
+                        stream(colors), ids ? stream(*ids) : VertexStream{nullptr, 4}});
 }
 
 // A per-triangle id table for gl_PrimitiveID lookups.
@@ -295,12 +323,16 @@ class OsMesaRenderer : public Renderer {
     BuildHorizon(level);
     for (std::size_t a = 0; a < level.actors.size(); ++a) {
       if (!level.actors[a].movable) continue;  // merged above
+      Eigen::AlignedBox3d& bounds_A = actor_bounds_A_[int(a)];
       for (const scene::Mesh& mesh : level.actors[a].meshes) {
+        for (const Eigen::Vector3f& p : mesh.positions_A) bounds_A.extend(p.cast<double>());
+        const MeshLods lods = MakeMeshLods(mesh.positions_A, WeldedIndices(mesh.positions_A, mesh.normals_A, mesh.uvs, mesh.lightmap_uvs, mesh.colors, nullptr, mesh.indices));
         GpuMesh gpu = Upload({&mesh.positions_A, &mesh.normals_A, &mesh.uvs, &mesh.lightmap_uvs,
-                              &mesh.colors, nullptr, &mesh.indices},
+                              &mesh.colors, nullptr, nullptr, &lods},
                              mesh.material, GL_STATIC_DRAW);
         gpu.surface = level.actors[a].surface ? int(*level.actors[a].surface) : -1;
         gpu.segment_base = legend_->actor(int(a));
+        gpu.moving = true;
         actor_meshes_.push_back({int(a), gpu});
       }
     }
@@ -381,6 +413,11 @@ class OsMesaRenderer : public Renderer {
     const Eigen::Matrix4d view_proj_d = projection * view_rotation;
     const Eigen::Matrix4f view_proj = view_proj_d.cast<float>();
     const Eigen::Vector3f sun = settings.sun_direction_W.normalized();
+
+    // Levels of detail in colour-only frames; depth, segmentation and normals are measurements.
+    lod_px_ = kinds == kColorImage ? std::max(settings.lod_px, 0.f) : 0.f;
+    pixel_angle_ = float(2.0 * std::tan(0.5 * view.fov_y_rad) / view.height);
+    ChooseMovingLevels();
 
     // Shadow maps first (they need the scene's upload above).
     const bool shadows = settings.shadows && kinds & kColorImage && sun.z() > 0.02f;
@@ -722,10 +759,13 @@ class OsMesaRenderer : public Renderer {
     const Eigen::Matrix4f static_clip = view_proj * static_model;
     const Eigen::Vector3f eye_S = (camera_ - origin_).cast<float>();  // in the chunks' frame
     auto actor_model = [&](int actor) {
-      const Eigen::Isometry3d& X_WA = actor_poses_->size() == level_->actors.size()
-                                          ? (*actor_poses_)[std::size_t(actor)]
-                                          : level_->actors[std::size_t(actor)].X_WA;
-      return Relative(Eigen::Affine3d(X_WA.matrix()), camera_);
+      return Relative(Eigen::Affine3d(ActorPose(actor).matrix()), camera_);
+    };
+    const Eigen::Vector3f static_to_camera = (origin_ - camera_).cast<float>();
+    auto chunk_error = [&](std::size_t i) {
+      const Eigen::AlignedBox3f& bounds = static_meshes_[i].first;
+      return LodError(Eigen::AlignedBox3f(bounds.min() + static_to_camera,
+                                          bounds.max() + static_to_camera));
     };
     // The level's chunks in view, nearest first.
     static_order_.clear();
@@ -740,7 +780,8 @@ class OsMesaRenderer : public Renderer {
     const bool moving = pass != Pass::kShadow || shadow_casters_ != Casters::kStill;
     const bool still = pass != Pass::kShadow || shadow_casters_ != Casters::kMoving;
     if (moving) {
-      for (const auto& [pose, meshes] : posed_robots_) {
+      for (std::size_t r = 0; r < posed_robots_.size(); ++r) {
+        const auto& [pose, meshes] = posed_robots_[r];
         for (const GpuMesh* mesh : meshes)
           Draw(*mesh, Relative(Eigen::Affine3d(pose.matrix()), camera_));
       }
@@ -751,6 +792,7 @@ class OsMesaRenderer : public Renderer {
     if (still) {
       for (const auto& [distance, i] : static_order_) {
         const GpuMesh& mesh = static_meshes_[i].second;
+        lod_error_m_ = chunk_error(i);
         if (!IsTranslucent(mesh)) Draw(mesh, static_model);
       }
       DrawTerrain();
@@ -768,12 +810,52 @@ class OsMesaRenderer : public Renderer {
     }
     for (auto it = static_order_.rbegin(); it != static_order_.rend(); ++it) {
       const GpuMesh& mesh = static_meshes_[it->second].second;
+      lod_error_m_ = chunk_error(it->second);
       if (IsTranslucent(mesh)) Draw(mesh, static_model);
     }
     for (const auto& [actor, mesh] : actor_meshes_) {
       if (IsTranslucent(mesh)) Draw(mesh, actor_model(actor));
     }
     glDisable(GL_BLEND);
+  }
+
+  // A movable actor's pose this frame, and its bounds (camera-centred).
+  const Eigen::Isometry3d& ActorPose(int actor) const {
+    return actor_poses_->size() == level_->actors.size() ? (*actor_poses_)[std::size_t(actor)]
+                                                         : level_->actors[std::size_t(actor)].X_WA;
+  }
+  Eigen::AlignedBox3f ActorBoundsC(int actor) const {
+    const Eigen::AlignedBox3d& box_A = actor_bounds_A_.at(actor);
+    Eigen::AlignedBox3f box_C;
+    for (int k = 0; k < 8 && !box_A.isEmpty(); ++k) {
+      box_C.extend((ActorPose(actor) * box_A.corner(Eigen::AlignedBox3d::CornerType(k)) - camera_)
+                       .cast<float>());
+    }
+    return box_C;
+  }
+
+  // What `lod_px` pixels span at the nearest point of `box_C` (camera-centred).
+  float PixelError(const Eigen::AlignedBox3f& box_C) const {
+    if (lod_px_ <= 0.f || box_C.isEmpty()) return 0.f;
+    return lod_px_ * pixel_angle_ * box_C.exteriorDistance(Eigen::Vector3f::Zero());
+  }
+
+  // The error a draw of what stays, within `box_C`, may have: PixelError, and
+  // with shadows no more than a fifth of the shadow-map texel there (the shadow
+  // maps hold another level: the two stay under the shadows' bias of 0.4
+  // texel, no acne). Shadow passes set their own.
+  float LodError(const Eigen::AlignedBox3f& box_C) const {
+    if (pass_ == Pass::kShadow) return lod_error_m_;
+    float error = PixelError(box_C);
+    const std::vector<ShadowCascade>& cascades = frame_uniforms_.cascades;
+    if (!cascades.empty() && look_ & kShadows) {
+      const Eigen::Vector3f& axis = frame_uniforms_.view_axis;
+      const float depth = axis.dot(box_C.center()) - 0.5f * box_C.sizes().dot(axis.cwiseAbs());
+      std::size_t c = 0;
+      while (c + 1 < cascades.size() && depth > cascades[c].far_m) ++c;
+      if (depth <= cascades.back().far_m) error = std::min(error, float(cascades[c].texel_m) / 5.f);
+    }
+    return error;
   }
 
   bool IsTranslucent(const GpuMesh& mesh) const {
@@ -815,7 +897,7 @@ class OsMesaRenderer : public Renderer {
       glUniformMatrix4fv(shadow_uniforms_[masked].model, 1, GL_FALSE, model.data());
       glBindTexture(GL_TEXTURE_2D, masked ? texture_id : 0);
       glBindVertexArray(mesh.vao);
-      glDrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
+      DrawTriangles(mesh);
       return;
     }
     UseProgram(mesh.surface >= 0 ? mesh.surface : int(m.surface), features);
@@ -840,7 +922,51 @@ class OsMesaRenderer : public Renderer {
       glActiveTexture(GL_TEXTURE0);
     }
     glBindVertexArray(mesh.vao);
-    glDrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
+    DrawTriangles(mesh);
+  }
+
+  // The level of detail: what moves, this frame's (ChooseMovingLevels); what
+  // stays, the coarsest within this draw's allowance (in colour, see NextLevel).
+  void DrawTriangles(const GpuMesh& mesh) {
+    MeshLods::Level level{0, std::uint32_t(mesh.index_count), 0.f};
+    if (!mesh.lods.empty()) {
+      if (mesh.moving) {
+        level = mesh.lods[std::min(mesh.level, mesh.lods.size() - 1)];
+      } else if (pass_ == Pass::kColor) {
+        level = mesh.lods[mesh.level = NextLevel(mesh, lod_error_m_)];
+      } else {
+        level = LevelFor(mesh.lods, lod_error_m_);
+      }
+    }
+    glDrawElements(GL_TRIANGLES, GLsizei(level.count), GL_UNSIGNED_INT,
+                   reinterpret_cast<const void*>(std::uintptr_t(level.first) * 4));
+  }
+
+  // The coarsest level within `error_m`, but a coarser one than the mesh's
+  // last only once well within it: a camera that keeps its distance does
+  // not see a mesh flicker between two levels.
+  static std::size_t NextLevel(const GpuMesh& mesh, float error_m) {
+    auto index = [&](float e) { return std::size_t(&LevelFor(mesh.lods, e) - mesh.lods.data()); };
+    const std::size_t k = index(error_m);
+    return k > mesh.level ? std::max(index(error_m / 1.5f), mesh.level) : k;
+  }
+
+  // This frame's level of each robot's and movable actor's meshes (before
+  // the shadow maps, which draw them at it too).
+  void ChooseMovingLevels() {
+    for (std::size_t r = 0; r < posed_robots_.size(); ++r) {
+      const Eigen::AlignedBox3d& box_W = robot_bounds_W_[r];
+      const float error =
+          box_W.isEmpty() ? 0.f
+                          : PixelError(Eigen::AlignedBox3f((box_W.min() - camera_).cast<float>(),
+                                                           (box_W.max() - camera_).cast<float>()));
+      for (const GpuMesh* mesh : posed_robots_[r].second) {
+        if (!mesh->lods.empty()) mesh->level = NextLevel(*mesh, error);
+      }
+    }
+    for (const auto& [actor, mesh] : actor_meshes_) {
+      if (!mesh.lods.empty()) mesh.level = NextLevel(mesh, PixelError(ActorBoundsC(actor)));
+    }
   }
 
   // Binds a texture; colour textures (sRGB) are decoded to linear light by
@@ -946,6 +1072,7 @@ class OsMesaRenderer : public Renderer {
         glClear(GL_DEPTH_BUFFER_BIT);
         program_key_ = -1;  // the shadow programs take this cascade's clip at first use
         shadow_casters_ = Casters::kStill;
+        lod_error_m_ = ShadowLodError(cascade);
         DrawScene(Pass::kShadow, cascade.light_clip.cast<float>());
         static_shadow_keys_[std::size_t(c)] = key;
       }
@@ -954,27 +1081,46 @@ class OsMesaRenderer : public Renderer {
       glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, shadow_map_, 0, c);
       program_key_ = -1;
       shadow_casters_ = Casters::kMoving;
+      lod_error_m_ = ShadowLodError(cascade);
       DrawScene(Pass::kShadow, cascade.light_clip.cast<float>());
     }
     shadow_casters_ = Casters::kAll;
     glDisable(GL_POLYGON_OFFSET_FILL);
   }
 
+  // A fifth of a texel: with a surface's own error (LodError), under the
+  // shadows' bias of 0.4 texel and more.
+  float ShadowLodError(const ShadowCascade& cascade) const {
+    return lod_px_ > 0.f ? float(cascade.texel_m) / 5.f : 0.f;
+  }
+
   // Robots: their posed meshes, uploaded once a frame for every pass.
   void UploadRobots(const std::vector<const scene::RobotState*>& robots) {
     posed_robots_.clear();
+    robot_bounds_W_.clear();
     for (const scene::RobotState* state : robots) {
       const scene::RobotModel& model = state->model();
       std::vector<GpuMesh>& meshes = robot_meshes_[&model];
       std::vector<const GpuMesh*> drawn;
+      Eigen::AlignedBox3f bounds_B;
       for (std::size_t m = 0; m < model.meshes.size(); ++m) {
+        for (const Eigen::Vector3f& p : state->positions_B(int(m))) bounds_B.extend(p);
         const scene::Mesh& bind = model.meshes[m].bind;
         if (meshes.size() <= m) {
-          meshes.push_back(
-              Upload({&state->positions_B(int(m)), &state->normals_B(int(m)), &bind.uvs,
-                      &bind.lightmap_uvs, &bind.colors, nullptr, &bind.indices},
-                     bind.material, GL_DYNAMIC_DRAW));
+          // Levels of detail within the sets of vertices that follow the same
+          // bones by the same weights (errors in this pose hold in every pose).
+          const std::vector<std::uint32_t> skin_groups = SkinGroups(model.meshes[m]);
+          const MeshLods lods = MakeMeshLods(
+              state->positions_B(int(m)),
+              WeldedIndices(state->positions_B(int(m)), state->normals_B(int(m)), bind.uvs,
+                            bind.lightmap_uvs, bind.colors, &skin_groups, bind.indices),
+              &skin_groups);
+          meshes.push_back(Upload({&state->positions_B(int(m)), &state->normals_B(int(m)),
+                                   &bind.uvs, &bind.lightmap_uvs, &bind.colors, nullptr, nullptr,
+                                   &lods},
+                                  bind.material, GL_DYNAMIC_DRAW));
           const int r = RobotIndex(model);
+          meshes.back().moving = true;
           meshes.back().segment_base = r >= 0 ? legend_->bone(r, 0) : 0xffffu;
           const auto groups = robot_groups_.find(&model);
           if (r >= 0 && groups != robot_groups_.end())
@@ -990,7 +1136,31 @@ class OsMesaRenderer : public Renderer {
         drawn.push_back(&meshes[m]);
       }
       posed_robots_.emplace_back(state->pose(), std::move(drawn));
+      Eigen::AlignedBox3d bounds_W;
+      for (int k = 0; k < 8 && !bounds_B.isEmpty(); ++k) {
+        bounds_W.extend(state->pose() *
+                        bounds_B.corner(Eigen::AlignedBox3f::CornerType(k)).cast<double>());
+      }
+      robot_bounds_W_.push_back(bounds_W);
     }
+  }
+
+  // Per vertex, an id of the bones and weights it follows.
+  static std::vector<std::uint32_t> SkinGroups(const scene::SkinnedMesh& mesh) {
+    const std::size_t n = mesh.bind.positions_A.size();
+    std::vector<std::uint32_t> group(n, 0);
+    if (mesh.influence_begin.size() != n + 1) return group;
+    std::map<std::vector<std::pair<std::uint16_t, float>>, std::uint32_t> ids;
+    std::vector<std::pair<std::uint16_t, float>> influences;
+    for (std::size_t v = 0; v < n; ++v) {
+      influences.clear();
+      for (std::uint32_t i = mesh.influence_begin[v]; i < mesh.influence_begin[v + 1]; ++i) {
+        influences.emplace_back(mesh.influence_joint[i], mesh.influence_weight[i]);
+      }
+      std::sort(influences.begin(), influences.end());
+      group[v] = ids.emplace(influences, std::uint32_t(ids.size())).first->second;
+    }
+    return group;
   }
 
   int RobotIndex(const scene::RobotModel& model) const {
@@ -1055,8 +1225,11 @@ class OsMesaRenderer : public Renderer {
       if (!chunk.any_uvs) chunk.uvs.clear();
       if (!chunk.any_lightmap_uvs) chunk.lightmap_uvs.clear();
       if (!chunk.any_colors) chunk.colors.clear();
+      const MeshLods lods = MakeMeshLods(
+          chunk.positions, WeldedIndices(chunk.positions, chunk.normals, chunk.uvs, chunk.lightmap_uvs,
+                                         chunk.colors, &chunk.segments, chunk.indices));
       GpuMesh gpu = Upload({&chunk.positions, &chunk.normals, &chunk.uvs, &chunk.lightmap_uvs,
-                            &chunk.colors, &chunk.segments, &chunk.indices},
+                            &chunk.colors, &chunk.segments, nullptr, &lods},
                            std::get<0>(key), GL_STATIC_DRAW);
       gpu.surface = std::get<1>(key);
       static_meshes_.push_back({chunk.bounds, gpu});
@@ -1416,6 +1589,11 @@ class OsMesaRenderer : public Renderer {
   Eigen::Vector3d camera_{Eigen::Vector3d::Zero()};
   const std::vector<Eigen::Isometry3d>* actor_poses_{nullptr};
   std::vector<std::pair<Eigen::Isometry3d, std::vector<const GpuMesh*>>> posed_robots_;
+  std::vector<Eigen::AlignedBox3d> robot_bounds_W_;    // as posed this frame
+  std::map<int, Eigen::AlignedBox3d> actor_bounds_A_;  // movable actors', by actor
+  // Levels of detail: this frame's allowance in pixels, a pixel's angle, and
+  // the error the draw being made may have.
+  float lod_px_{0.f}, pixel_angle_{0.f}, lod_error_m_{0.f};
   std::vector<std::uint8_t> pixels_;
   std::vector<float> depth_, normal_;
   std::vector<std::uint32_t> segment_;

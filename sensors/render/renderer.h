@@ -67,6 +67,12 @@ struct RenderSettings {
   // Anisotropic filtering of material textures (1: trilinear mipmaps only).
   // Off by default: llvmpipe takes about 9 s to compile each shader variant that uses it.
   int anisotropy{1};
+  // Levels of detail, in frames of colour alone: meshes are drawn simplified
+  // where that moves their surface by no more than `lod_px` pixels and, under
+  // shadows, a fifth of a shadow-map texel. Frames with a depth, segmentation
+  // or normals image (measurements) are drawn as given, and so is everything
+  // with 0.
+  float lod_px{1.0f};
   int shadow_map_px{1024};
   int shadow_cascades{2};
   double shadow_distance_m{300.0};  // shadows end this far along the optical axis

@@ -292,6 +292,72 @@ TEST(RendererLookTest, NormalsOfATiltedPlaneInTheCameraFrame) {
   EXPECT_EQ(sky[0] * sky[0] + sky[1] * sky[1] + sky[2] * sky[2], 0.f);
 }
 
+// Levels of detail: a finely cut sphere (16k triangles) far away, in a frame
+// of colour alone, may be drawn simplified by up to a pixel: its outline stays
+// within a pixel of the circle it projects to; with a depth image it is drawn
+// as given (and its depth is the sphere's).
+TEST(RendererLookTest, ASimplifiedSphereKeepsItsOutlineWithinAPixel) {
+  testing::TempDir dir;
+  constexpr double kRadius = 5.0, kDistance = 120.0;
+  constexpr int kAround = 128, kUp = 64;
+  std::ostringstream obj;
+  obj << "o sphere\n";
+  for (int j = 0; j <= kUp; ++j) {
+    for (int i = 0; i < kAround; ++i) {
+      const double theta = M_PI * j / kUp, phi = 2.0 * M_PI * i / kAround;
+      const Vector3d n(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                       std::cos(theta));
+      obj << "v " << kRadius * n.x() << " " << kRadius * n.y() << " " << kRadius * n.z() << "\n"
+          << "vn " << n.x() << " " << n.y() << " " << n.z() << "\n";
+    }
+  }
+  for (int j = 0; j < kUp; ++j) {
+    for (int i = 0; i < kAround; ++i) {
+      const int a = 1 + j * kAround + i, b = 1 + j * kAround + (i + 1) % kAround;
+      const int c = a + kAround, d = b + kAround;
+      obj << "f " << a << "//" << a << " " << c << "//" << c << " " << d << "//" << d << "\n"
+          << "f " << a << "//" << a << " " << d << "//" << d << " " << b << "//" << b << "\n";
+    }
+  }
+  dir.Write("sphere.obj", obj.str());
+  const OneActorScene scene(dir, "sphere", "sphere.obj");
+  CameraView view;
+  view.X_WC = LookAt(Vector3d(-kDistance, 0, 0), Vector3d::Zero());
+  RenderSettings settings = RenderSettings::Preset(Quality::kFast);
+  settings.haze = false;
+  const double f = 0.5 * view.height / std::tan(0.5 * view.fov_y_rad);
+  const double r_px = f * kRadius / std::sqrt(kDistance * kDistance - kRadius * kRadius);
+  auto sphere_pixels = [&](const Frame& frame) {
+    int count = 0;
+    for (int row = 0; row < frame.height; ++row) {
+      for (int column = 0; column < frame.width; ++column) {
+        const std::uint8_t* rgb = Pixel(frame, column, row);
+        count += rgb[2] < rgb[0] + 30;  // grey, not the blue sky
+      }
+    }
+    return count;
+  };
+  Frame simplified, exact;
+  settings.images = kColorImage;
+  scene.renderer->Render(view, {}, {}, settings, &simplified);
+  settings.images = kColorImage | kDepthImage;
+  scene.renderer->Render(view, {}, {}, settings, &exact);
+  const double disc = M_PI * r_px * r_px;  // 1,294 px
+  EXPECT_NEAR(sphere_pixels(exact), disc, M_PI * r_px) << "r = " << r_px << " px";
+  EXPECT_NEAR(sphere_pixels(simplified), disc, 2.0 * M_PI * r_px + 4.0);
+  EXPECT_NEAR(exact.depth_m[std::size_t(240 * 640 + 320)], kDistance - kRadius, 0.01);
+  int differing = 0;
+  for (std::size_t i = 0; i < exact.rgb.size(); ++i) {
+    differing += std::abs(int(exact.rgb[i]) - int(simplified.rgb[i])) > 8;
+  }
+  EXPECT_GT(differing, 0) << "the colour frame was drawn simplified";
+  settings.images = kColorImage;
+  settings.lod_px = 0.f;
+  Frame as_given;
+  scene.renderer->Render(view, {}, {}, settings, &as_given);
+  EXPECT_EQ(as_given.rgb, exact.rgb) << "lod_px = 0: as given";
+}
+
 TEST(RendererLookTest, ABoxCastsItsShadowWhereTrigonometryPutsIt) {
   // A 2 m x 2 m x 4 m box on a plane; the sun 45 degrees up in the -x
   // direction: the top edge's shadow ends at x = 1 + 4 / tan 45 = 5.
