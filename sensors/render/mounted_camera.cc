@@ -28,7 +28,7 @@ CameraKind ParseCameraKind(const scene::SensorSpec& spec) {
                           scene::ChoiceList(types) + ", got '" + spec.type + "'");
 }
 
-// quality, shadows, fxaa, msaa, haze, anisotropy, images: the camera's look.
+// quality, shadows, fxaa, msaa, haze, anisotropy, lod_px, images: the camera's look.
 void ReadLook(const scene::SensorSpec& spec, scene::SettingsReader* read, RenderSettings* look) {
   try {
     *look = RenderSettings::Preset(ParseQuality(read->Text("quality", "fast")));
@@ -46,6 +46,11 @@ void ReadLook(const scene::SensorSpec& spec, scene::SettingsReader* read, Render
   if (look->anisotropy < 1 || look->anisotropy > 16) {
     read->Fail("anisotropy", "'anisotropy' must be 1 (off) to 16");
   }
+  const double lod_px = read->Number("lod_px", look->lod_px);
+  if (!(lod_px >= 0.0 && lod_px <= 8.0)) {
+    read->Fail("lod_px", "'lod_px' must be 0 (meshes as given) to 8 pixels");
+  }
+  look->lod_px = float(lod_px);
   look->images = kColorImage;
   if (read->Has("images")) {
     look->images = 0;

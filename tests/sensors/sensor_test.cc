@@ -250,6 +250,9 @@ TEST(SensorTest, CameraMistakesNameTheCameraAndField) {
   EXPECT_EQ(
       CameraError("type = \"drone\"\n"),
       "level.toml:8: camera 'c': 'type' must be chase, trailing, payload or fixed, got 'drone'");
+  EXPECT_EQ(CameraError("type = \"chase\"\nlod_px = -1\n"),
+            "level.toml:9: camera 'c': 'lod_px' must be 0 (meshes as given) to 8 pixels");
+  EXPECT_EQ(CameraError("type = \"chase\"\nlod_px = 0.5\n"), "no error");
   EXPECT_EQ(CameraError("type = \"payload\"\nmount = \"link6\"\noverlay = true\n"), "no error");
 }
 
