@@ -8,7 +8,8 @@
 //
 //  3. The overlay's cost.
 //  4. The looks: the sample level's chase view at 640x480 and 1280x720 with
-//     the plain, fast and high presets, and each image kind, against the
+//     the plain, fast and high presets (colour, as chase cameras write; with
+//     depth; without levels of detail), and each image kind, against the
 //     plain look in the same run (ratio).
 //
 //   bench_render [--seconds S] [--looks]   (--looks: section 4 only)
@@ -89,28 +90,43 @@ int BenchLooks() {
                   ms / plain_ms);
     };
     using render::Quality;
+    // The looks as a chase camera writes them (colour), then with depth (drawn
+    // as given: no levels of detail) and without levels of detail.
+    auto look = [](Quality quality, render::ImageKinds kinds, float lod_px = 1.f) {
+      render::RenderSettings settings = render::RenderSettings::Preset(quality);
+      settings.images = kinds;
+      settings.lod_px = lod_px;
+      return settings;
+    };
+    const render::ImageKinds color(render::kColorImage);
+    const render::ImageKinds color_depth(render::kColorImage | render::kDepthImage);
     for (const auto& [name, quality] :
          {std::pair{"plain", Quality::kPlain}, std::pair{"fast", Quality::kFast},
           std::pair{"high", Quality::kHigh}}) {
-      row(std::string(name) + " (color, depth)", render::RenderSettings::Preset(quality));
+      row(std::string(name) + " (color)", look(quality, color));
     }
-    render::RenderSettings shadows = render::RenderSettings::Preset(Quality::kFast);
+    for (const auto& [name, quality] :
+         {std::pair{"plain", Quality::kPlain}, std::pair{"fast", Quality::kFast},
+          std::pair{"high", Quality::kHigh}}) {
+      row(std::string(name) + " (color, depth)", look(quality, color_depth));
+      row(std::string(name) + " (color), no levels of detail", look(quality, color, 0.f));
+    }
+    render::RenderSettings shadows = look(Quality::kFast, color);
     shadows.shadows = true;
     row("fast + shadows", shadows);
-    render::RenderSettings msaa = render::RenderSettings::Preset(Quality::kFast);
+    render::RenderSettings msaa = look(Quality::kFast, color);
     msaa.msaa_samples = 4;
     row("fast + 4x multisampling", msaa);
-    render::RenderSettings fxaa = render::RenderSettings::Preset(Quality::kFast);
+    render::RenderSettings fxaa = look(Quality::kFast, color);
     fxaa.fxaa = true;
     row("fast + FXAA", fxaa);
-    render::RenderSettings high_msaa = render::RenderSettings::Preset(Quality::kHigh);
+    render::RenderSettings high_msaa = look(Quality::kHigh, color);
     high_msaa.fxaa = false;
     high_msaa.msaa_samples = 4;
     row("high with 4x MSAA for FXAA", high_msaa);
-    row("high, flying 10 m a frame", render::RenderSettings::Preset(Quality::kHigh), 10.0);
+    row("high, flying 10 m a frame", look(Quality::kHigh, color), 10.0);
     for (const auto& [name, kinds] :
-         {std::pair{"high: color only", render::ImageKinds(render::kColorImage)},
-          std::pair{"high: + segmentation",
+         {std::pair{"high: + segmentation",
                     render::ImageKinds(render::kColorImage | render::kSegmentationImage)},
           std::pair{"high: + normals",
                     render::ImageKinds(render::kColorImage | render::kNormalsImage)},
@@ -119,9 +135,7 @@ int BenchLooks() {
                                        render::kSegmentationImage | render::kNormalsImage)},
           std::pair{"depth only", render::ImageKinds(render::kDepthImage)},
           std::pair{"segmentation only", render::ImageKinds(render::kSegmentationImage)}}) {
-      render::RenderSettings settings = render::RenderSettings::Preset(Quality::kHigh);
-      settings.images = kinds;
-      row(name, settings);
+      row(name, look(Quality::kHigh, kinds));
     }
   }
   return 0;
