@@ -780,8 +780,7 @@ class OsMesaRenderer : public Renderer {
     const bool moving = pass != Pass::kShadow || shadow_casters_ != Casters::kStill;
     const bool still = pass != Pass::kShadow || shadow_casters_ != Casters::kMoving;
     if (moving) {
-      for (std::size_t r = 0; r < posed_robots_.size(); ++r) {
-        const auto& [pose, meshes] = posed_robots_[r];
+      for (const auto& [pose, meshes] : posed_robots_) {
         for (const GpuMesh* mesh : meshes)
           Draw(*mesh, Relative(Eigen::Affine3d(pose.matrix()), camera_));
       }
