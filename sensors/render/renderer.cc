@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -16,6 +17,7 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "sensors/render/deferred_shading.h"
 #include "sensors/render/detail_textures.h"
 #include "sensors/render/mesh_lods.h"
 #include "sensors/render/segmentation.h"
@@ -46,6 +48,7 @@ namespace {
 
 constexpr double kPatternPeriod_m = 6900.0;  // the ground's and water's patterns repeat here
 constexpr int kDetailPx = 256;
+constexpr float kSnowLine_m = 2800.f;
 
 GLuint Compile(GLenum type, const char* source) {
   const GLuint shader = glCreateShader(type);
@@ -93,7 +96,7 @@ void FlipRows(RgbaImage* image) {
 struct GpuMesh {
   GLuint vao{0}, positions{0}, normals{0}, uvs{0}, lightmap_uvs{0}, colors{0}, segments{0},
       indices{0};
-  GLsizei index_count{0};  // of the mesh as given (level 0)
+  GLsizei index_count{0};             // of the mesh as given (level 0)
   std::vector<MeshLods::Level> lods;  // its levels of detail in `indices`; empty: level 0 only
   // What moves (robots, movable actors) takes one level a frame for every
   // pass, shadows too (its own shadow then falls on the surface drawn);
@@ -298,6 +301,8 @@ class OsMesaRenderer : public Renderer {
     program_key_ = -1;
     // The ground's detail textures.
     const std::vector<std::uint8_t> detail = MakeDetailTextures(kDetailPx);
+    detail_cpu_ = DetailTextures(detail, kDetailPx, kNumDetailLayers);
+    deferred_ = std::make_unique<DeferredShader>();
     glGenTextures(1, &detail_);
     glBindTexture(GL_TEXTURE_2D_ARRAY, detail_);
     glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA8, kDetailPx, kDetailPx, kNumDetailLayers, 0,
@@ -326,7 +331,9 @@ class OsMesaRenderer : public Renderer {
       Eigen::AlignedBox3d& bounds_A = actor_bounds_A_[int(a)];
       for (const scene::Mesh& mesh : level.actors[a].meshes) {
         for (const Eigen::Vector3f& p : mesh.positions_A) bounds_A.extend(p.cast<double>());
-        const MeshLods lods = MakeMeshLods(mesh.positions_A, WeldedIndices(mesh.positions_A, mesh.normals_A, mesh.uvs, mesh.lightmap_uvs, mesh.colors, nullptr, mesh.indices));
+        const MeshLods lods = MakeMeshLods(
+            mesh.positions_A, WeldedIndices(mesh.positions_A, mesh.normals_A, mesh.uvs,
+                                            mesh.lightmap_uvs, mesh.colors, nullptr, mesh.indices));
         GpuMesh gpu = Upload({&mesh.positions_A, &mesh.normals_A, &mesh.uvs, &mesh.lightmap_uvs,
                               &mesh.colors, nullptr, nullptr, &lods},
                              mesh.material, GL_STATIC_DRAW);
@@ -421,12 +428,15 @@ class OsMesaRenderer : public Renderer {
 
     // Shadow maps first (they need the scene's upload above).
     const bool shadows = settings.shadows && kinds & kColorImage && sun.z() > 0.02f;
+    // Deferred shading (on the CPU) for the gamma-correct looks without multisampling.
+    const bool deferred =
+        kinds & kColorImage && settings.deferred && settings.gamma_correct && samples == 0;
     std::vector<ShadowCascade> cascades;
     if (shadows) {
       cascades = FitShadowCascades(view, sun.cast<double>(), settings.shadow_distance_m,
                                    std::clamp(settings.shadow_cascades, 1, 4),
                                    std::clamp(settings.shadow_map_px, 256, 8192), 1500.0);
-      DrawShadowMaps(cascades, sun, std::clamp(settings.shadow_map_px, 256, 8192));
+      DrawShadowMaps(cascades, sun, std::clamp(settings.shadow_map_px, 256, 8192), deferred);
     }
 
     // The look; each program gets this frame's uniforms at its first use in it.
@@ -447,7 +457,31 @@ class OsMesaRenderer : public Renderer {
 
     // Colour: into the multisampled buffer, or straight into the data buffer
     // (then with segment and normal in the same pass).
-    if (kinds & kColorImage) {
+    const Eigen::Matrix4f clip_to_world = view_proj_d.inverse().cast<float>();
+    if (deferred) {
+      // The opaque surfaces into the G-buffer, read back; the nearest
+      // translucent surfaces into a layer of their own over that depth; each
+      // pixel lit once on the CPU.
+      glBindFramebuffer(GL_FRAMEBUFFER, gbuffer_fbo_);
+      glViewport(0, 0, view.width, view.height);
+      ClearTargets(want_data, horizon, /*keep_color=*/true);
+      const GLenum data = want_data ? GL_COLOR_ATTACHMENT1 : GL_NONE;
+      const GLenum normals = want_data ? GL_COLOR_ATTACHMENT2 : GL_NONE;
+      const GLenum opaque[] = {GL_COLOR_ATTACHMENT0, data, normals, GL_COLOR_ATTACHMENT3};
+      glDrawBuffers(4, opaque);
+      look_ = look | kGBuffer | (want_data ? kData : 0);
+      translucent_drawn_ = false;
+      DrawScene(Pass::kColor, view_proj, [&] {
+        ReadLayer(view.width, view.height, &opaque_);
+        glBindFramebuffer(GL_FRAMEBUFFER, translucent_fbo_);
+        const GLenum layer[] = {GL_COLOR_ATTACHMENT0, data, normals, GL_COLOR_ATTACHMENT3};
+        glDrawBuffers(4, layer);
+        look_ = look | kGBuffer | kTranslucent | (want_data ? kData : 0);
+      });
+      if (translucent_drawn_) ReadLayer(view.width, view.height, &translucent_);
+      deferred_->Shade(LightingOf(settings, clip_to_world), detail_cpu_, opaque_,
+                       translucent_drawn_ ? &translucent_ : nullptr, &lit_);
+    } else if (kinds & kColorImage) {
       glBindFramebuffer(GL_FRAMEBUFFER, samples > 0 ? msaa_fbo_ : fbo_);
       glViewport(0, 0, view.width, view.height);
       const bool data_too = samples == 0 && want_data;
@@ -456,7 +490,7 @@ class OsMesaRenderer : public Renderer {
       look_ = look | (data_too ? kData : 0);
       DrawScene(Pass::kColor, view_proj, [&] {
         glDrawBuffers(1, color_only);
-        DrawSky(view_proj_d.inverse().cast<float>(), horizon, sun);
+        DrawSky(clip_to_world, horizon, sun);
         glDrawBuffers(data_too ? 3 : 1, data_too ? all : color_only);
       });
       if (samples > 0) {
@@ -530,7 +564,39 @@ class OsMesaRenderer : public Renderer {
     } else {
       frame->normal_C.clear();
     }
-    if (kinds & kColorImage) {
+    if (deferred) {
+      // The edge filter and the overlay on the CPU's image; rows flipped.
+      const std::vector<std::uint8_t>* image = &lit_;
+      if (settings.fxaa) {
+        deferred_->FilterEdges(lit_, w, h, &filtered_);
+        image = &filtered_;
+      }
+      if (marks) {
+        glBindFramebuffer(GL_FRAMEBUFFER, overlay_fbo_);
+        const float clear[] = {0.f, 0.f, 0.f, 0.f};
+        glDrawBuffers(1, color_only);
+        glClearBufferfv(GL_COLOR, 0, clear);
+        DrawOverlay(*overlay, view_proj);
+        overlay_rgba_.resize(count);
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, overlay_fbo_);
+        glReadBuffer(GL_COLOR_ATTACHMENT0);
+        glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, overlay_rgba_.data());
+      }
+      frame->rgb.resize(3 * count);
+      for (int y = 0; y < h; ++y) {
+        const std::size_t row = std::size_t(h - 1 - y) * std::size_t(w);
+        std::memcpy(&frame->rgb[3 * std::size_t(y) * std::size_t(w)], &(*image)[3 * row],
+                    3 * std::size_t(w));
+        if (!marks) continue;
+        for (int x = 0; x < w; ++x) {
+          const std::uint32_t mark = overlay_rgba_[row + std::size_t(x)];
+          if ((mark >> 24) == 0) continue;
+          std::uint8_t* dst = &frame->rgb[3 * (std::size_t(y) * std::size_t(w) + std::size_t(x))];
+          dst[0] = std::uint8_t(mark), dst[1] = std::uint8_t(mark >> 8),
+          dst[2] = std::uint8_t(mark >> 16);
+        }
+      }
+    } else if (kinds & kColorImage) {
       glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
       if (marks) {
         glDrawBuffers(1, color_only);
@@ -604,10 +670,13 @@ class OsMesaRenderer : public Renderer {
           {"NORMAL_MAP", (key & kNormalMap) != 0},
           {"ALPHA_MASK", (key & kAlphaMask) != 0},
           {"VERTEX_COLORS", (key & kVertexColors) != 0},
-          {"TRIANGLE_SEGMENTS", (key & kTriangleSegments) != 0}};
+          {"TRIANGLE_SEGMENTS", (key & kTriangleSegments) != 0},
+          {"GBUFFER", (key & kGBuffer) != 0},
+          {"TRANSLUCENT", (key & kTranslucent) != 0}};
       for (const auto& [name, value] : defines) {
         fragment += "#define " + std::string(name) + " " + std::to_string(value) + "\n";
       }
+      fragment += shaders::kShading;
       fragment += shaders::kSceneFragment;
       found =
           programs_.emplace(key, SceneProgram{Link(shaders::kSceneVertex, fragment.c_str()), {}})
@@ -709,7 +778,7 @@ class OsMesaRenderer : public Renderer {
     glUniform1f(U("camera_z"), u.camera_z);
     glUniform2fv(U("camera_xy"), 1, u.camera_xy.data());
     glUniform1f(U("water_level"), water_level_);
-    glUniform1f(U("snow_line"), 2800.f);
+    glUniform1f(U("snow_line"), kSnowLine_m);
     glUniform3fv(U("ground_rgb"), 4, u.ground[0].data());
     glUniform3fv(U("view_axis"), 1, u.view_axis.data());
     glUniformMatrix3fv(U("world_to_camera"), 1, GL_FALSE, u.R_CW.data());
@@ -764,8 +833,8 @@ class OsMesaRenderer : public Renderer {
     const Eigen::Vector3f static_to_camera = (origin_ - camera_).cast<float>();
     auto chunk_error = [&](std::size_t i) {
       const Eigen::AlignedBox3f& bounds = static_meshes_[i].first;
-      return LodError(Eigen::AlignedBox3f(bounds.min() + static_to_camera,
-                                          bounds.max() + static_to_camera));
+      return LodError(
+          Eigen::AlignedBox3f(bounds.min() + static_to_camera, bounds.max() + static_to_camera));
     };
     // The level's chunks in view, nearest first.
     static_order_.clear();
@@ -803,7 +872,7 @@ class OsMesaRenderer : public Renderer {
     if (between) between();
     if (pass == Pass::kShadow) return;
 
-    if (pass == Pass::kColor) {
+    if (pass == Pass::kColor && !(look_ & kGBuffer)) {
       glEnable(GL_BLEND);
       glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
     }
@@ -847,7 +916,9 @@ class OsMesaRenderer : public Renderer {
     if (pass_ == Pass::kShadow) return lod_error_m_;
     float error = PixelError(box_C);
     const std::vector<ShadowCascade>& cascades = frame_uniforms_.cascades;
-    if (!cascades.empty() && look_ & kShadows) {
+    // (Deferred shading moves its shadow lookups off the surface by this
+    // draw's allowance instead: LightingFrame::lod_offset_per_m.)
+    if (!cascades.empty() && look_ & kShadows && !(look_ & kGBuffer)) {
       const Eigen::Vector3f& axis = frame_uniforms_.view_axis;
       const float depth = axis.dot(box_C.center()) - 0.5f * box_C.sizes().dot(axis.cwiseAbs());
       std::size_t c = 0;
@@ -899,6 +970,7 @@ class OsMesaRenderer : public Renderer {
       DrawTriangles(mesh);
       return;
     }
+    if (look_ & kTranslucent) translucent_drawn_ = true;
     UseProgram(mesh.surface >= 0 ? mesh.surface : int(m.surface), features);
     glUniformMatrix4fv(U("model"), 1, GL_FALSE, model.data());
     const Eigen::Vector3f base = Shading(m.base_color.head<3>(), m.linear_color);
@@ -929,7 +1001,7 @@ class OsMesaRenderer : public Renderer {
   void DrawTriangles(const GpuMesh& mesh) {
     MeshLods::Level level{0, std::uint32_t(mesh.index_count), 0.f};
     if (!mesh.lods.empty()) {
-      if (mesh.moving) {
+      if (mesh.moving && !(pass_ == Pass::kShadow && cpu_shadows_)) {
         level = mesh.lods[std::min(mesh.level, mesh.lods.size() - 1)];
       } else if (pass_ == Pass::kColor) {
         level = mesh.lods[mesh.level = NextLevel(mesh, lod_error_m_)];
@@ -1029,8 +1101,11 @@ class OsMesaRenderer : public Renderer {
   // drawn into a map of its own only when the cascade's box, the sun or the
   // terrain's tiles change; each frame that map copied and what moves (robots,
   // movable actors) drawn over it.
+  // With `cpu` (deferred shading), the maps as the CPU shades with them, in
+  // shadow_cpu_: the still casters' map read back when redrawn, and each frame
+  // only the texels the moving casters cover drawn and read back.
   void DrawShadowMaps(const std::vector<ShadowCascade>& cascades, const Eigen::Vector3f& sun,
-                      int px) {
+                      int px, bool cpu) {
     const int layers = int(cascades.size());
     if (shadow_map_ == 0 || shadow_px_ != px || shadow_layers_ < layers) {
       for (GLuint* map : {&shadow_map_, &shadow_static_}) {
@@ -1075,6 +1150,10 @@ class OsMesaRenderer : public Renderer {
         DrawScene(Pass::kShadow, cascade.light_clip.cast<float>());
         static_shadow_keys_[std::size_t(c)] = key;
       }
+      if (cpu) {
+        DrawMovingShadowsForCpu(cascade, c, px);
+        continue;
+      }
       glCopyImageSubData(shadow_static_, GL_TEXTURE_2D_ARRAY, 0, 0, 0, c, shadow_map_,
                          GL_TEXTURE_2D_ARRAY, 0, 0, 0, c, px, px, 1);
       glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, shadow_map_, 0, c);
@@ -1085,6 +1164,128 @@ class OsMesaRenderer : public Renderer {
     }
     shadow_casters_ = Casters::kAll;
     glDisable(GL_POLYGON_OFFSET_FILL);
+  }
+
+  // Cascade c of shadow_cpu_: the still casters' map (read back when it was
+  // redrawn), the moving casters drawn over it within the texels they cover,
+  // read back; last frame's moving texels restored first.
+  void DrawMovingShadowsForCpu(const ShadowCascade& cascade, int c, int px) {
+    const auto& key = static_shadow_keys_[std::size_t(c)];
+    const std::size_t layer = std::size_t(px) * std::size_t(px), at = std::size_t(c) * layer;
+    if (shadow_cpu_.size() != std::size_t(shadow_layers_) * layer) {
+      shadow_cpu_.assign(std::size_t(shadow_layers_) * layer, 1.f);
+      shadow_cpu_static_.assign(shadow_cpu_.size(), 1.f);
+      cpu_static_keys_.assign(std::size_t(shadow_layers_), StaticShadowKey{});
+      moving_rects_.assign(std::size_t(shadow_layers_), {0, 0, 0, 0});
+    }
+    std::array<int, 4>& last = moving_rects_[std::size_t(c)];
+    if (!(cpu_static_keys_[std::size_t(c)] == key)) {
+      glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, shadow_static_, 0, c);
+      glReadPixels(0, 0, px, px, GL_DEPTH_COMPONENT, GL_FLOAT, &shadow_cpu_static_[at]);
+      std::copy_n(&shadow_cpu_static_[at], layer, &shadow_cpu_[at]);
+      cpu_static_keys_[std::size_t(c)] = key;
+      last = {0, 0, 0, 0};
+    }
+    for (int y = last[1]; y < last[3]; ++y) {
+      const std::size_t row = at + std::size_t(y) * std::size_t(px) + std::size_t(last[0]);
+      std::copy_n(&shadow_cpu_static_[row], last[2] - last[0], &shadow_cpu_[row]);
+    }
+    last = MovingTexels(cascade, px);
+    const int w = last[2] - last[0], h = last[3] - last[1];
+    if (w <= 0 || h <= 0) return;
+    // Moving casters too at a fifth of a texel (the CPU's lookups allow for
+    // the level a colour frame drew them at).
+    cpu_shadows_ = true;
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, shadow_map_, 0, c);
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(last[0], last[1], w, h);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    program_key_ = -1;
+    shadow_casters_ = Casters::kMoving;
+    lod_error_m_ = ShadowLodError(cascade);
+    DrawScene(Pass::kShadow, cascade.light_clip.cast<float>());
+    glDisable(GL_SCISSOR_TEST);
+    cpu_shadows_ = false;
+    moving_depth_.resize(std::size_t(w) * std::size_t(h));
+    glReadPixels(last[0], last[1], w, h, GL_DEPTH_COMPONENT, GL_FLOAT, moving_depth_.data());
+    for (int y = 0; y < h; ++y) {
+      float* row =
+          &shadow_cpu_[at + std::size_t(last[1] + y) * std::size_t(px) + std::size_t(last[0])];
+      const float* moving = &moving_depth_[std::size_t(y) * std::size_t(w)];
+      for (int x = 0; x < w; ++x) row[x] = std::min(row[x], moving[x]);
+    }
+  }
+
+  // The texels of a cascade's map (x0, y0, x1, y1) that this frame's robots'
+  // and movable actors' boxes cover, with a margin of two.
+  std::array<int, 4> MovingTexels(const ShadowCascade& cascade, int px) const {
+    Eigen::AlignedBox2f covered;
+    const Eigen::Matrix4f M = cascade.light_clip.cast<float>();
+    auto add = [&](const Eigen::AlignedBox3f& box_C) {
+      for (int k = 0; k < 8 && !box_C.isEmpty(); ++k) {
+        const Eigen::Vector4f q =
+            M * box_C.corner(Eigen::AlignedBox3f::CornerType(k)).homogeneous();
+        covered.extend(Eigen::Vector2f(0.5f * q.x() + 0.5f, 0.5f * q.y() + 0.5f) * float(px));
+      }
+    };
+    for (const Eigen::AlignedBox3d& box_W : robot_bounds_W_) {
+      if (!box_W.isEmpty()) {
+        add(Eigen::AlignedBox3f((box_W.min() - camera_).cast<float>(),
+                                (box_W.max() - camera_).cast<float>()));
+      }
+    }
+    for (const auto& [actor, mesh] : actor_meshes_) {
+      if (!IsTranslucent(mesh)) add(ActorBoundsC(actor));
+    }
+    if (covered.isEmpty()) return {0, 0, 0, 0};
+    auto texel = [px](float v) { return std::clamp(int(std::floor(v)), 0, px); };
+    return {texel(covered.min().x() - 2.f), texel(covered.min().y() - 2.f),
+            texel(covered.max().x() + 3.f), texel(covered.max().y() + 3.f)};
+  }
+
+  // The G-buffer layer `layer` (opaque_ or translucent_) read back.
+  void ReadLayer(int width, int height, SurfaceLayer* layer) {
+    const bool opaque = layer == &opaque_;
+    const std::size_t count = std::size_t(width) * std::size_t(height);
+    layer->width = width;
+    layer->height = height;
+    layer->albedo.resize(count);
+    layer->normal.resize(count);
+    layer->depth.resize(count);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, opaque ? gbuffer_fbo_ : translucent_fbo_);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, layer->albedo.data());
+    glReadBuffer(GL_COLOR_ATTACHMENT3);
+    glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, layer->normal.data());
+    glReadPixels(0, 0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, layer->depth.data());
+  }
+
+  // This frame's lighting for the CPU (the scene programs' frame uniforms).
+  LightingFrame LightingOf(const RenderSettings& settings,
+                           const Eigen::Matrix4f& clip_to_world) const {
+    const FrameUniforms& u = frame_uniforms_;
+    LightingFrame f;
+    f.clip_to_world = clip_to_world;
+    f.sun = u.sun;
+    f.horizon = u.horizon;
+    f.zenith = u.zenith;
+    f.sky_horizon_display = settings.sky_rgb;
+    f.sky_zenith_display = Zenith(settings.sky_rgb);
+    f.fog = u.fog;
+    f.camera_z = u.camera_z;
+    f.camera_xy = u.camera_xy;
+    f.water_level = water_level_;
+    f.snow_line = kSnowLine_m;
+    for (int i = 0; i < 4; ++i) f.ground[std::size_t(i)] = u.ground[i];
+    f.view_axis = u.view_axis;
+    f.materials = settings.materials;
+    f.lod_offset_per_m = lod_px_ * pixel_angle_;
+    const std::size_t layer = std::size_t(shadow_px_) * std::size_t(shadow_px_);
+    for (std::size_t c = 0; c < u.cascades.size(); ++c) {
+      f.cascades.push_back({u.cascades[c].light_clip.cast<float>(), float(u.cascades[c].far_m),
+                            float(u.cascades[c].texel_m), shadow_px_, &shadow_cpu_[c * layer]});
+    }
+    return f;
   }
 
   // A fifth of a texel: with a surface's own error (LodError), under the
@@ -1114,10 +1315,10 @@ class OsMesaRenderer : public Renderer {
               WeldedIndices(state->positions_B(int(m)), state->normals_B(int(m)), bind.uvs,
                             bind.lightmap_uvs, bind.colors, &skin_groups, bind.indices),
               &skin_groups);
-          meshes.push_back(Upload({&state->positions_B(int(m)), &state->normals_B(int(m)),
-                                   &bind.uvs, &bind.lightmap_uvs, &bind.colors, nullptr, nullptr,
-                                   &lods},
-                                  bind.material, GL_DYNAMIC_DRAW));
+          meshes.push_back(
+              Upload({&state->positions_B(int(m)), &state->normals_B(int(m)), &bind.uvs,
+                      &bind.lightmap_uvs, &bind.colors, nullptr, nullptr, &lods},
+                     bind.material, GL_DYNAMIC_DRAW));
           const int r = RobotIndex(model);
           meshes.back().moving = true;
           meshes.back().segment_base = r >= 0 ? legend_->bone(r, 0) : 0xffffu;
@@ -1224,9 +1425,10 @@ class OsMesaRenderer : public Renderer {
       if (!chunk.any_uvs) chunk.uvs.clear();
       if (!chunk.any_lightmap_uvs) chunk.lightmap_uvs.clear();
       if (!chunk.any_colors) chunk.colors.clear();
-      const MeshLods lods = MakeMeshLods(
-          chunk.positions, WeldedIndices(chunk.positions, chunk.normals, chunk.uvs, chunk.lightmap_uvs,
-                                         chunk.colors, &chunk.segments, chunk.indices));
+      const MeshLods lods =
+          MakeMeshLods(chunk.positions,
+                       WeldedIndices(chunk.positions, chunk.normals, chunk.uvs, chunk.lightmap_uvs,
+                                     chunk.colors, &chunk.segments, chunk.indices));
       GpuMesh gpu = Upload({&chunk.positions, &chunk.normals, &chunk.uvs, &chunk.lightmap_uvs,
                             &chunk.colors, &chunk.segments, nullptr, &lods},
                            std::get<0>(key), GL_STATIC_DRAW);
@@ -1482,6 +1684,10 @@ class OsMesaRenderer : public Renderer {
       glGenRenderbuffers(4, buffers_);
       glGenFramebuffers(1, &msaa_fbo_);
       glGenRenderbuffers(2, msaa_buffers_);
+      glGenFramebuffers(1, &gbuffer_fbo_);
+      glGenFramebuffers(1, &translucent_fbo_);
+      glGenFramebuffers(1, &overlay_fbo_);
+      glGenRenderbuffers(5, layer_buffers_);
     }
     auto attach = [&](GLuint fbo, GLuint buffer, GLenum format, GLenum attachment, int n) {
       glBindFramebuffer(GL_FRAMEBUFFER, fbo);
@@ -1501,6 +1707,26 @@ class OsMesaRenderer : public Renderer {
     attach(fbo_, buffers_[2], GL_RGBA32F, GL_COLOR_ATTACHMENT2, 0);
     attach(fbo_, buffers_[3], GL_DEPTH_COMPONENT32F, GL_DEPTH_ATTACHMENT, 0);
     check("the");
+    // Deferred shading's layers (SurfaceLayer), sharing the segment, normal
+    // and depth buffers: the opaque surfaces', the translucent ones', the overlay's.
+    auto share = [&](GLenum attachment, GLuint buffer) {
+      glFramebufferRenderbuffer(GL_FRAMEBUFFER, attachment, GL_RENDERBUFFER, buffer);
+    };
+    attach(gbuffer_fbo_, layer_buffers_[0], GL_RGBA8, GL_COLOR_ATTACHMENT0, 0);
+    attach(gbuffer_fbo_, layer_buffers_[1], GL_RGBA8, GL_COLOR_ATTACHMENT3, 0);
+    share(GL_COLOR_ATTACHMENT1, buffers_[1]);
+    share(GL_COLOR_ATTACHMENT2, buffers_[2]);
+    share(GL_DEPTH_ATTACHMENT, buffers_[3]);
+    check("the opaque layer's");
+    attach(translucent_fbo_, layer_buffers_[2], GL_RGBA8, GL_COLOR_ATTACHMENT0, 0);
+    attach(translucent_fbo_, layer_buffers_[3], GL_RGBA8, GL_COLOR_ATTACHMENT3, 0);
+    share(GL_COLOR_ATTACHMENT1, buffers_[1]);
+    share(GL_COLOR_ATTACHMENT2, buffers_[2]);
+    share(GL_DEPTH_ATTACHMENT, buffers_[3]);
+    check("the translucent layer's");
+    attach(overlay_fbo_, layer_buffers_[4], GL_RGBA8, GL_COLOR_ATTACHMENT0, 0);
+    share(GL_DEPTH_ATTACHMENT, buffers_[3]);
+    check("the overlay's");
     if (samples > 0) {
       attach(msaa_fbo_, msaa_buffers_[0], GL_RGBA8, GL_COLOR_ATTACHMENT0, samples);
       attach(msaa_fbo_, msaa_buffers_[1], GL_DEPTH_COMPONENT32F, GL_DEPTH_ATTACHMENT, samples);
@@ -1523,6 +1749,8 @@ class OsMesaRenderer : public Renderer {
   static constexpr int kGamma = 4, kMaterials = 8, kShadows = 16, kData = 32, kDataOnly = 64;
   static constexpr int kTexture = 128, kLightmap = 256, kNormalMap = 512, kAlphaMask = 1024,
                        kVertexColors = 2048, kTriangleSegments = 4096;
+  // Deferred shading: the G-buffer pass's programs, for opaque and for translucent surfaces.
+  static constexpr int kGBuffer = 8192, kTranslucent = 16384;
   std::map<int, SceneProgram> programs_;
   SceneProgram* program_{nullptr};
   int program_key_{-1};
@@ -1560,6 +1788,24 @@ class OsMesaRenderer : public Renderer {
   };
   std::vector<StaticShadowKey> static_shadow_keys_;
   int shadow_px_{0}, shadow_layers_{0};
+  // Deferred shading: its layers' framebuffers and buffers (opaque albedo and
+  // normal, translucent albedo, normal and depth with code, overlay), what
+  // was read back of them, the CPU's shader and image, and its copies of the
+  // detail textures and the shadow maps.
+  GLuint gbuffer_fbo_{0}, translucent_fbo_{0}, overlay_fbo_{0}, layer_buffers_[5]{0, 0, 0, 0, 0};
+  SurfaceLayer opaque_, translucent_;
+  bool translucent_drawn_{false};
+  bool cpu_shadows_{false};  // drawing the moving casters' shadows for the CPU
+  std::unique_ptr<DeferredShader> deferred_;
+  DetailTextures detail_cpu_;
+  std::vector<std::uint8_t> lit_, filtered_;
+  std::vector<std::uint32_t> overlay_rgba_;
+  std::vector<float> shadow_cpu_;  // the cascades' maps as shaded: still casters and moving ones
+  std::vector<float> shadow_cpu_static_;          // the still casters' maps
+  std::vector<StaticShadowKey> cpu_static_keys_;  // what shadow_cpu_static_ holds
+  // Per cascade, the texels moving casters drew into (x0, y0, x1, y1; empty: x0 >= x1).
+  std::vector<std::array<int, 4>> moving_rects_;
+  std::vector<float> moving_depth_;
   GLuint overlay_vao_{0}, overlay_buffers_[2]{0, 0};
   GLfloat max_anisotropy_{1.f};
   GLuint anisotropic_{0};  // a sampler

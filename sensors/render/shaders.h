@@ -38,53 +38,36 @@ void main() {
 }
 )";
 
-// Compiled for each use with defines after the version line (llvmpipe runs
-// every branch of a shader, and a shader that may discard loses the early
-// depth test, so each program holds only what its draws use):
-//   the look: GAMMA (shade in linear light, write sRGB),
-//     MATERIALS, SHADOWS, and SURFACE 0 plain, 1 terrain, 2 water;
+// What the scene's programs share: the frame's uniforms and the shading of a
+// surface point from its albedo, normal and position. Compiled for each use
+// with defines after the version line (llvmpipe runs every branch of a
+// shader, and a shader that may discard loses the early depth test, so each
+// program holds only what its draws use):
+//   the look: GAMMA (shade in linear light, write sRGB), MATERIALS, SHADOWS;
+//   the scene program's surface: SURFACE 0 plain, 1 terrain, 2 water;
 //   the mesh: TEXTURE, LIGHTMAP, NORMAL_MAP, ALPHA_MASK, VERTEX_COLORS,
 //     TRIANGLE_SEGMENTS (per-triangle ids for robots' bones);
-//   the outputs: DATA (segment and normal too), DATA_ONLY (only those).
-// Colours reach it in the shading space (linear with GAMMA, else display).
-inline constexpr const char* kSceneFragment = R"(
-in vec3 world_normal;
-in vec3 rel_position;
-in vec2 tex_uv;
-in vec2 baked_uv;
-in vec4 vertex_color;
-flat in uint segment_of_vertex;
-layout(location = 0) out vec4 color;
-#if DATA == 1 || DATA_ONLY == 1
-layout(location = 1) out uint segment;
-layout(location = 2) out vec4 camera_normal;
-#endif
-
-uniform vec4 base_color;          // shading space
-uniform sampler2D base_texture;   // sampled in the shading space
-uniform sampler2D lightmap;       // baked lighting replaces the sun (Quake 3 maps)
-uniform sampler2D normal_texture;
-uniform float alpha_cutoff;
-uniform vec2 metal_rough;
+//   the outputs: DATA (segment and normal too), DATA_ONLY (only those),
+//     GBUFFER (what deferred shading needs, not the colour), TRANSLUCENT (of
+//     a translucent surface: with its alpha, depth and code).
+// Colours reach them in the shading space (linear with GAMMA, else display).
+inline constexpr const char* kShading = R"(
+uniform vec3 sun;
+uniform vec3 horizon;             // the sky's colours, shading space
+uniform vec3 zenith;
+uniform vec2 fog;                 // start, end; end <= 0: none
 uniform float camera_z;           // the camera's world height: heights for the ground's layers
 uniform vec2 camera_xy;           // the camera's world x, y modulo 6900 m (patterns repeat there)
 uniform float water_level;
 uniform float snow_line;
 uniform vec3 ground_rgb[4];       // grass, rock, snow, sand; shading space
 uniform sampler2DArray detail;    // grass, rock, snow, sand
-uniform vec3 sun;
-uniform vec3 horizon;             // the sky's colours, shading space
-uniform vec3 zenith;
-uniform vec2 fog;                 // start, end; end <= 0: none
 uniform sampler2DArrayShadow shadow_map;
 uniform mat4 shadow_clip[4];
 uniform float cascade_far[4];
 uniform float shadow_texel[4];
 uniform int cascades;
 uniform vec3 view_axis;           // the camera's optical axis in the world
-uniform mat3 world_to_camera;     // rows: camera x (forward), y (left), z up
-uniform uint segment_base;
-uniform usamplerBuffer segments;  // per triangle, added to segment_base
 
 // Value noise on a 1-unit lattice; the lattice's hash is integer arithmetic
 // (llvmpipe's sin costs several times as much).
@@ -98,16 +81,18 @@ float Noise(vec2 p) {
   return mix(mix(Hash(i), Hash(i + vec2(1, 0)), s.x), mix(Hash(i + vec2(0, 1)), Hash(i + vec2(1, 1)), s.x), s.y);
 }
 
-float Shadow(vec3 n, float view_depth) {
+// The sun's light reaching point p (camera-centred) of a surface with normal n: 0 in shadow.
+float Shadow(vec3 n, vec3 p) {
 #if SHADOWS == 0
   return 1.0;
 #else
+  float view_depth = dot(p, view_axis);
   if (view_depth > cascade_far[cascades - 1]) return 1.0;
   int c = 0;
   while (c < cascades - 1 && view_depth > cascade_far[c]) ++c;
   // Pushed off the surface along its normal, more where the sun grazes it: no acne.
   float grazing = 1.0 - clamp(dot(n, sun), 0.0, 1.0);
-  vec4 q = shadow_clip[c] * vec4(rel_position + n * ((0.4 + 1.5 * grazing) * shadow_texel[c]), 1.0);
+  vec4 q = shadow_clip[c] * vec4(p + n * ((0.4 + 1.5 * grazing) * shadow_texel[c]), 1.0);
   vec2 st = 0.5 * q.xy + 0.5;
   if (any(lessThan(st, vec2(0.0))) || any(greaterThan(st, vec2(1.0)))) return 1.0;
   return texture(shadow_map, vec4(st, float(c), q.z));  // bilinear percentage-closer
@@ -128,6 +113,108 @@ vec3 Out(vec3 c) {
 vec3 Sky(vec3 d) {
   return mix(horizon, zenith, pow(clamp(d.z, 0.0, 1.0), 0.6));
 }
+
+// How much of the horizon's colour covers a surface `distance_m` away.
+float Haze(float distance_m) {
+  return fog.y > 0.0 ? clamp((distance_m - fog.x) / max(fog.y - fog.x, 1e-3), 0.0, 1.0) : 0.0;
+}
+
+// Ground: sand by the water, rock on steep slopes, snow high up, grass elsewhere;
+// `base` is the imagery's colour, or without imagery the grass varied by noise.
+// st_dx, st_dy: the screen derivatives of the world position's x, y.
+vec3 GroundAlbedo(vec3 base, bool imagery, vec3 n, vec3 p, float distance_m, vec2 st_dx, vec2 st_dy) {
+  vec2 st = p.xy + camera_xy;
+  float height = camera_z + p.z;
+  float up = clamp(n.z, 0.0, 1.0);
+  float rock = smoothstep(0.82, 0.7, up);
+  float snow = 0.0;
+  if (height > snow_line - 250.0) {  // the noise moves the line by 100 m at most
+    snow = smoothstep(snow_line - 150.0, snow_line + 150.0, height + 200.0 * (Noise(0.01 * st) - 0.5)) * (1.0 - rock);
+  }
+  float sand = (1.0 - smoothstep(water_level + 0.8, water_level + 2.5, height)) * (1.0 - rock);
+  vec3 ground = imagery ? base : ground_rgb[0] * (0.85 + 0.3 * Noise(0.05 * st));
+  ground = mix(ground, ground_rgb[3], sand);
+  ground = mix(ground, ground_rgb[1], rock);
+  ground = mix(ground, ground_rgb[2], snow);
+  // Detail texture: world-anchored, one scale (the colour noise or imagery above
+  // hides its tiling; a second scale cost a fifth of a frame); fades with distance.
+  int layer = rock > 0.5 ? 1 : snow > 0.5 ? 2 : sand > 0.5 ? 3 : 0;
+  float fade = smoothstep(60.0, 400.0, distance_m);
+  float d = 1.0;
+  if (fade < 1.0) {
+    d = 2.0 * textureGrad(detail, vec3(st / 3.0, float(layer)), st_dx / 3.0, st_dy / 3.0).r;
+  }
+  return ground * mix(d, 1.0, fade);
+}
+
+// Sun (with its shadow) and sky light on a surface of `albedo` at p with normal n;
+// with MATERIALS, the sun's highlight by metalness and roughness.
+vec3 Lit(vec3 albedo, vec3 n, vec3 p, float distance_m, vec2 metal_rough) {
+#if GAMMA == 1
+  float sun_light = max(dot(n, sun), 0.0) * Shadow(n, p);
+  // Sky light from above, less from the ground below.
+  vec3 lit = albedo * (0.75 * sun_light + 0.25 * mix(0.55, 1.0, 0.5 + 0.5 * n.z));
+#if MATERIALS == 1
+  if (metal_rough.y < 0.95 && sun_light > 0.0) {
+    vec3 h = normalize(sun - p / max(distance_m, 1e-6));
+    float shininess = 2.0 / max(metal_rough.y * metal_rough.y, 0.002);
+    vec3 f0 = mix(vec3(0.04), albedo, metal_rough.x);
+    lit += f0 * pow(max(dot(n, h), 0.0), shininess) * sun_light * (shininess + 8.0) / 32.0;
+  }
+#endif
+  return lit;
+#else
+  return albedo * (0.35 + 0.65 * abs(dot(n, sun)));  // the plain look
+#endif
+}
+
+// G-buffer codes: a surface's kind (deferred_shading.h's SurfaceKind) + 8 x
+// metalness (0..31); and its normal, octahedral in 12 + 12 bits, with roughness.
+const int kLitSurface = 0, kGround = 1, kGroundImagery = 2, kPrelit = 3, kWater = 4;
+vec4 PackNormal(vec3 n, float roughness) {
+  n /= abs(n.x) + abs(n.y) + abs(n.z);
+  vec2 o = n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+  uvec2 q = uvec2(round(clamp(0.5 * o + 0.5, 0.0, 1.0) * 4095.0));
+  return vec4(float(q.x >> 4u), float(((q.x & 15u) << 4u) | (q.y >> 8u)), float(q.y & 255u),
+              round(255.0 * clamp(roughness, 0.0, 1.0))) / 255.0;
+}
+// Translucent surfaces: the normal in 8 + 8 bits, roughness, the code.
+vec4 PackNormalAndCode(vec3 n, float roughness, int code) {
+  n /= abs(n.x) + abs(n.y) + abs(n.z);
+  vec2 o = n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+  return vec4(round(clamp(0.5 * o + 0.5, 0.0, 1.0) * 255.0), round(255.0 * clamp(roughness, 0.0, 1.0)),
+              float(code)) / 255.0;
+}
+)";
+
+// Scene geometry: colour (or, with GBUFFER, what deferred shading needs:
+// deferred_shading.h's SurfaceLayer), segment id and camera-frame normal at
+// once (the outputs a pass has no attachment for are dropped).
+inline constexpr const char* kSceneFragment = R"(
+in vec3 world_normal;
+in vec3 rel_position;
+in vec2 tex_uv;
+in vec2 baked_uv;
+in vec4 vertex_color;
+flat in uint segment_of_vertex;
+layout(location = 0) out vec4 color;  // with GBUFFER: sqrt(albedo), code or alpha
+#if DATA == 1 || DATA_ONLY == 1
+layout(location = 1) out uint segment;
+layout(location = 2) out vec4 camera_normal;
+#endif
+#if GBUFFER == 1
+layout(location = 3) out vec4 g_normal;  // PackNormal; TRANSLUCENT: PackNormalAndCode
+#endif
+
+uniform vec4 base_color;          // shading space
+uniform sampler2D base_texture;   // sampled in the shading space
+uniform sampler2D lightmap;       // baked lighting replaces the sun (Quake 3 maps)
+uniform sampler2D normal_texture;
+uniform float alpha_cutoff;
+uniform vec2 metal_rough;
+uniform mat3 world_to_camera;     // rows: camera x (forward), y (left), z up
+uniform uint segment_base;
+uniform usamplerBuffer segments;  // per triangle, added to segment_base
 
 void main() {
   vec4 albedo = base_color;
@@ -170,42 +257,36 @@ void main() {
 #endif
 
   float distance_m = length(rel_position);
-  float haze = fog.y > 0.0 ? clamp((distance_m - fog.x) / max(fog.y - fog.x, 1e-3), 0.0, 1.0) : 0.0;
+#if GBUFFER == 1
+  // Deferred: the surface's albedo (lit already under a lightmap), normal and kind.
+  int kind = kLitSurface;
+  vec3 base = albedo.rgb;
+#if LIGHTMAP == 1
 #if SURFACE == 1 && MATERIALS == 1
-  {
-    // Ground: sand by the water, rock on steep slopes, snow high up, grass elsewhere.
-    vec2 st = rel_position.xy + camera_xy;
-    float height = camera_z + rel_position.z;
-    float up = clamp(n.z, 0.0, 1.0);
-    float rock = smoothstep(0.82, 0.7, up);
-    float snow = 0.0;
-    if (height > snow_line - 250.0) {  // the noise moves the line by 100 m at most
-      snow = smoothstep(snow_line - 150.0, snow_line + 150.0, height + 200.0 * (Noise(0.01 * st) - 0.5)) * (1.0 - rock);
-    }
-    float sand = (1.0 - smoothstep(water_level + 0.8, water_level + 2.5, height)) * (1.0 - rock);
-#if TEXTURE == 1
-    vec3 ground = albedo.rgb;
-#else
-    vec3 ground = ground_rgb[0] * (0.85 + 0.3 * Noise(0.05 * st));
+  base = GroundAlbedo(base, TEXTURE == 1, n, rel_position, distance_m, dFdx(rel_position.xy), dFdy(rel_position.xy));
 #endif
-    ground = mix(ground, ground_rgb[3], sand);
-    ground = mix(ground, ground_rgb[1], rock);
-    ground = mix(ground, ground_rgb[2], snow);
-    // Detail texture: world-anchored, one scale (the colour noise or imagery above
-    // hides its tiling; a second scale cost a fifth of a frame); fades with distance.
-    // (Sampled only where it shows, with the derivatives taken outside the branch.)
-    int layer = rock > 0.5 ? 1 : snow > 0.5 ? 2 : sand > 0.5 ? 3 : 0;
-    float fade = smoothstep(60.0, 400.0, distance_m);
-    vec2 st_dx = dFdx(st), st_dy = dFdy(st);
-    float d = 1.0;
-    if (fade < 1.0) {
-      d = 2.0 * textureGrad(detail, vec3(st / 3.0, float(layer)), st_dx / 3.0, st_dy / 3.0).r;
-    }
-    albedo.rgb = ground * mix(d, 1.0, fade);
-  }
+  // Quake 3 stores lightmaps at half brightness (its "overbright" bit): twice the display value.
+  base *= min((GAMMA == 1 ? 4.595 : 2.0) * texture(lightmap, baked_uv).rgb, vec3(1.0));
+  kind = kPrelit;
+#elif SURFACE == 1 && MATERIALS == 1
+  kind = TEXTURE == 1 ? kGroundImagery : kGround;
 #elif SURFACE == 2 && MATERIALS == 1
+  kind = kWater;
+#endif
+  int code = kind + 8 * int(round(31.0 * clamp(metal_rough.x, 0.0, 1.0)));
+#if TRANSLUCENT == 1
+  color = vec4(sqrt(base), albedo.a);
+  g_normal = PackNormalAndCode(n, metal_rough.y, code);
+#else
+  color = vec4(sqrt(base), float(code) / 255.0);
+  g_normal = PackNormal(n, metal_rough.y);
+#endif
+}
+#else
+#if SURFACE == 2 && MATERIALS == 1
   {
     // Water: ripples, the sky reflected by Fresnel's law, the sun's glint.
+    float haze = Haze(distance_m);
     vec3 to_eye = -rel_position / max(distance_m, 1e-6);
     vec2 p = rel_position.xy + camera_xy;
     vec3 rn = normalize(vec3(0.06 * (Noise(0.7 * p) - 0.5) + 0.04 * (Noise(2.3 * p.yx) - 0.5),
@@ -214,33 +295,24 @@ void main() {
     float fresnel = 0.02 + 0.98 * pow(1.0 - cos_i, 5.0);
     vec3 body = albedo.rgb * (0.35 + 0.4 * max(sun.z, 0.0));
     vec3 h = normalize(sun + to_eye);
-    float glint = pow(max(dot(rn, h), 0.0), 400.0) * 4.0 * Shadow(n, dot(rel_position, view_axis));
+    float glint = pow(max(dot(rn, h), 0.0), 400.0) * 4.0 * Shadow(n, rel_position);
     vec3 c = mix(body, Sky(reflect(-to_eye, rn)), fresnel) + vec3(glint);
     color = vec4(Out(mix(c, horizon, haze)), mix(0.55 + 0.45 * fresnel, 1.0, haze));
     return;
   }
 #endif
-
+#if SURFACE == 1 && MATERIALS == 1
+  albedo.rgb = GroundAlbedo(albedo.rgb, TEXTURE == 1, n, rel_position, distance_m, dFdx(rel_position.xy), dFdy(rel_position.xy));
+#endif
 #if LIGHTMAP == 1
   // Quake 3 stores lightmaps at half brightness (its "overbright" bit): twice the display value.
   vec3 lit = albedo.rgb * min((GAMMA == 1 ? 4.595 : 2.0) * texture(lightmap, baked_uv).rgb, vec3(1.0));
-#elif GAMMA == 1
-  float sun_light = max(dot(n, sun), 0.0) * Shadow(n, dot(rel_position, view_axis));
-  // Sky light from above, less from the ground below.
-  vec3 lit = albedo.rgb * (0.75 * sun_light + 0.25 * mix(0.55, 1.0, 0.5 + 0.5 * n.z));
-#if MATERIALS == 1
-  if (metal_rough.y < 0.95 && sun_light > 0.0) {
-    vec3 h = normalize(sun - rel_position / max(distance_m, 1e-6));
-    float shininess = 2.0 / max(metal_rough.y * metal_rough.y, 0.002);
-    vec3 f0 = mix(vec3(0.04), albedo.rgb, metal_rough.x);
-    lit += f0 * pow(max(dot(n, h), 0.0), shininess) * sun_light * (shininess + 8.0) / 32.0;
-  }
-#endif
 #else
-  vec3 lit = albedo.rgb * (0.35 + 0.65 * abs(dot(n, sun)));  // the plain look
+  vec3 lit = Lit(albedo.rgb, n, rel_position, distance_m, metal_rough);
 #endif
-  color = vec4(Out(mix(lit, horizon, haze)), albedo.a);
+  color = vec4(Out(mix(lit, horizon, Haze(distance_m))), albedo.a);
 }
+#endif
 #endif
 )";
 

@@ -815,6 +815,46 @@ TEST(RendererWingTest, BendingMovesTheSilhouetteToTheAnalyticTip) {
   EXPECT_TRUE(is_sky(frame_straight)) << px.transpose();  // the straight wing is not
 }
 
+// Deferred shading (the CPU's lighting of the G-buffer) against forward
+// shading (llvmpipe's, as the scene programs draw) on the sample level's chase
+// view: terrain, lake, tower, wing, their shadows, haze and sky. The two
+// implement one look; they differ by rounding, by the detail texture's level
+// at silhouettes and by the shadow lookups' levels-of-detail offset.
+TEST(RendererLookTest, DeferredShadingMatchesForwardShading) {
+  const scene::Level level = scene::LoadLevel(testing::SampleLevel());
+  auto renderer = MakeRenderer();
+  renderer->SetLevel(level, {});
+  scene::RobotState wing(level.robots[0]);
+  wing.SetPose(Eigen::Translation3d(-40, -30, 25) * Eigen::AngleAxisd(0.6, Vector3d::UnitZ()));
+  wing.Update();
+  CameraView view;
+  view.X_WC = ChaseCamera({}).Update(wing.pose(), 0.0);
+  for (const Quality quality : {Quality::kFast, Quality::kHigh}) {
+    RenderSettings settings = RenderSettings::Preset(quality);
+    settings.images = kColorImage;
+    Frame deferred, forward;
+    renderer->Render(view, {}, {&wing}, settings, &deferred);
+    settings.deferred = false;
+    renderer->Render(view, {}, {&wing}, settings, &forward);
+    ASSERT_EQ(deferred.rgb.size(), forward.rgb.size());
+    double sum = 0.0;
+    std::size_t far_off = 0;
+    const std::size_t pixels = deferred.rgb.size() / 3;
+    for (std::size_t i = 0; i < pixels; ++i) {
+      int most = 0;
+      for (int c = 0; c < 3; ++c) {
+        const int d = std::abs(int(deferred.rgb[3 * i + c]) - int(forward.rgb[3 * i + c]));
+        sum += d;
+        most = std::max(most, d);
+      }
+      far_off += most > 8;
+    }
+    const int q = int(quality);
+    EXPECT_LT(sum / (3.0 * double(pixels)), 1.5) << q;
+    EXPECT_LT(double(far_off) / double(pixels), 0.005) << q;
+  }
+}
+
 TEST(CameraTest, ChaseCameraAimsAtTheRobotAndFollowsWithoutOvershoot) {
   ChaseCamera chase({});
   Isometry3d X_WB = Eigen::Translation3d(10, 20, 60) * Eigen::AngleAxisd(0.7, Vector3d::UnitZ());
