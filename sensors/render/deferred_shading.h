@@ -80,6 +80,9 @@ struct LightingFrame {
   // shadow lookups move that much further off the surface (no acne).
   float lod_offset_per_m{0.f};
   std::vector<ShadowMapView> cascades;  // empty: no shadows
+  // Casters that move (robots, movable actors) in a map of their own around
+  // them (not in the cascades), infinitely deep where none was drawn; px 0: none.
+  ShadowMapView moving_casters;
 };
 
 // The ground's detail textures on the CPU: layers of one channel with their

@@ -49,6 +49,7 @@ namespace {
 constexpr double kPatternPeriod_m = 6900.0;  // the ground's and water's patterns repeat here
 constexpr int kDetailPx = 256;
 constexpr float kSnowLine_m = 2800.f;
+constexpr int kMovingShadowPx = 512;  // the moving casters' map (deferred shading)
 
 GLuint Compile(GLenum type, const char* source) {
   const GLuint shader = glCreateShader(type);
@@ -1101,9 +1102,9 @@ class OsMesaRenderer : public Renderer {
   // drawn into a map of its own only when the cascade's box, the sun or the
   // terrain's tiles change; each frame that map copied and what moves (robots,
   // movable actors) drawn over it.
-  // With `cpu` (deferred shading), the maps as the CPU shades with them, in
-  // shadow_cpu_: the still casters' map read back when redrawn, and each frame
-  // only the texels the moving casters cover drawn and read back.
+  // With `cpu` (deferred shading), the maps as the CPU shades with them: the
+  // still casters' maps read back when redrawn, the moving casters in a map
+  // of their own each frame (DrawMovingShadowsForCpu).
   void DrawShadowMaps(const std::vector<ShadowCascade>& cascades, const Eigen::Vector3f& sun,
                       int px, bool cpu) {
     const int layers = int(cascades.size());
@@ -1151,7 +1152,7 @@ class OsMesaRenderer : public Renderer {
         static_shadow_keys_[std::size_t(c)] = key;
       }
       if (cpu) {
-        DrawMovingShadowsForCpu(cascade, c, px);
+        ReadStillShadows(c, px);
         continue;
       }
       glCopyImageSubData(shadow_static_, GL_TEXTURE_2D_ARRAY, 0, 0, 0, c, shadow_map_,
@@ -1162,85 +1163,74 @@ class OsMesaRenderer : public Renderer {
       lod_error_m_ = ShadowLodError(cascade);
       DrawScene(Pass::kShadow, cascade.light_clip.cast<float>());
     }
+    if (cpu) DrawMovingShadowsForCpu(sun);
     shadow_casters_ = Casters::kAll;
     glDisable(GL_POLYGON_OFFSET_FILL);
   }
 
-  // Cascade c of shadow_cpu_: the still casters' map (read back when it was
-  // redrawn), the moving casters drawn over it within the texels they cover,
-  // read back; last frame's moving texels restored first.
-  void DrawMovingShadowsForCpu(const ShadowCascade& cascade, int c, int px) {
-    const auto& key = static_shadow_keys_[std::size_t(c)];
-    const std::size_t layer = std::size_t(px) * std::size_t(px), at = std::size_t(c) * layer;
-    if (shadow_cpu_.size() != std::size_t(shadow_layers_) * layer) {
-      shadow_cpu_.assign(std::size_t(shadow_layers_) * layer, 1.f);
-      shadow_cpu_static_.assign(shadow_cpu_.size(), 1.f);
+  // Cascade c's still casters for the CPU (shadow_cpu_static_): read back
+  // when its map was redrawn.
+  void ReadStillShadows(int c, int px) {
+    const std::size_t layer = std::size_t(px) * std::size_t(px);
+    if (shadow_cpu_static_.size() != std::size_t(shadow_layers_) * layer) {
+      shadow_cpu_static_.assign(std::size_t(shadow_layers_) * layer, 1.f);
       cpu_static_keys_.assign(std::size_t(shadow_layers_), StaticShadowKey{});
-      moving_rects_.assign(std::size_t(shadow_layers_), {0, 0, 0, 0});
     }
-    std::array<int, 4>& last = moving_rects_[std::size_t(c)];
-    if (!(cpu_static_keys_[std::size_t(c)] == key)) {
-      glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, shadow_static_, 0, c);
-      glReadPixels(0, 0, px, px, GL_DEPTH_COMPONENT, GL_FLOAT, &shadow_cpu_static_[at]);
-      std::copy_n(&shadow_cpu_static_[at], layer, &shadow_cpu_[at]);
-      cpu_static_keys_[std::size_t(c)] = key;
-      last = {0, 0, 0, 0};
-    }
-    for (int y = last[1]; y < last[3]; ++y) {
-      const std::size_t row = at + std::size_t(y) * std::size_t(px) + std::size_t(last[0]);
-      std::copy_n(&shadow_cpu_static_[row], last[2] - last[0], &shadow_cpu_[row]);
-    }
-    last = MovingTexels(cascade, px);
-    const int w = last[2] - last[0], h = last[3] - last[1];
-    if (w <= 0 || h <= 0) return;
-    // Moving casters too at a fifth of a texel (the CPU's lookups allow for
-    // the level a colour frame drew them at).
-    cpu_shadows_ = true;
-    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, shadow_map_, 0, c);
-    glEnable(GL_SCISSOR_TEST);
-    glScissor(last[0], last[1], w, h);
-    glClear(GL_DEPTH_BUFFER_BIT);
-    program_key_ = -1;
-    shadow_casters_ = Casters::kMoving;
-    lod_error_m_ = ShadowLodError(cascade);
-    DrawScene(Pass::kShadow, cascade.light_clip.cast<float>());
-    glDisable(GL_SCISSOR_TEST);
-    cpu_shadows_ = false;
-    moving_depth_.resize(std::size_t(w) * std::size_t(h));
-    glReadPixels(last[0], last[1], w, h, GL_DEPTH_COMPONENT, GL_FLOAT, moving_depth_.data());
-    for (int y = 0; y < h; ++y) {
-      float* row =
-          &shadow_cpu_[at + std::size_t(last[1] + y) * std::size_t(px) + std::size_t(last[0])];
-      const float* moving = &moving_depth_[std::size_t(y) * std::size_t(w)];
-      for (int x = 0; x < w; ++x) row[x] = std::min(row[x], moving[x]);
-    }
+    if (cpu_static_keys_[std::size_t(c)] == static_shadow_keys_[std::size_t(c)]) return;
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, shadow_static_, 0, c);
+    glReadPixels(0, 0, px, px, GL_DEPTH_COMPONENT, GL_FLOAT,
+                 &shadow_cpu_static_[std::size_t(c) * layer]);
+    cpu_static_keys_[std::size_t(c)] = static_shadow_keys_[std::size_t(c)];
   }
 
-  // The texels of a cascade's map (x0, y0, x1, y1) that this frame's robots'
-  // and movable actors' boxes cover, with a margin of two.
-  std::array<int, 4> MovingTexels(const ShadowCascade& cascade, int px) const {
-    Eigen::AlignedBox2f covered;
-    const Eigen::Matrix4f M = cascade.light_clip.cast<float>();
-    auto add = [&](const Eigen::AlignedBox3f& box_C) {
-      for (int k = 0; k < 8 && !box_C.isEmpty(); ++k) {
-        const Eigen::Vector4f q =
-            M * box_C.corner(Eigen::AlignedBox3f::CornerType(k)).homogeneous();
-        covered.extend(Eigen::Vector2f(0.5f * q.x() + 0.5f, 0.5f * q.y() + 0.5f) * float(px));
-      }
-    };
+  // The moving casters (robots, movable actors) for the CPU: drawn once into
+  // a map of their own around them and read back (moving_casters_); where no
+  // caster was drawn, infinitely deep.
+  void DrawMovingShadowsForCpu(const Eigen::Vector3f& sun) {
+    moving_casters_ = ShadowMapView{};
+    Eigen::AlignedBox3f box_C;
     for (const Eigen::AlignedBox3d& box_W : robot_bounds_W_) {
       if (!box_W.isEmpty()) {
-        add(Eigen::AlignedBox3f((box_W.min() - camera_).cast<float>(),
-                                (box_W.max() - camera_).cast<float>()));
+        box_C.extend(Eigen::AlignedBox3f((box_W.min() - camera_).cast<float>(),
+                                         (box_W.max() - camera_).cast<float>()));
       }
     }
     for (const auto& [actor, mesh] : actor_meshes_) {
-      if (!IsTranslucent(mesh)) add(ActorBoundsC(actor));
+      if (!IsTranslucent(mesh)) box_C.extend(ActorBoundsC(actor));
     }
-    if (covered.isEmpty()) return {0, 0, 0, 0};
-    auto texel = [px](float v) { return std::clamp(int(std::floor(v)), 0, px); };
-    return {texel(covered.min().x() - 2.f), texel(covered.min().y() - 2.f),
-            texel(covered.max().x() + 3.f), texel(covered.max().y() + 3.f)};
+    if (box_C.isEmpty()) return;
+    const ShadowCascade box =
+        FitCasterShadow(box_C.center().cast<double>(), 0.5 * box_C.diagonal().norm() + 0.01,
+                        sun.cast<double>(), kMovingShadowPx);
+    if (moving_shadow_fbo_ == 0) {
+      glGenFramebuffers(1, &moving_shadow_fbo_);
+      glGenRenderbuffers(1, &moving_shadow_depth_);
+      glBindRenderbuffer(GL_RENDERBUFFER, moving_shadow_depth_);
+      glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, kMovingShadowPx,
+                            kMovingShadowPx);
+      glBindFramebuffer(GL_FRAMEBUFFER, moving_shadow_fbo_);
+      glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
+                                moving_shadow_depth_);
+      glDrawBuffer(GL_NONE);
+      glReadBuffer(GL_NONE);
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, moving_shadow_fbo_);
+    glViewport(0, 0, kMovingShadowPx, kMovingShadowPx);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    program_key_ = -1;
+    shadow_casters_ = Casters::kMoving;
+    cpu_shadows_ = true;
+    lod_error_m_ = ShadowLodError(box);
+    DrawScene(Pass::kShadow, box.light_clip.cast<float>());
+    cpu_shadows_ = false;
+    moving_depth_.resize(std::size_t(kMovingShadowPx) * kMovingShadowPx);
+    glReadPixels(0, 0, kMovingShadowPx, kMovingShadowPx, GL_DEPTH_COMPONENT, GL_FLOAT,
+                 moving_depth_.data());
+    for (float& d : moving_depth_) {
+      if (d >= 1.f) d = std::numeric_limits<float>::infinity();
+    }
+    moving_casters_ = {box.light_clip.cast<float>(), 0.f, float(box.texel_m), kMovingShadowPx,
+                       moving_depth_.data()};
   }
 
   // The G-buffer layer `layer` (opaque_ or translucent_) read back.
@@ -1283,8 +1273,10 @@ class OsMesaRenderer : public Renderer {
     const std::size_t layer = std::size_t(shadow_px_) * std::size_t(shadow_px_);
     for (std::size_t c = 0; c < u.cascades.size(); ++c) {
       f.cascades.push_back({u.cascades[c].light_clip.cast<float>(), float(u.cascades[c].far_m),
-                            float(u.cascades[c].texel_m), shadow_px_, &shadow_cpu_[c * layer]});
+                            float(u.cascades[c].texel_m), shadow_px_,
+                            &shadow_cpu_static_[c * layer]});
     }
+    if (!u.cascades.empty()) f.moving_casters = moving_casters_;
     return f;
   }
 
@@ -1795,17 +1787,16 @@ class OsMesaRenderer : public Renderer {
   GLuint gbuffer_fbo_{0}, translucent_fbo_{0}, overlay_fbo_{0}, layer_buffers_[5]{0, 0, 0, 0, 0};
   SurfaceLayer opaque_, translucent_;
   bool translucent_drawn_{false};
-  bool cpu_shadows_{false};  // drawing the moving casters' shadows for the CPU
+  bool cpu_shadows_{false};  // drawing the moving casters' map for the CPU
   std::unique_ptr<DeferredShader> deferred_;
   DetailTextures detail_cpu_;
   std::vector<std::uint8_t> lit_, filtered_;
   std::vector<std::uint32_t> overlay_rgba_;
-  std::vector<float> shadow_cpu_;  // the cascades' maps as shaded: still casters and moving ones
   std::vector<float> shadow_cpu_static_;          // the still casters' maps
   std::vector<StaticShadowKey> cpu_static_keys_;  // what shadow_cpu_static_ holds
-  // Per cascade, the texels moving casters drew into (x0, y0, x1, y1; empty: x0 >= x1).
-  std::vector<std::array<int, 4>> moving_rects_;
-  std::vector<float> moving_depth_;
+  GLuint moving_shadow_fbo_{0}, moving_shadow_depth_{0};
+  std::vector<float> moving_depth_;  // the moving casters' map
+  ShadowMapView moving_casters_;
   GLuint overlay_vao_{0}, overlay_buffers_[2]{0, 0};
   GLfloat max_anisotropy_{1.f};
   GLuint anisotropic_{0};  // a sampler

@@ -5,20 +5,55 @@
 
 namespace sandbox::render {
 
-std::vector<ShadowCascade> FitShadowCascades(const CameraView& view, const Eigen::Vector3d& sun_W,
-                                             double distance_m, int count, int map_px,
-                                             double caster_reach_m) {
+namespace {
+
+// Light axes (rows): x and y across the map, z towards the sun.
+Eigen::Matrix3d SunAxes(const Eigen::Vector3d& sun_W) {
   const Eigen::Vector3d z = sun_W.normalized();
-  // Light axes: x and y across the map, z towards the sun.
   const Eigen::Vector3d x =
       (std::abs(z.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX())
           .cross(z)
           .normalized();
-  const Eigen::Vector3d y = z.cross(x);
   Eigen::Matrix3d R_LW;
   R_LW.row(0) = x;
-  R_LW.row(1) = y;
+  R_LW.row(1) = z.cross(x);
   R_LW.row(2) = z;
+  return R_LW;
+}
+
+// Camera-centred world to the clip space of the box centred at centre_L (light
+// axes) with half size r across and depth from `top` to `bottom` along the sun.
+Eigen::Matrix4d LightClip(const Eigen::Matrix3d& R_LW, const Eigen::Vector3d& centre_L, double r,
+                          double top, double bottom) {
+  Eigen::Matrix4d M = Eigen::Matrix4d::Zero();
+  M.block<1, 3>(0, 0) = R_LW.row(0) / r;
+  M(0, 3) = -centre_L.x() / r;
+  M.block<1, 3>(1, 0) = R_LW.row(1) / r;
+  M(1, 3) = -centre_L.y() / r;
+  M.block<1, 3>(2, 0) = -R_LW.row(2) / (top - bottom);
+  M(2, 3) = top / (top - bottom);
+  M(3, 3) = 1.0;
+  return M;
+}
+
+}  // namespace
+
+ShadowCascade FitCasterShadow(const Eigen::Vector3d& centre_C, double radius_m,
+                              const Eigen::Vector3d& sun_W, int map_px) {
+  const Eigen::Matrix3d R_LW = SunAxes(sun_W);
+  const Eigen::Vector3d centre_L = R_LW * centre_C;
+  ShadowCascade box;
+  box.light_clip =
+      LightClip(R_LW, centre_L, radius_m, centre_L.z() + radius_m, centre_L.z() - radius_m);
+  box.texel_m = 2.0 * radius_m / map_px;
+  box.half_size_m = radius_m;
+  return box;
+}
+
+std::vector<ShadowCascade> FitShadowCascades(const CameraView& view, const Eigen::Vector3d& sun_W,
+                                             double distance_m, int count, int map_px,
+                                             double caster_reach_m) {
+  const Eigen::Matrix3d R_LW = SunAxes(sun_W);
   const double near = view.near_m, far = std::max(distance_m, 2.0 * near);
   const double ty = std::tan(0.5 * view.fov_y_rad), tx = ty * view.width / view.height;
   const Eigen::Matrix3d R_WC = view.X_WC.linear();
@@ -52,15 +87,7 @@ std::vector<ShadowCascade> FitShadowCascades(const CameraView& view, const Eigen
     }
     centre_L -= camera_L;
     const double top = centre_L.z() + r + caster_reach_m, bottom = centre_L.z() - r;
-    Eigen::Matrix4d M = Eigen::Matrix4d::Zero();
-    M.block<1, 3>(0, 0) = R_LW.row(0) / r;
-    M(0, 3) = -centre_L.x() / r;
-    M.block<1, 3>(1, 0) = R_LW.row(1) / r;
-    M(1, 3) = -centre_L.y() / r;
-    M.block<1, 3>(2, 0) = -R_LW.row(2) / (top - bottom);
-    M(2, 3) = top / (top - bottom);
-    M(3, 3) = 1.0;
-    cascades.push_back({M, d1, texel, cell, r});
+    cascades.push_back({LightClip(R_LW, centre_L, r, top, bottom), d1, texel, cell, r});
     d0 = d1;
   }
   return cascades;

@@ -33,4 +33,11 @@ std::vector<ShadowCascade> FitShadowCascades(const CameraView& view, const Eigen
                                              double distance_m, int count, int map_px,
                                              double caster_reach_m);
 
+// A map of `map_px` texels a side, seen from the sun, around casters within
+// `radius_m` of `centre_C` (camera-centred): its box is the sphere's, depth 0
+// at its top towards the sun and 1 at its bottom (receivers further down lie
+// beyond 1). far_m and cell are not set.
+ShadowCascade FitCasterShadow(const Eigen::Vector3d& centre_C, double radius_m,
+                              const Eigen::Vector3d& sun_W, int map_px);
+
 }  // namespace sandbox::render

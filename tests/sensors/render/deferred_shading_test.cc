@@ -9,6 +9,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "sensors/render/detail_textures.h"
@@ -198,8 +199,9 @@ TEST(DeferredShadingTest, ATranslucentSurfaceIsBlendedOverTheOpaqueOneByItsAlpha
 }
 
 // A G-buffer of every kind (ground with detail, water, prelit, shiny metal,
-// sky), shadows in two cascades and a translucent layer: each kernel and
-// thread count gives the same bytes, and so does the edge filter.
+// sky), shadows in two cascades and a moving casters' map, and a translucent
+// layer: each kernel and thread count gives the same bytes, and so does the
+// edge filter.
 TEST(DeferredShadingTest, EveryKernelAndThreadCountGivesTheSameBytes) {
   const Camera camera{203, 77};
   LightingFrame frame = Frame(camera);
@@ -220,6 +222,12 @@ TEST(DeferredShadingTest, EveryKernelAndThreadCountGivesTheSameBytes) {
     frame.cascades.push_back(
         {clip, 40.f * float(c + 1), 0.5f, kPx, &maps[std::size_t(c) * kPx * kPx]});
   }
+  std::vector<float> moving(kPx * kPx);
+  for (float& d : moving)
+    d = unit(random) < 0.7f ? std::numeric_limits<float>::infinity() : unit(random);
+  Eigen::Matrix4f moving_clip = Eigen::Matrix4f::Identity() / 20.f;
+  moving_clip(2, 2) = -0.05f, moving_clip(2, 3) = 0.5f, moving_clip(3, 3) = 1.f;
+  frame.moving_casters = {moving_clip, 0.f, 0.1f, kPx, moving.data()};
   SurfaceLayer opaque = Layer(camera.width, camera.height), translucent = opaque;
   for (std::size_t i = 0; i < opaque.depth.size(); ++i) {
     const bool sky = unit(random) < 0.1f;
