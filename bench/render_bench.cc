@@ -8,11 +8,12 @@
 //
 //  3. The overlay's cost.
 //  4. The looks: the sample level's chase view at 640x480 and 1280x720 with
-//     the plain, fast and high presets (colour, as chase cameras write; with
-//     depth; without levels of detail), and each image kind, against the
-//     plain look in the same run (ratio).
+//     the plain, fast and high presets (colour, as chase cameras write;
+//     shaded forward, the reference for deferred shading; with depth;
+//     without levels of detail), and each image kind, against the plain look
+//     in the same run (ratio); the looks take turns a frame at a time.
 //
-//   bench_render [--seconds S] [--looks]   (--looks: section 4 only)
+//   bench_render [--seconds S] [--looks [--rounds N]]   (--looks: section 4 only)
 
 #include <algorithm>
 #include <atomic>
@@ -23,6 +24,7 @@
 #include <cstring>
 #include <deque>
 #include <filesystem>
+#include <map>
 #include <mutex>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -34,6 +36,7 @@
 #include "sensors/face_scanner.h"
 #include "sensors/render/cameras.h"
 #include "sensors/render/debug_overlay.h"
+#include "sensors/render/deferred_shading.h"
 #include "sensors/render/renderer.h"
 
 namespace {
@@ -42,100 +45,139 @@ using namespace sandbox;
 using Clock = std::chrono::steady_clock;
 namespace fs = std::filesystem;
 
-// Median milliseconds a frame of the sample level's chase view (the wing
-// posed mid-turn) with `settings` at `width` x `height`, after a warm-up;
-// with `step_m`, the wing and its camera move that far along x each frame.
-double ChaseFrameMs(render::Renderer& renderer, scene::RobotState wing, int width, int height,
-                    const render::RenderSettings& settings, double step_m = 0.0) {
+// The looks: each row renders the sample level's chase view (the wing posed
+// mid-turn) with its settings; the rows take turns a frame at a time, so that
+// the machine's slow and fast moments fall on all of them. Rows share a
+// renderer where its state (the levels of detail each mesh was last drawn
+// at) comes out the same: frames of colour alone at one allowance, frames
+// with measurement images, and a moving row each its own.
+// With `step_m`, the row's wing and camera move that far along x each frame.
+struct LookRow {
+  std::string name;
+  render::RenderSettings settings;
+  double step_m{0.0};
+  render::Renderer* renderer{nullptr};
+  scene::RobotState wing;
+  render::ChaseCamera chase;
   render::CameraView view;
-  view.width = width;
-  view.height = height;
-  render::ChaseCamera chase({});
-  render::Frame frame;
   std::vector<double> ms;
-  for (int i = 0; i < 13; ++i) {
-    if (i == 0 || step_m > 0.0) {
-      wing.SetPose(Eigen::Translation3d(step_m, 0, 0) * wing.pose());
-      wing.Update();
-      view.X_WC = chase.Update(wing.pose(), i == 0 ? 0.0 : 1.0 / 30.0);
-    }
-    const auto start = Clock::now();
-    renderer.Render(view, {}, {&wing}, settings, &frame);
-    if (i >= 3)  // the first frames of a look compile its shaders
-      ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
-  }
-  return bench::Median(ms);
-}
+};
 
-int BenchLooks() {
+int BenchLooks(int rounds) {
   const scene::Level level =
       scene::LoadLevel(std::string(SANDBOX_SOURCE_DIR) + "/assets/sample/level.toml");
-  auto renderer = render::MakeRenderer();
-  renderer->SetLevel(level, {});
   scene::RobotState wing(level.robots[0]);
   wing.SetPose(Eigen::Translation3d(-40, -30, 25) *
                Eigen::AngleAxisd(0.6, Eigen::Vector3d::UnitZ()));
   wing.Update();
+  using render::Quality;
+  auto look = [](Quality quality, render::ImageKinds kinds, float lod_px = 1.f) {
+    render::RenderSettings settings = render::RenderSettings::Preset(quality);
+    settings.images = kinds;
+    settings.lod_px = lod_px;
+    return settings;
+  };
+  const render::ImageKinds color(render::kColorImage);
+  const render::ImageKinds color_depth(render::kColorImage | render::kDepthImage);
+  std::vector<std::pair<std::string, render::RenderSettings>> settings;
+  std::vector<double> steps;
+  auto add = [&](const std::string& name, const render::RenderSettings& s, double step_m = 0.0) {
+    settings.emplace_back(name, s);
+    steps.push_back(step_m);
+  };
+  // The looks as a chase camera writes them (colour), then shaded forward
+  // (as drawn: the reference deferred shading replaces), with depth (drawn as
+  // given: no levels of detail) and without levels of detail.
+  for (const auto& [name, quality] :
+       {std::pair{"plain", Quality::kPlain}, std::pair{"fast", Quality::kFast},
+        std::pair{"high", Quality::kHigh}}) {
+    add(std::string(name) + " (color)", look(quality, color));
+  }
+  for (const auto& [name, quality] :
+       {std::pair{"fast", Quality::kFast}, std::pair{"high", Quality::kHigh}}) {
+    render::RenderSettings forward = look(quality, color);
+    forward.deferred = false;
+    add(std::string(name) + ", shaded forward", forward);
+  }
+  for (const auto& [name, quality] :
+       {std::pair{"plain", Quality::kPlain}, std::pair{"fast", Quality::kFast},
+        std::pair{"high", Quality::kHigh}}) {
+    add(std::string(name) + " (color, depth)", look(quality, color_depth));
+    add(std::string(name) + " (color), no levels of detail", look(quality, color, 0.f));
+  }
+  render::RenderSettings fast_shadows = look(Quality::kFast, color);
+  fast_shadows.shadows = true;
+  add("fast + shadows", fast_shadows);
+  render::RenderSettings fast_fxaa = look(Quality::kFast, color);
+  fast_fxaa.fxaa = true;
+  add("fast + FXAA", fast_fxaa);
+  render::RenderSettings fast_msaa = look(Quality::kFast, color);
+  fast_msaa.msaa_samples = 4;
+  add("fast + 4x multisampling", fast_msaa);
+  add("high, flying 10 m a frame", look(Quality::kHigh, color), 10.0);
+  for (const auto& [name, kinds] :
+       {std::pair{"high: + segmentation",
+                  render::ImageKinds(render::kColorImage | render::kSegmentationImage)},
+        std::pair{"high: all four",
+                  render::ImageKinds(render::kColorImage | render::kDepthImage |
+                                     render::kSegmentationImage | render::kNormalsImage)},
+        std::pair{"depth only", render::ImageKinds(render::kDepthImage)},
+        std::pair{"segmentation only", render::ImageKinds(render::kSegmentationImage)}}) {
+    add(name, look(Quality::kHigh, kinds));
+  }
   std::printf(
-      "looks: sample level, chase camera, wing mid-turn; median ms a frame (fps), ratio "
-      "to plain at that size\n");
+      "looks: sample level, chase camera, wing mid-turn; the rows take turns a frame at a "
+      "time, %d rounds after 3 of warm-up;\nmedian ms a frame (fps), ratio to plain at that "
+      "size; deferred shading kernel: %s\n",
+      rounds, render::DeferredShader().kernel().c_str());
   std::printf("%-10s %-34s %10s %8s %8s\n", "size", "look", "ms", "fps", "ratio");
   for (const auto& [width, height] : {std::pair{640, 480}, std::pair{1280, 720}}) {
-    double plain_ms = 0.0;
-    auto row = [&](const std::string& name, const render::RenderSettings& settings,
-                   double step_m = 0.0) {
-      const double ms = ChaseFrameMs(*renderer, wing, width, height, settings, step_m);
-      if (plain_ms == 0.0) plain_ms = ms;
-      std::printf("%4dx%-5d %-34s %10.2f %8.1f %7.2fx\n", width, height, name.c_str(), ms, 1e3 / ms,
-                  ms / plain_ms);
-    };
-    using render::Quality;
-    // The looks as a chase camera writes them (colour), then with depth (drawn
-    // as given: no levels of detail) and without levels of detail.
-    auto look = [](Quality quality, render::ImageKinds kinds, float lod_px = 1.f) {
-      render::RenderSettings settings = render::RenderSettings::Preset(quality);
-      settings.images = kinds;
-      settings.lod_px = lod_px;
-      return settings;
-    };
-    const render::ImageKinds color(render::kColorImage);
-    const render::ImageKinds color_depth(render::kColorImage | render::kDepthImage);
-    for (const auto& [name, quality] :
-         {std::pair{"plain", Quality::kPlain}, std::pair{"fast", Quality::kFast},
-          std::pair{"high", Quality::kHigh}}) {
-      row(std::string(name) + " (color)", look(quality, color));
+    std::vector<LookRow> rows;
+    std::map<std::string, std::unique_ptr<render::Renderer>> renderers;
+    for (std::size_t i = 0; i < settings.size(); ++i) {
+      const render::RenderSettings& s = settings[i].second;
+      const std::string group = steps[i] > 0.0                    ? settings[i].first
+                                : s.images == render::kColorImage ? std::to_string(s.lod_px)
+                                                                  : "measurements";
+      std::unique_ptr<render::Renderer>& renderer = renderers[group];
+      if (!renderer) {
+        renderer = render::MakeRenderer();
+        renderer->SetLevel(level, {});
+      }
+      LookRow row{settings[i].first,
+                  settings[i].second,
+                  steps[i],
+                  renderer.get(),
+                  wing,
+                  render::ChaseCamera({}),
+                  {},
+                  {}};
+      row.view.width = width;
+      row.view.height = height;
+      row.view.X_WC = row.chase.Update(row.wing.pose(), 0.0);
+      rows.push_back(std::move(row));
     }
-    for (const auto& [name, quality] :
-         {std::pair{"plain", Quality::kPlain}, std::pair{"fast", Quality::kFast},
-          std::pair{"high", Quality::kHigh}}) {
-      row(std::string(name) + " (color, depth)", look(quality, color_depth));
-      row(std::string(name) + " (color), no levels of detail", look(quality, color, 0.f));
+    render::Frame frame;
+    for (int round = 0; round < rounds + 3; ++round) {
+      for (LookRow& row : rows) {
+        if (row.step_m > 0.0) {
+          row.wing.SetPose(Eigen::Translation3d(row.step_m, 0, 0) * row.wing.pose());
+          row.wing.Update();
+          row.view.X_WC = row.chase.Update(row.wing.pose(), 1.0 / 30.0);
+        }
+        const auto start = Clock::now();
+        row.renderer->Render(row.view, {}, {&row.wing}, row.settings, &frame);
+        // (The first frames of a look compile its shaders.)
+        if (round >= 3) {
+          row.ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+        }
+      }
     }
-    render::RenderSettings shadows = look(Quality::kFast, color);
-    shadows.shadows = true;
-    row("fast + shadows", shadows);
-    render::RenderSettings msaa = look(Quality::kFast, color);
-    msaa.msaa_samples = 4;
-    row("fast + 4x multisampling", msaa);
-    render::RenderSettings fxaa = look(Quality::kFast, color);
-    fxaa.fxaa = true;
-    row("fast + FXAA", fxaa);
-    render::RenderSettings high_msaa = look(Quality::kHigh, color);
-    high_msaa.fxaa = false;
-    high_msaa.msaa_samples = 4;
-    row("high with 4x MSAA for FXAA", high_msaa);
-    row("high, flying 10 m a frame", look(Quality::kHigh, color), 10.0);
-    for (const auto& [name, kinds] :
-         {std::pair{"high: + segmentation",
-                    render::ImageKinds(render::kColorImage | render::kSegmentationImage)},
-          std::pair{"high: + normals",
-                    render::ImageKinds(render::kColorImage | render::kNormalsImage)},
-          std::pair{"high: all four",
-                    render::ImageKinds(render::kColorImage | render::kDepthImage |
-                                       render::kSegmentationImage | render::kNormalsImage)},
-          std::pair{"depth only", render::ImageKinds(render::kDepthImage)},
-          std::pair{"segmentation only", render::ImageKinds(render::kSegmentationImage)}}) {
-      row(name, look(Quality::kHigh, kinds));
+    const double plain_ms = bench::Median(rows.front().ms);
+    for (const LookRow& row : rows) {
+      const double ms = bench::Median(row.ms);
+      std::printf("%4dx%-5d %-34s %10.2f %8.1f %7.2fx\n", width, height, row.name.c_str(), ms,
+                  1e3 / ms, ms / plain_ms);
     }
   }
   return 0;
@@ -146,11 +188,13 @@ int BenchLooks() {
 int main(int argc, char** argv) {
   double seconds = 5.0;
   bool looks_only = false;
+  int rounds = 15;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--seconds") && i + 1 < argc) seconds = std::atof(argv[++i]);
     if (!std::strcmp(argv[i], "--looks")) looks_only = true;
+    if (!std::strcmp(argv[i], "--rounds") && i + 1 < argc) rounds = std::atoi(argv[++i]);
   }
-  if (looks_only) return BenchLooks();
+  if (looks_only) return BenchLooks(std::max(rounds, 1));
   // 1. Chase camera, render thread + encoder thread.
   {
     const scene::Level level =

@@ -76,27 +76,41 @@ DetailTextures::DetailTextures(const std::vector<std::uint8_t>& rgba, int size, 
     offset += s * s;
   }
   layer_stride_ = offset;
-  texels_.assign(std::size_t(layers) * std::size_t(offset), 0.f);
+  std::vector<std::uint8_t> texels(std::size_t(layers) * std::size_t(offset));
+  quads_.assign(texels.size(), 0);
   for (int layer = 0; layer < layers; ++layer) {
-    float* base = &texels_[std::size_t(layer) * std::size_t(offset)];
+    std::uint8_t* base = &texels[std::size_t(layer) * std::size_t(offset)];
     for (int i = 0; i < size * size; ++i) {
-      base[i] = float(rgba[4 * (std::size_t(layer) * std::size_t(size * size) + std::size_t(i))]);
+      base[i] = rgba[4 * (std::size_t(layer) * std::size_t(size * size) + std::size_t(i))];
     }
     for (std::size_t l = 1; l < level_offset_.size(); ++l) {
       const int s = size >> l, below = s * 2;
-      const float* src = base + level_offset_[l - 1];
-      float* dst = base + level_offset_[l];
+      const std::uint8_t* src = base + level_offset_[l - 1];
+      std::uint8_t* dst = base + level_offset_[l];
       for (int y = 0; y < s; ++y) {
         for (int x = 0; x < s; ++x) {
-          dst[y * s + x] =
-              0.25f * (src[2 * y * below + 2 * x] + src[2 * y * below + 2 * x + 1] +
-                       src[(2 * y + 1) * below + 2 * x] + src[(2 * y + 1) * below + 2 * x + 1]);
+          const int sum = src[2 * y * below + 2 * x] + src[2 * y * below + 2 * x + 1] +
+                          src[(2 * y + 1) * below + 2 * x] + src[(2 * y + 1) * below + 2 * x + 1];
+          dst[y * s + x] = std::uint8_t((sum + 2) / 4);
+        }
+      }
+    }
+    // Each texel with its neighbours, repeating at the edges.
+    for (std::size_t l = 0; l < level_offset_.size(); ++l) {
+      const int s = size >> l;
+      const std::uint8_t* t = base + level_offset_[l];
+      std::int32_t* q =
+          &quads_[std::size_t(layer) * std::size_t(offset) + std::size_t(level_offset_[l])];
+      for (int y = 0; y < s; ++y) {
+        for (int x = 0; x < s; ++x) {
+          const int x1 = (x + 1) % s, y1 = (y + 1) % s;
+          q[y * s + x] = std::int32_t(
+              std::uint32_t(t[y * s + x]) | std::uint32_t(t[y * s + x1]) << 8 |
+              std::uint32_t(t[y1 * s + x]) << 16 | std::uint32_t(t[y1 * s + x1]) << 24);
         }
       }
     }
   }
-  // Bytes to 0..1, as the sampler reads them.
-  for (float& t : texels_) t /= 255.f;
 }
 
 DeferredShader::DeferredShader(int threads, const std::string& kernel) : kernel_(kernel) {
@@ -166,27 +180,28 @@ void DeferredShader::RunParallel(int count, const std::function<void(int)>& job)
 
 void DeferredShader::Shade(const LightingFrame& frame, const DetailTextures& detail,
                            const SurfaceLayer& opaque, const SurfaceLayer* translucent,
-                           std::vector<std::uint8_t>* rgb) {
+                           std::vector<std::uint8_t>* rgba) {
   const int w = opaque.width, h = opaque.height;
-  rgb->resize(3 * std::size_t(w) * std::size_t(h));
+  rgba->resize(4 * std::size_t(w) * std::size_t(h));
+  std::uint32_t* words = reinterpret_cast<std::uint32_t*>(rgba->data());
   // The cascades' maps, one after the other, as the kernel gathers from them.
   const float* shadow = frame.cascades.empty() ? nullptr : frame.cascades.front().depth;
   // Bands of 16 rows (whole 2 x 2 quads), drawn from a counter.
   constexpr int kBand = 16;
   const int bands = (h + kBand - 1) / kBand;
   luma_.resize(std::size_t(w) * std::size_t(h));
-  luma_of_ = rgb->data();
+  luma_of_ = rgba->data();
   RunParallel(bands, [&](int band) {
     const int begin = band * kBand, end = std::min(h, begin + kBand);
     if (simd_ == Simd::kAvx512) {
       const avx512::Constants k{&frame, &detail, SrgbTable(), shadow, w, h};
-      avx512::ShadeRows(k, opaque, translucent, begin, end, rgb->data(), luma_.data());
+      avx512::ShadeRows(k, opaque, translucent, begin, end, words, luma_.data());
     } else if (simd_ == Simd::kAvx2) {
       const avx2::Constants k{&frame, &detail, SrgbTable(), shadow, w, h};
-      avx2::ShadeRows(k, opaque, translucent, begin, end, rgb->data(), luma_.data());
+      avx2::ShadeRows(k, opaque, translucent, begin, end, words, luma_.data());
     } else {
       const sse2::Constants k{&frame, &detail, SrgbTable(), shadow, w, h};
-      sse2::ShadeRows(k, opaque, translucent, begin, end, rgb->data(), luma_.data());
+      sse2::ShadeRows(k, opaque, translucent, begin, end, words, luma_.data());
     }
   });
 }
@@ -199,7 +214,7 @@ void DeferredShader::FilterEdges(const std::vector<std::uint8_t>& in, int width,
   if (luma_of_ != in.data() || luma_.size() != count) {
     luma_.resize(count);
     for (std::size_t i = 0; i < count; ++i) {
-      luma_[i] = (0.299f * in[3 * i] + 0.587f * in[3 * i + 1] + 0.114f * in[3 * i + 2]) / 255.f;
+      luma_[i] = (0.299f * in[4 * i] + 0.587f * in[4 * i + 1] + 0.114f * in[4 * i + 2]) / 255.f;
     }
   }
   const float* luma = luma_.data();
@@ -215,10 +230,10 @@ void DeferredShader::FilterEdges(const std::vector<std::uint8_t>& in, int width,
     const int x0 = std::clamp(int(x0f), 0, width - 1), x1 = std::clamp(int(x0f) + 1, 0, width - 1);
     const int y0 = std::clamp(int(y0f), 0, height - 1),
               y1 = std::clamp(int(y0f) + 1, 0, height - 1);
-    const std::uint8_t* c00 = &in[3 * (std::size_t(y0) * std::size_t(width) + std::size_t(x0))];
-    const std::uint8_t* c10 = &in[3 * (std::size_t(y0) * std::size_t(width) + std::size_t(x1))];
-    const std::uint8_t* c01 = &in[3 * (std::size_t(y1) * std::size_t(width) + std::size_t(x0))];
-    const std::uint8_t* c11 = &in[3 * (std::size_t(y1) * std::size_t(width) + std::size_t(x1))];
+    const std::uint8_t* c00 = &in[4 * (std::size_t(y0) * std::size_t(width) + std::size_t(x0))];
+    const std::uint8_t* c10 = &in[4 * (std::size_t(y0) * std::size_t(width) + std::size_t(x1))];
+    const std::uint8_t* c01 = &in[4 * (std::size_t(y1) * std::size_t(width) + std::size_t(x0))];
+    const std::uint8_t* c11 = &in[4 * (std::size_t(y1) * std::size_t(width) + std::size_t(x1))];
     for (int c = 0; c < 3; ++c) {
       const float top = c00[c] + (c10[c] - c00[c]) * ax, bottom = c01[c] + (c11[c] - c01[c]) * ax;
       rgb[c] = (top + (bottom - top) * ay) * (1.f / 255.f);
@@ -250,7 +265,7 @@ void DeferredShader::FilterEdges(const std::vector<std::uint8_t>& in, int width,
     }
     const float l_wide = 0.299f * wide[0] + 0.587f * wide[1] + 0.114f * wide[2];
     const float* chosen = l_wide < lo || l_wide > hi ? near_pair : wide;
-    std::uint8_t* dst = &(*out)[3 * (std::size_t(y) * std::size_t(width) + std::size_t(x))];
+    std::uint8_t* dst = &(*out)[4 * (std::size_t(y) * std::size_t(width) + std::size_t(x))];
     for (int k = 0; k < 3; ++k)
       dst[k] = std::uint8_t(std::lround(std::clamp(chosen[k], 0.f, 1.f) * 255.f));
   };

@@ -86,7 +86,10 @@ struct LightingFrame {
 };
 
 // The ground's detail textures on the CPU: layers of one channel with their
-// mip levels, sampled as GL samples a repeating trilinear texture.
+// mip levels (each texel the rounded mean of the four below, as GL makes
+// them), sampled as GL samples a repeating trilinear texture. Each texel is
+// stored with its right, upper and upper right neighbours (repeating), a byte
+// each: one load gives a bilinear sample's four texels.
 class DetailTextures {
  public:
   DetailTextures() = default;
@@ -94,7 +97,8 @@ class DetailTextures {
   DetailTextures(const std::vector<std::uint8_t>& rgba, int size, int layers);
   int size() const { return size_; }
   int levels() const { return int(level_offset_.size()); }
-  const float* data() const { return texels_.data(); }
+  // Texel (x, y) of a level: bytes (x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1).
+  const std::int32_t* data() const { return quads_.data(); }
   // Offsets of each level of layer 0 in data(); a layer's levels follow each other.
   const std::int32_t* level_offsets() const { return level_offset_.data(); }
   int layer_stride() const { return layer_stride_; }
@@ -102,7 +106,7 @@ class DetailTextures {
  private:
   int size_{0}, layer_stride_{0};
   std::vector<std::int32_t> level_offset_;
-  std::vector<float> texels_;
+  std::vector<std::int32_t> quads_;
 };
 
 class DeferredShader {
@@ -117,12 +121,12 @@ class DeferredShader {
   DeferredShader& operator=(const DeferredShader&) = delete;
 
   // Lights `opaque`, then blends `translucent` (when given) over it, into
-  // `rgb` (3 bytes a pixel, display values, row 0 at the bottom).
+  // `rgba` (4 bytes a pixel, display values, alpha 255, row 0 at the bottom).
   void Shade(const LightingFrame& frame, const DetailTextures& detail, const SurfaceLayer& opaque,
-             const SurfaceLayer* translucent, std::vector<std::uint8_t>* rgb);
+             const SurfaceLayer* translucent, std::vector<std::uint8_t>* rgba);
 
   // The edge filter (FXAA, as shaders.h's kEdgeFilterFragment) from `in`
-  // into `out` (both rgb, row 0 at the bottom, width x height).
+  // into `out` (both rgba, row 0 at the bottom, width x height).
   void FilterEdges(const std::vector<std::uint8_t>& in, int width, int height,
                    std::vector<std::uint8_t>* out);
 

@@ -586,15 +586,16 @@ class OsMesaRenderer : public Renderer {
       frame->rgb.resize(3 * count);
       for (int y = 0; y < h; ++y) {
         const std::size_t row = std::size_t(h - 1 - y) * std::size_t(w);
-        std::memcpy(&frame->rgb[3 * std::size_t(y) * std::size_t(w)], &(*image)[3 * row],
-                    3 * std::size_t(w));
-        if (!marks) continue;
-        for (int x = 0; x < w; ++x) {
+        const std::uint8_t* src = &(*image)[4 * row];
+        std::uint8_t* dst = &frame->rgb[3 * std::size_t(y) * std::size_t(w)];
+        // Four bytes a pixel written three apart (the fourth overwritten next).
+        for (int x = 0; x + 1 < w; ++x) std::memcpy(dst + 3 * x, src + 4 * x, 4);
+        std::memcpy(dst + 3 * (w - 1), src + 4 * (w - 1), 3);
+        for (int x = 0; marks && x < w; ++x) {
           const std::uint32_t mark = overlay_rgba_[row + std::size_t(x)];
           if ((mark >> 24) == 0) continue;
-          std::uint8_t* dst = &frame->rgb[3 * (std::size_t(y) * std::size_t(w) + std::size_t(x))];
-          dst[0] = std::uint8_t(mark), dst[1] = std::uint8_t(mark >> 8),
-          dst[2] = std::uint8_t(mark >> 16);
+          dst[3 * x] = std::uint8_t(mark), dst[3 * x + 1] = std::uint8_t(mark >> 8),
+                  dst[3 * x + 2] = std::uint8_t(mark >> 16);
         }
       }
     } else if (kinds & kColorImage) {

@@ -93,8 +93,8 @@ LightingFrame Frame(const Camera& camera) {
   return frame;
 }
 
-const std::uint8_t* At(const std::vector<std::uint8_t>& rgb, int width, int x, int y) {
-  return &rgb[3 * (std::size_t(y) * std::size_t(width) + std::size_t(x))];
+const std::uint8_t* At(const std::vector<std::uint8_t>& rgba, int width, int x, int y) {
+  return &rgba[4 * (std::size_t(y) * std::size_t(width) + std::size_t(x))];
 }
 
 TEST(DeferredShadingTest, EncodeSrgbIsTheTransferFunction) {
