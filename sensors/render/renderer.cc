@@ -463,7 +463,9 @@ class OsMesaRenderer : public Renderer {
       // The opaque surfaces into the G-buffer, read back; the nearest
       // translucent surfaces into a layer of their own over that depth; each
       // pixel lit once on the CPU.
-      glBindFramebuffer(GL_FRAMEBUFFER, gbuffer_fbo_);
+      // (Without segment and normal images, into a framebuffer without them:
+      // llvmpipe pays for every target attached.)
+      glBindFramebuffer(GL_FRAMEBUFFER, want_data ? gbuffer_fbo_ : gbuffer_lean_fbo_);
       glViewport(0, 0, view.width, view.height);
       ClearTargets(want_data, horizon, /*keep_color=*/true);
       const GLenum data = want_data ? GL_COLOR_ATTACHMENT1 : GL_NONE;
@@ -474,7 +476,7 @@ class OsMesaRenderer : public Renderer {
       translucent_drawn_ = false;
       DrawScene(Pass::kColor, view_proj, [&] {
         ReadLayer(view.width, view.height, &opaque_);
-        glBindFramebuffer(GL_FRAMEBUFFER, translucent_fbo_);
+        glBindFramebuffer(GL_FRAMEBUFFER, want_data ? translucent_fbo_ : translucent_lean_fbo_);
         const GLenum layer[] = {GL_COLOR_ATTACHMENT0, data, normals, GL_COLOR_ATTACHMENT3};
         glDrawBuffers(4, layer);
         look_ = look | kGBuffer | kTranslucent | (want_data ? kData : 0);
@@ -1243,7 +1245,7 @@ class OsMesaRenderer : public Renderer {
     layer->albedo.resize(count);
     layer->normal.resize(count);
     layer->depth.resize(count);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, opaque ? gbuffer_fbo_ : translucent_fbo_);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, opaque ? gbuffer_lean_fbo_ : translucent_lean_fbo_);
     glReadBuffer(GL_COLOR_ATTACHMENT0);
     glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, layer->albedo.data());
     glReadBuffer(GL_COLOR_ATTACHMENT3);
@@ -1679,6 +1681,8 @@ class OsMesaRenderer : public Renderer {
       glGenRenderbuffers(2, msaa_buffers_);
       glGenFramebuffers(1, &gbuffer_fbo_);
       glGenFramebuffers(1, &translucent_fbo_);
+      glGenFramebuffers(1, &gbuffer_lean_fbo_);
+      glGenFramebuffers(1, &translucent_lean_fbo_);
       glGenFramebuffers(1, &overlay_fbo_);
       glGenRenderbuffers(5, layer_buffers_);
     }
@@ -1717,6 +1721,14 @@ class OsMesaRenderer : public Renderer {
     share(GL_COLOR_ATTACHMENT2, buffers_[2]);
     share(GL_DEPTH_ATTACHMENT, buffers_[3]);
     check("the translucent layer's");
+    for (const auto& [lean, layer] :
+         {std::pair{gbuffer_lean_fbo_, 0}, std::pair{translucent_lean_fbo_, 2}}) {
+      glBindFramebuffer(GL_FRAMEBUFFER, lean);
+      share(GL_COLOR_ATTACHMENT0, layer_buffers_[layer]);
+      share(GL_COLOR_ATTACHMENT3, layer_buffers_[layer + 1]);
+      share(GL_DEPTH_ATTACHMENT, buffers_[3]);
+      check("a lean layer's");
+    }
     attach(overlay_fbo_, layer_buffers_[4], GL_RGBA8, GL_COLOR_ATTACHMENT0, 0);
     share(GL_DEPTH_ATTACHMENT, buffers_[3]);
     check("the overlay's");
@@ -1786,6 +1798,7 @@ class OsMesaRenderer : public Renderer {
   // was read back of them, the CPU's shader and image, and its copies of the
   // detail textures and the shadow maps.
   GLuint gbuffer_fbo_{0}, translucent_fbo_{0}, overlay_fbo_{0}, layer_buffers_[5]{0, 0, 0, 0, 0};
+  GLuint gbuffer_lean_fbo_{0}, translucent_lean_fbo_{0};  // the same without segment and normal
   SurfaceLayer opaque_, translucent_;
   bool translucent_drawn_{false};
   bool cpu_shadows_{false};  // drawing the moving casters' map for the CPU
