@@ -32,24 +32,39 @@ std::uint8_t EncodeSrgb(float linear) {
   return std::uint8_t(std::lround(std::clamp(s, 0.f, 1.f) * 255.f));
 }
 
-// The kernel three times: for AVX-512, for AVX2 with FMA, and for any x86-64.
+// The kernel three times: for AVX-512, for AVX2 with FMA, and for any x86-64
+// (each function of the first two compiled for its instruction set, by GCC's
+// or clang's pragma).
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx512f,avx512dq,avx2,fma"))), \
+                             apply_to = function)
+#else
 #pragma GCC push_options
 #pragma GCC target("avx512f,avx512dq,avx2,fma")
+#endif
 namespace avx512 {
 #define SANDBOX_SIMD 512
 #include "sensors/render/deferred_kernel.inc"
 #undef SANDBOX_SIMD
 }  // namespace avx512
+#if defined(__clang__)
+#pragma clang attribute pop
+#pragma clang attribute push(__attribute__((target("avx2,fma"))), apply_to = function)
+#else
 #pragma GCC pop_options
-
 #pragma GCC push_options
 #pragma GCC target("avx2,fma")
+#endif
 namespace avx2 {
 #define SANDBOX_SIMD 256
 #include "sensors/render/deferred_kernel.inc"
 #undef SANDBOX_SIMD
 }  // namespace avx2
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
 #pragma GCC pop_options
+#endif
 
 namespace sse2 {
 #define SANDBOX_SIMD 0
