@@ -10,6 +10,7 @@
 
 #include "scene/collision_world.h"
 #include "scene/terrain_tile.h"
+#include "scene/triangle_bvh.h"
 
 namespace sandbox::scene {
 
@@ -40,11 +41,13 @@ struct MeshArrays {
   const std::vector<std::uint32_t>* indices;
 };
 
-// One Bullet object: a shape over at most kMaxPartsPerShape mesh parts.
+// One Bullet object: a shape over at most kMaxPartsPerShape mesh parts, and
+// the ray caster's hierarchy over the same triangles (its own frame).
 struct MeshObject {
   std::unique_ptr<btTriangleIndexVertexArray> mesh_interface;
   std::unique_ptr<btBvhTriangleMeshShape> shape;
   std::unique_ptr<btCollisionObject> object;
+  std::shared_ptr<const TriangleBvh> bvh;
   Eigen::Isometry3d X_BO{Eigen::Isometry3d::Identity()};  // in its body's frame
   std::uint64_t tile{0};  // a terrain tile's key (TileId::key() + 1), 0 for the rest
 };
@@ -158,7 +161,15 @@ struct CollisionWorld::Impl {
       MeshObject object;
       object.mesh_interface = std::make_unique<btTriangleIndexVertexArray>();
       const std::size_t end = std::min(parts.size(), first + kMaxPartsPerShape);
-      for (std::size_t p = first; p < end; ++p) object.mesh_interface->addIndexedMesh(parts[p]);
+      std::vector<TriangleSoup> soups;
+      for (std::size_t p = first; p < end; ++p) {
+        object.mesh_interface->addIndexedMesh(parts[p]);
+        soups.push_back({reinterpret_cast<const Eigen::Vector3f*>(parts[p].m_vertexBase),
+                         std::size_t(parts[p].m_numVertices),
+                         reinterpret_cast<const std::uint32_t*>(parts[p].m_triangleIndexBase),
+                         std::size_t(parts[p].m_numTriangles)});
+      }
+      object.bvh = std::make_shared<const TriangleBvh>(BuildTriangleBvh(soups));
       object.shape = std::make_unique<btBvhTriangleMeshShape>(object.mesh_interface.get(), true);
       object.object = std::make_unique<btCollisionObject>();
       object.object->setCollisionShape(object.shape.get());

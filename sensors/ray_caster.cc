@@ -39,6 +39,10 @@ struct Target {
   bool identity{false};  // X_BL is exactly the identity
   const btQuantizedBvhNode* nodes{nullptr};
   Eigen::Vector3f bvh_min, quantization;  // quantized = (local - bvh_min) * quantization
+  // The object's own hierarchy (local frame), and how far its boxes are grown
+  // for the rounding of rays taken into that frame.
+  const scene::TriangleBvh* bvh{nullptr};
+  float box_margin{0.f};
   struct Part {
     const unsigned char* vertices;
     int vertex_stride;
@@ -76,6 +80,15 @@ std::vector<Target> CollectTargets(const scene::CollisionWorld& world) {
     const unsigned short zero[3] = {0, 0, 0}, top[3] = {65534, 65534, 65534};
     t.bvh_min = ToEigen(bvh->unQuantize(zero));
     t.quantization = 65534.0f * (ToEigen(bvh->unQuantize(top)) - t.bvh_min).cwiseInverse();
+    t.bvh = object.bvh.get();
+    if (t.bvh == nullptr) throw std::logic_error("RayCaster: an object without its hierarchy");
+    {
+      // A few thousand ulps of the coordinates involved: the boxes' and the placement's.
+      const float scale =
+          std::max({t.bvh->lower.cwiseAbs().maxCoeff(), t.bvh->upper.cwiseAbs().maxCoeff(),
+                    t.p_LB.cwiseAbs().maxCoeff(), ToEigen(X.getOrigin()).cwiseAbs().maxCoeff()});
+      t.box_margin = 1e-5f * scale + 1e-6f;
+    }
     const IndexedMeshArray& meshes = object.mesh_interface->getIndexedMeshArray();
     for (int m = 0; m < meshes.size(); ++m) {
       t.parts.push_back({meshes[m].m_vertexBase, meshes[m].m_vertexStride,
@@ -326,6 +339,11 @@ inline Vec4 Add(const Vec4& a, const Vec4& b) {
 }
 inline __m128 Abs(__m128 x) { return _mm_andnot_ps(_mm_set1_ps(-0.0f), x); }
 inline __m128 L1(const Vec4& a) { return Add(Add(Abs(a.x), Abs(a.y)), Abs(a.z)); }
+// The lanes whose bits are set in `bits` (a movemask), all bits set.
+inline __m128 LaneMask(int bits) {
+  const __m128i bit = _mm_setr_epi32(1, 2, 4, 8);
+  return _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(bits), bit), bit));
+}
 inline __m128 Select(__m128 mask, __m128 a, __m128 b) {
   return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
 }
@@ -426,11 +444,22 @@ constexpr bool kPlainFirst = false;
 #undef SANDBOX_KERNEL_TARGET
 }  // namespace fma_kernel
 
+namespace avx512_kernel {
+#include "sensors/packet_walk16.inc"
+}  // namespace avx512_kernel
+
 // The FMA kernel where the CPU has the unit, unless SANDBOX_RAY_KERNEL=sse2
-// asks for the portable one (tests run both; the results are the same).
+// asks for the portable one; Cast()'s packets of sixteen rays where it has
+// AVX-512 too, unless SANDBOX_RAY_KERNEL=fma or sse2 asks for packets of four
+// (tests run each; the results are the same).
 const bool kHasFma = [] {
   const char* kernel = std::getenv("SANDBOX_RAY_KERNEL");
   return __builtin_cpu_supports("fma") && !(kernel != nullptr && std::string(kernel) == "sse2");
+}();
+const bool kHasAvx512 = [] {
+  const char* kernel = std::getenv("SANDBOX_RAY_KERNEL");
+  return kHasFma && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+         !(kernel != nullptr && std::string(kernel) == "fma");
 }();
 
 inline void WalkTarget4(const Target& target, Packet* packet) {
@@ -438,6 +467,17 @@ inline void WalkTarget4(const Target& target, Packet* packet) {
     fma_kernel::WalkTarget4(target, packet);
   } else {
     sse2_kernel::WalkTarget4(target, packet);
+  }
+}
+// The object's own hierarchy where it has one (every object the scene made),
+// else Bullet's.
+inline void WalkWide4(const Target& target, Packet* packet) {
+  if (target.bvh == nullptr) {
+    WalkTarget4(target, packet);
+  } else if (kHasFma) {
+    fma_kernel::WalkWide4(target, packet);
+  } else {
+    sse2_kernel::WalkWide4(target, packet);
   }
 }
 
@@ -775,7 +815,7 @@ struct RayCaster::Targets {
 
 const char* RayCaster::kernel() {
 #if defined(__SSE2__)
-  return kHasFma ? "fma" : "sse2";
+  return kHasAvx512 ? "avx512" : kHasFma ? "fma" : "sse2";
 #else
   return "scalar";
 #endif
@@ -915,6 +955,10 @@ void RayCaster::Cast(const scene::CollisionWorld& world, const RayBatch& rays,
     const std::size_t num_targets = many.empty() ? count : many.size();
     std::size_t i = first;
 #if defined(__SSE2__)
+    if (kHasAvx512) {
+      avx512_kernel::CastRays16(rays, origin_B, first, end, targets, num_targets, hits);
+      i = end;
+    }
     // Four rays at a time; the last packet of the batch may be partly empty.
     for (; i < end; i += 4) {
       alignas(16) float lane[7][4];
@@ -950,7 +994,7 @@ void RayCaster::Cast(const scene::CollisionWorld& world, const RayBatch& rays,
         for (; t < run_end; ++t) {
           const Target& target = *targets[t];
           if (PacketMeetsBox(packet, inverse, target.aabb_min, target.aabb_max) != 0) {
-            WalkTarget4(target, &packet);
+            WalkWide4(target, &packet);
           }
         }
       }
