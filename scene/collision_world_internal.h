@@ -6,6 +6,7 @@
 
 #include <map>
 #include <memory>
+#include <thread>
 #include <vector>
 
 #include "scene/collision_world.h"
@@ -169,8 +170,21 @@ struct CollisionWorld::Impl {
                          reinterpret_cast<const std::uint32_t*>(parts[p].m_triangleIndexBase),
                          std::size_t(parts[p].m_numTriangles)});
       }
-      object.bvh = std::make_shared<const TriangleBvh>(BuildTriangleBvh(soups));
+      // The ray caster's hierarchy, built beside Bullet's when large enough to
+      // be worth a thread (both only read the arrays).
+      std::size_t triangles = 0;
+      for (const TriangleSoup& soup : soups) triangles += soup.num_triangles;
+      auto build = [&object, &soups] {
+        object.bvh = std::make_shared<const TriangleBvh>(BuildTriangleBvh(soups));
+      };
+      std::thread builder;
+      if (triangles >= 20000) {
+        builder = std::thread(build);
+      } else {
+        build();
+      }
       object.shape = std::make_unique<btBvhTriangleMeshShape>(object.mesh_interface.get(), true);
+      if (builder.joinable()) builder.join();
       object.object = std::make_unique<btCollisionObject>();
       object.object->setCollisionShape(object.shape.get());
       object.object->setUserIndex(body);

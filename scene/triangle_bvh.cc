@@ -22,22 +22,27 @@ struct Box {
   }
 };
 
-struct Triangle {
+// A triangle as the builder sorts it: its box and centre; which triangle of
+// which part it is.
+struct Item {
   Box box;
-  Eigen::Vector3f centroid;
-  std::array<Eigen::Vector3f, 3> corner;
+  Eigen::Vector3f centre;
   std::int32_t part, index;
 };
 
 class Builder {
  public:
-  explicit Builder(std::vector<Triangle> triangles) : triangles_(std::move(triangles)) {}
+  Builder(const std::vector<TriangleSoup>& parts, std::vector<Item> items)
+      : parts_(parts), items_(std::move(items)) {}
 
   TriangleBvh Build() {
-    if (!triangles_.empty()) {
-      Box all = BoundsOf(0, triangles_.size());
+    if (!items_.empty()) {
+      Box all;
+      for (const Item& item : items_) all.Extend(item.box);
       bvh_.lower = all.lower, bvh_.upper = all.upper;
-      bvh_.root = Subtree(0, triangles_.size(), &bvh_.depth);
+      bvh_.root = Subtree({0, items_.size(), all}, &bvh_.depth);
+      bvh_.nodes.shrink_to_fit();
+      bvh_.leaves.shrink_to_fit();
     }
     return std::move(bvh_);
   }
@@ -45,32 +50,29 @@ class Builder {
  private:
   struct Range {
     std::size_t begin, end;
+    Box box;  // of its triangles
     std::size_t size() const { return end - begin; }
   };
 
-  Box BoundsOf(std::size_t begin, std::size_t end) const {
-    Box box;
-    for (std::size_t i = begin; i < end; ++i) box.Extend(triangles_[i].box);
-    return box;
-  }
-
-  // The subtree over triangles [begin, end): a leaf of up to four, or a node
-  // over up to four groups, each made by splitting the largest group in two.
-  std::int32_t Subtree(std::size_t begin, std::size_t end, int* depth) {
-    if (end - begin <= std::size_t(kLeafSize)) {
+  // The subtree over a range: a leaf of up to four triangles, or a node over
+  // up to four groups, each made by splitting the largest group in two.
+  std::int32_t Subtree(const Range& range, int* depth) {
+    if (range.size() <= std::size_t(kLeafSize)) {
       *depth = 1;
-      return MakeLeaf(begin, end);
+      return MakeLeaf(range.begin, range.end);
     }
-    std::vector<Range> groups{{begin, end}};
-    while (groups.size() < std::size_t(TriangleBvh::kWidth)) {
-      auto largest =
-          std::max_element(groups.begin(), groups.end(),
-                           [](const Range& a, const Range& b) { return a.size() < b.size(); });
-      if (largest->size() <= std::size_t(kLeafSize)) break;
-      const Range whole = *largest;
-      const std::size_t middle = Split(whole.begin, whole.end);
-      *largest = {whole.begin, middle};
-      groups.push_back({middle, whole.end});
+    std::array<Range, TriangleBvh::kWidth> groups;
+    int count = 1;
+    groups[0] = range;
+    while (count < TriangleBvh::kWidth) {
+      int largest = 0;
+      for (int g = 1; g < count; ++g) {
+        if (groups[std::size_t(g)].size() > groups[std::size_t(largest)].size()) largest = g;
+      }
+      if (groups[std::size_t(largest)].size() <= std::size_t(kLeafSize)) break;
+      Range second;
+      Split(&groups[std::size_t(largest)], &second);
+      groups[std::size_t(count++)] = second;
     }
     const auto index = std::int32_t(bvh_.nodes.size());
     bvh_.nodes.emplace_back();
@@ -78,11 +80,11 @@ class Builder {
     for (int c = 0; c < TriangleBvh::kWidth; ++c) {
       std::int32_t child = TriangleBvh::kEmpty;
       Box box;
-      if (c < int(groups.size())) {
+      if (c < count) {
         int child_depth = 0;
-        child = Subtree(groups[std::size_t(c)].begin, groups[std::size_t(c)].end, &child_depth);
+        child = Subtree(groups[std::size_t(c)], &child_depth);
         deepest = std::max(deepest, child_depth);
-        box = BoundsOf(groups[std::size_t(c)].begin, groups[std::size_t(c)].end);
+        box = groups[std::size_t(c)].box;
       }
       TriangleBvh::Node& node = bvh_.nodes[std::size_t(index)];
       node.child[c] = child;
@@ -96,93 +98,126 @@ class Builder {
     TriangleBvh::Leaves leaf{};
     leaf.count = std::int32_t(end - begin);
     for (int lane = 0; lane < TriangleBvh::kWidth; ++lane) {
-      const Triangle& t = triangles_[std::min(begin + std::size_t(lane), end - 1)];
+      const Item& item = items_[std::min(begin + std::size_t(lane), end - 1)];
+      const TriangleSoup& part = parts_[std::size_t(item.part)];
+      const std::uint32_t* index = part.indices + 3 * std::size_t(item.index);
       for (int k = 0; k < 3; ++k) {
-        for (int a = 0; a < 3; ++a) leaf.corner[3 * k + a][lane] = t.corner[std::size_t(k)][a];
+        for (int a = 0; a < 3; ++a) leaf.corner[3 * k + a][lane] = part.positions[index[k]][a];
       }
-      leaf.part[lane] = t.part, leaf.triangle[lane] = t.index;
+      leaf.part[lane] = item.part, leaf.triangle[lane] = item.index;
     }
     bvh_.leaves.push_back(leaf);
     return TriangleBvh::Leaf(std::int32_t(bvh_.leaves.size()) - 1);
   }
 
-  // Splits [begin, end) in two where the surface area heuristic over binned
-  // centroids is lowest (in the middle when the centroids coincide); returns
-  // where the second part begins.
-  std::size_t Split(std::size_t begin, std::size_t end) {
-    Box centroids;
-    for (std::size_t i = begin; i < end; ++i) centroids.Extend(triangles_[i].centroid);
-    const Eigen::Vector3f extent = centroids.upper - centroids.lower;
+  // Splits *first in two where the surface area heuristic over binned
+  // centres is lowest (in the middle of the longest extent when no split by
+  // area parts them): *first keeps the first part, *second takes the rest.
+  void Split(Range* first, Range* second) {
+    const std::size_t begin = first->begin, end = first->end;
+    Box centres;
+    for (std::size_t i = begin; i < end; ++i) centres.Extend(items_[i].centre);
+    const Eigen::Vector3f extent = centres.upper - centres.lower;
+    Eigen::Vector3f scale;
+    for (int a = 0; a < 3; ++a) scale[a] = extent[a] > 0.f ? float(kBins) / extent[a] : 0.f;
+    // The axes tried: all three for small ranges, the longest extent's for
+    // large ones (where the others rarely win and binning costs most).
+    int longest = 0;
+    for (int a = 1; a < 3; ++a) {
+      if (extent[a] > extent[longest]) longest = a;
+    }
+    const bool all_axes = end - begin <= 4096;
+    // The axes' bins in one pass.
+    std::array<std::array<Box, kBins>, 3> boxes;
+    std::array<std::array<std::size_t, kBins>, 3> counts{};
+    for (std::size_t i = begin; i < end; ++i) {
+      const Item& item = items_[i];
+      for (int a = all_axes ? 0 : longest; a < (all_axes ? 3 : longest + 1); ++a) {
+        const int b = BinOf(item.centre[a], centres.lower[a], scale[a]);
+        boxes[std::size_t(a)][std::size_t(b)].Extend(item.box);
+        ++counts[std::size_t(a)][std::size_t(b)];
+      }
+    }
     float best_cost = kInf;
     int best_axis = -1, best_bin = 0;
-    for (int axis = 0; axis < 3; ++axis) {
-      if (!(extent[axis] > 0.f)) continue;
-      const float scale = float(kBins) / extent[axis];
-      std::array<Box, kBins> boxes;
-      std::array<std::size_t, kBins> counts{};
-      for (std::size_t i = begin; i < end; ++i) {
-        const int b = BinOf(triangles_[i].centroid[axis], centroids.lower[axis], scale);
-        boxes[std::size_t(b)].Extend(triangles_[i].box);
-        ++counts[std::size_t(b)];
-      }
-      // Costs of splitting after bin b: areas and counts from the left and the right.
+    Box best_left, best_right;
+    for (int a = 0; a < 3; ++a) {
+      if (!(extent[a] > 0.f) || (!all_axes && a != longest)) continue;
+      const auto& box = boxes[std::size_t(a)];
+      const auto& n = counts[std::size_t(a)];
+      // The left parts' boxes and costs, then the right parts' from the other end.
+      std::array<Box, kBins> left_box;
       std::array<float, kBins> left_cost{};
       Box left;
       std::size_t left_count = 0;
       for (int b = 0; b < kBins - 1; ++b) {
-        left.Extend(boxes[std::size_t(b)]);
-        left_count += counts[std::size_t(b)];
+        left.Extend(box[std::size_t(b)]);
+        left_count += n[std::size_t(b)];
+        left_box[std::size_t(b)] = left;
         left_cost[std::size_t(b)] = left.HalfArea() * float(left_count);
       }
       Box right;
       std::size_t right_count = 0;
       for (int b = kBins - 1; b > 0; --b) {
-        right.Extend(boxes[std::size_t(b)]);
-        right_count += counts[std::size_t(b)];
+        right.Extend(box[std::size_t(b)]);
+        right_count += n[std::size_t(b)];
         const float cost = left_cost[std::size_t(b - 1)] + right.HalfArea() * float(right_count);
-        if (right_count < end - begin && cost < best_cost) {
-          best_cost = cost, best_axis = axis, best_bin = b - 1;
+        if (right_count < end - begin && right_count > 0 && cost < best_cost) {
+          best_cost = cost, best_axis = a, best_bin = b - 1;
+          best_left = left_box[std::size_t(b - 1)], best_right = right;
         }
       }
     }
+    std::size_t middle = begin;
     if (best_axis >= 0) {
-      const float scale = float(kBins) / extent[best_axis];
-      const float low = centroids.lower[best_axis];
-      const auto middle = std::partition(
-          triangles_.begin() + std::ptrdiff_t(begin), triangles_.begin() + std::ptrdiff_t(end),
-          [&](const Triangle& t) { return BinOf(t.centroid[best_axis], low, scale) <= best_bin; });
-      const auto at = std::size_t(middle - triangles_.begin());
-      if (at > begin && at < end) return at;
+      const float low = centres.lower[best_axis], s = scale[best_axis];
+      middle = std::size_t(
+          std::partition(
+              items_.begin() + std::ptrdiff_t(begin), items_.begin() + std::ptrdiff_t(end),
+              [&](const Item& item) { return BinOf(item.centre[best_axis], low, s) <= best_bin; }) -
+          items_.begin());
+    }
+    if (middle > begin && middle < end) {
+      *first = {begin, middle, best_left};
+      *second = {middle, end, best_right};
+      return;
     }
     // No split by area: half the triangles each side along the longest extent.
     int axis = 0;
     for (int a = 1; a < 3; ++a) {
       if (extent[a] > extent[axis]) axis = a;
     }
-    const std::size_t middle = begin + (end - begin) / 2;
+    middle = begin + (end - begin) / 2;
     std::nth_element(
-        triangles_.begin() + std::ptrdiff_t(begin), triangles_.begin() + std::ptrdiff_t(middle),
-        triangles_.begin() + std::ptrdiff_t(end), [axis](const Triangle& a, const Triangle& b) {
-          return a.centroid[axis] < b.centroid[axis];
-        });
-    return middle;
+        items_.begin() + std::ptrdiff_t(begin), items_.begin() + std::ptrdiff_t(middle),
+        items_.begin() + std::ptrdiff_t(end),
+        [axis](const Item& a, const Item& b) { return a.centre[axis] < b.centre[axis]; });
+    *first = {begin, middle, BoundsOf(begin, middle)};
+    *second = {middle, end, BoundsOf(middle, end)};
+  }
+
+  Box BoundsOf(std::size_t begin, std::size_t end) const {
+    Box box;
+    for (std::size_t i = begin; i < end; ++i) box.Extend(items_[i].box);
+    return box;
   }
 
   static int BinOf(float value, float low, float scale) {
     return std::clamp(int((value - low) * scale), 0, kBins - 1);
   }
 
-  std::vector<Triangle> triangles_;
+  const std::vector<TriangleSoup>& parts_;
+  std::vector<Item> items_;
   TriangleBvh bvh_;
 };
 
 }  // namespace
 
 TriangleBvh BuildTriangleBvh(const std::vector<TriangleSoup>& parts) {
-  std::vector<Triangle> triangles;
+  std::vector<Item> items;
   std::size_t total = 0;
   for (const TriangleSoup& part : parts) total += part.num_triangles;
-  triangles.reserve(total);
+  items.reserve(total);
   for (std::size_t p = 0; p < parts.size(); ++p) {
     const TriangleSoup& part = parts[p];
     for (std::size_t t = 0; t < part.num_triangles; ++t) {
@@ -191,17 +226,14 @@ TriangleBvh BuildTriangleBvh(const std::vector<TriangleSoup>& parts) {
           index[2] >= part.num_positions) {
         continue;
       }
-      Triangle triangle;
-      triangle.part = std::int32_t(p), triangle.index = std::int32_t(t);
-      for (int k = 0; k < 3; ++k) {
-        triangle.corner[std::size_t(k)] = part.positions[index[k]];
-        triangle.box.Extend(triangle.corner[std::size_t(k)]);
-      }
-      triangle.centroid = 0.5f * (triangle.box.lower + triangle.box.upper);
-      triangles.push_back(triangle);
+      Item item;
+      item.part = std::int32_t(p), item.index = std::int32_t(t);
+      for (int k = 0; k < 3; ++k) item.box.Extend(part.positions[index[k]]);
+      item.centre = 0.5f * (item.box.lower + item.box.upper);
+      items.push_back(item);
     }
   }
-  return Builder(std::move(triangles)).Build();
+  return Builder(parts, std::move(items)).Build();
 }
 
 }  // namespace sandbox::scene
