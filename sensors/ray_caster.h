@@ -1,8 +1,9 @@
 #pragma once
 // Batched ray casting over the Bullet world, split over worker threads.
-// Thread-safe by construction: every ray walks Bullet's quantized BVH nodes
-// and the level's own triangle arrays read-only, with its own stack; nothing
-// of Bullet's mutable query state (btCollisionWorld::rayTest) is used.
+// Thread-safe by construction: every ray walks each object's own hierarchy
+// (scene::TriangleBvh; the structured kernels, Bullet's quantized BVH) and the
+// level's triangle arrays read-only, with its own stack; nothing of Bullet's
+// mutable query state (btCollisionWorld::rayTest) is used.
 //
 // Hits are watertight (docs/sensors.md, "Grazing and origin rules"): each
 // triangle is tested in the Bullet frame with its corners placed as Bullet
@@ -128,9 +129,11 @@ class RayCaster {
   // Entries a BVH walk keeps on its own stack before it grows on the heap
   // (a deeper tree costs an allocation per walk, never a dropped node).
   static constexpr int kStackInPlace = 32;
-  // The packet kernel in use: "fma" (the CPU's fused multiply-add unit),
-  // "sse2" (fused operations emulated where they decide; SANDBOX_RAY_KERNEL=sse2
-  // forces it) or "scalar" (no SSE2). All give the same hits.
+  // The packet kernel in use: "avx512" (sixteen rays a packet in Cast(), the
+  // FMA kernel's arithmetic), "fma" (the CPU's fused multiply-add unit, four
+  // rays; SANDBOX_RAY_KERNEL=fma forces it), "sse2" (fused operations emulated
+  // where they decide; SANDBOX_RAY_KERNEL=sse2) or "scalar" (no SSE2). All
+  // give the same hits.
   static const char* kernel();
   // Rays cast since construction (frame statistics).
   std::int64_t rays_cast() const { return rays_cast_; }
