@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "scene/collision_world.h"
+#include "sensors/worker_pool.h"
 
 namespace sandbox::sensors {
 
@@ -125,7 +126,7 @@ class RayCaster {
   void CastSweep(const scene::CollisionWorld& world, const RayBatch& rays, const RaySweep& sweep,
                  const RayFilter& filter, RayHits* hits);
 
-  int threads() const { return static_cast<int>(workers_.size()) + 1; }
+  int threads() const { return pool_.threads(); }
   // Entries a BVH walk keeps on its own stack before it grows on the heap
   // (a deeper tree costs an allocation per walk, never a dropped node).
   static constexpr int kStackInPlace = 32;
@@ -144,24 +145,7 @@ class RayCaster {
   void RunParallel(int count, const std::function<void(int)>& job);
 
  private:
-  void WorkerLoop();
-  // Takes the next chunk of job `generation` into *chunk; false once that
-  // job's chunks are all taken or a newer job has begun.
-  bool Claim(std::uint64_t generation, int chunks, int* chunk);
-
-  // Work hand-out: a job generation counter the workers watch (spinning a
-  // little, then sleeping), and a claim counter they all draw chunks from,
-  // tagged with the generation so that a late worker cannot take a chunk
-  // of the next job for the job it woke for.
-  std::vector<std::thread> workers_;
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  const std::function<void(int)>* job_{nullptr};
-  int chunks_{0};
-  std::atomic<std::uint64_t> claim_{0};  // generation << 32 | next chunk
-  std::atomic<int> unfinished_{0};
-  std::atomic<std::uint64_t> generation_{0};
-  std::atomic<bool> stop_{false};
+  WorkerPool pool_;
   std::int64_t rays_cast_{0};
   // The world's objects as the kernels read them, kept for one state of one
   // world (scene::CollisionWorld::instance() and revision()).

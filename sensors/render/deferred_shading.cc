@@ -128,7 +128,8 @@ DetailTextures::DetailTextures(const std::vector<std::uint8_t>& rgba, int size, 
   }
 }
 
-DeferredShader::DeferredShader(int threads, const std::string& kernel) : kernel_(kernel) {
+DeferredShader::DeferredShader(int threads, const std::string& kernel)
+    : kernel_(kernel), pool_(threads) {
   const std::vector<std::string> kernels = Kernels();
   const char* chosen = std::getenv("SANDBOX_SHADE_KERNEL");
   if (kernel_.empty()) kernel_ = chosen != nullptr && *chosen != 0 ? chosen : kernels.front();
@@ -139,58 +140,6 @@ DeferredShader::DeferredShader(int threads, const std::string& kernel) : kernel_
                                 "' is not one this CPU runs (" + known + ")");
   }
   simd_ = kernel_ == "avx512" ? Simd::kAvx512 : kernel_ == "avx2" ? Simd::kAvx2 : Simd::kSse2;
-  if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
-  for (int i = 1; i < threads; ++i) helpers_.emplace_back([this] { HelperLoop(); });
-}
-
-DeferredShader::~DeferredShader() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    stop_ = true;
-  }
-  wake_.notify_all();
-  for (std::thread& t : helpers_) t.join();
-}
-
-void DeferredShader::HelperLoop() {
-  std::uint64_t seen = 0;
-  std::unique_lock<std::mutex> lock(mutex_);
-  for (;;) {
-    wake_.wait(lock, [&] { return stop_ || generation_ != seen; });
-    if (stop_) return;
-    seen = generation_;
-    while (next_ < count_) {
-      const int k = next_++;
-      ++running_;
-      lock.unlock();
-      (*job_)(k);
-      lock.lock();
-      if (--running_ == 0 && next_ >= count_) done_.notify_all();
-    }
-  }
-}
-
-void DeferredShader::RunParallel(int count, const std::function<void(int)>& job) {
-  if (helpers_.empty()) {
-    for (int k = 0; k < count; ++k) job(k);
-    return;
-  }
-  std::unique_lock<std::mutex> lock(mutex_);
-  job_ = &job;
-  count_ = count;
-  next_ = 0;
-  ++generation_;
-  wake_.notify_all();
-  while (next_ < count_) {
-    const int k = next_++;
-    ++running_;
-    lock.unlock();
-    job(k);
-    lock.lock();
-    --running_;
-  }
-  done_.wait(lock, [&] { return running_ == 0; });
-  job_ = nullptr;
 }
 
 void DeferredShader::Shade(const LightingFrame& frame, const DetailTextures& detail,
@@ -206,7 +155,7 @@ void DeferredShader::Shade(const LightingFrame& frame, const DetailTextures& det
   const int bands = (h + kBand - 1) / kBand;
   luma_.resize(std::size_t(w) * std::size_t(h));
   luma_of_ = rgba->data();
-  RunParallel(bands, [&](int band) {
+  pool_.RunParallel(bands, [&](int band) {
     const int begin = band * kBand, end = std::min(h, begin + kBand);
     if (simd_ == Simd::kAvx512) {
       const avx512::Constants k{&frame, &detail, SrgbTable(), shadow, w, h};
@@ -285,7 +234,7 @@ void DeferredShader::FilterEdges(const std::vector<std::uint8_t>& in, int width,
       dst[k] = std::uint8_t(std::lround(std::clamp(chosen[k], 0.f, 1.f) * 255.f));
   };
   constexpr int kBand = 32;
-  RunParallel((height + kBand - 1) / kBand, [&](int band) {
+  pool_.RunParallel((height + kBand - 1) / kBand, [&](int band) {
     for (int y = band * kBand; y < std::min(height, (band + 1) * kBand); ++y) {
       auto at = [&](int x) { filter(x, y); };
       if (simd_ == Simd::kAvx512) {

@@ -15,13 +15,11 @@
 
 #include <Eigen/Core>
 #include <array>
-#include <condition_variable>
 #include <cstdint>
-#include <functional>
-#include <mutex>
 #include <string>
-#include <thread>
 #include <vector>
+
+#include "sensors/worker_pool.h"
 
 namespace sandbox::render {
 
@@ -111,14 +109,10 @@ class DetailTextures {
 
 class DeferredShader {
  public:
-  // Starts `threads` - 1 helper threads (0: one per core); the caller is the
-  // last. `kernel`: "avx512", "avx2" or "sse2" (all give the same bytes);
-  // empty: $SANDBOX_SHADE_KERNEL if set, else the widest the CPU runs.
-  // Throws std::invalid_argument for an unknown kernel or one the CPU lacks.
+  // Runs on `threads` threads (0: one per core), the caller one of them. `kernel`: "avx512", "avx2"
+  // or "sse2" (all give the same bytes); empty: $SANDBOX_SHADE_KERNEL if set, else the widest the
+  // CPU runs. Throws std::invalid_argument for an unknown kernel or one the CPU lacks.
   explicit DeferredShader(int threads = 0, const std::string& kernel = "");
-  ~DeferredShader();
-  DeferredShader(const DeferredShader&) = delete;
-  DeferredShader& operator=(const DeferredShader&) = delete;
 
   // Lights `opaque`, then blends `translucent` (when given) over it, into
   // `rgba` (4 bytes a pixel, display values, alpha 255, row 0 at the bottom).
@@ -135,19 +129,9 @@ class DeferredShader {
   static std::vector<std::string> Kernels();
 
  private:
-  // Runs job(k), k < count, over the helpers and the caller.
-  void RunParallel(int count, const std::function<void(int)>& job);
-  void HelperLoop();
-
   std::string kernel_;
   enum class Simd { kSse2, kAvx2, kAvx512 } simd_{Simd::kSse2};
-  std::vector<std::thread> helpers_;
-  std::mutex mutex_;
-  std::condition_variable wake_, done_;
-  const std::function<void(int)>* job_{nullptr};
-  int count_{0}, next_{0}, running_{0};
-  std::uint64_t generation_{0};
-  bool stop_{false};
+  sensors::WorkerPool pool_;
   std::vector<float> luma_;               // of the last image made or filtered
   const std::uint8_t* luma_of_{nullptr};  // that image
 };

@@ -1704,30 +1704,27 @@ class OsMesaRenderer : public Renderer {
     attach(fbo_, buffers_[2], GL_RGBA32F, GL_COLOR_ATTACHMENT2, 0);
     attach(fbo_, buffers_[3], GL_DEPTH_COMPONENT32F, GL_DEPTH_ATTACHMENT, 0);
     check("the");
-    // Deferred shading's layers (SurfaceLayer), sharing the segment, normal
-    // and depth buffers: the opaque surfaces', the translucent ones', the overlay's.
+    // Deferred shading's layers (SurfaceLayer): the opaque surfaces' and the
+    // translucent ones', each in a framebuffer with the segment, normal and
+    // depth buffers and in a lean one with the depth alone; the overlay's target.
     auto share = [&](GLenum attachment, GLuint buffer) {
       glFramebufferRenderbuffer(GL_FRAMEBUFFER, attachment, GL_RENDERBUFFER, buffer);
     };
-    attach(gbuffer_fbo_, layer_buffers_[0], GL_RGBA8, GL_COLOR_ATTACHMENT0, 0);
-    attach(gbuffer_fbo_, layer_buffers_[1], GL_RGBA8, GL_COLOR_ATTACHMENT3, 0);
-    share(GL_COLOR_ATTACHMENT1, buffers_[1]);
-    share(GL_COLOR_ATTACHMENT2, buffers_[2]);
-    share(GL_DEPTH_ATTACHMENT, buffers_[3]);
-    check("the opaque layer's");
-    attach(translucent_fbo_, layer_buffers_[2], GL_RGBA8, GL_COLOR_ATTACHMENT0, 0);
-    attach(translucent_fbo_, layer_buffers_[3], GL_RGBA8, GL_COLOR_ATTACHMENT3, 0);
-    share(GL_COLOR_ATTACHMENT1, buffers_[1]);
-    share(GL_COLOR_ATTACHMENT2, buffers_[2]);
-    share(GL_DEPTH_ATTACHMENT, buffers_[3]);
-    check("the translucent layer's");
-    for (const auto& [lean, layer] :
-         {std::pair{gbuffer_lean_fbo_, 0}, std::pair{translucent_lean_fbo_, 2}}) {
-      glBindFramebuffer(GL_FRAMEBUFFER, lean);
-      share(GL_COLOR_ATTACHMENT0, layer_buffers_[layer]);
-      share(GL_COLOR_ATTACHMENT3, layer_buffers_[layer + 1]);
+    for (int layer = 0; layer < 2; ++layer) {
+      const GLuint albedo = layer_buffers_[2 * layer], normal = layer_buffers_[2 * layer + 1];
+      attach(layer == 0 ? gbuffer_fbo_ : translucent_fbo_, albedo, GL_RGBA8, GL_COLOR_ATTACHMENT0,
+             0);
+      attach(layer == 0 ? gbuffer_fbo_ : translucent_fbo_, normal, GL_RGBA8, GL_COLOR_ATTACHMENT3,
+             0);
+      share(GL_COLOR_ATTACHMENT1, buffers_[1]);
+      share(GL_COLOR_ATTACHMENT2, buffers_[2]);
       share(GL_DEPTH_ATTACHMENT, buffers_[3]);
-      check("a lean layer's");
+      check("a deferred shading layer's");
+      glBindFramebuffer(GL_FRAMEBUFFER, layer == 0 ? gbuffer_lean_fbo_ : translucent_lean_fbo_);
+      share(GL_COLOR_ATTACHMENT0, albedo);
+      share(GL_COLOR_ATTACHMENT3, normal);
+      share(GL_DEPTH_ATTACHMENT, buffers_[3]);
+      check("a lean deferred shading layer's");
     }
     attach(overlay_fbo_, layer_buffers_[4], GL_RGBA8, GL_COLOR_ATTACHMENT0, 0);
     share(GL_DEPTH_ATTACHMENT, buffers_[3]);
