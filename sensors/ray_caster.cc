@@ -627,6 +627,93 @@ inline bool NodeMeetsGrid(const btQuantizedBvhNode& node, const GridCull& cull) 
   return _mm_movemask_ps(_mm_cmpge_ps(top, from)) == 0xF;
 }
 
+// CullFor over the object's own hierarchy (float boxes in its frame):
+// w = (X_BL p - origin) . axis is linear in p, and the slack covers the
+// boxes' growth for the change of frame and the rounding of the sums.
+GridCull CullForWide(const Target& target, const Eigen::Vector3d& origin,
+                     const Eigen::Vector3d* const axes[], int count, const double limit[],
+                     const double margin[], bool integral_first_two) {
+  const btTransform& X_BL = target.X_BL;
+  Eigen::Matrix3d R_BL;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) R_BL(r, c) = double(X_BL.getBasis()[r][c]);
+  }
+  const Eigen::Vector3d p_BL(X_BL.getOrigin().x(), X_BL.getOrigin().y(), X_BL.getOrigin().z());
+  const double extent =
+      std::max(target.bvh->lower.cwiseAbs().maxCoeff(), target.bvh->upper.cwiseAbs().maxCoeff());
+  alignas(16) float positive[3][4] = {}, negative[3][4] = {}, w0[4] = {}, slack[4] = {};
+  alignas(16) float top[4] = {};
+  for (int w = 0; w < count; ++w) {
+    const Eigen::Vector3d a = R_BL.transpose() * *axes[w];
+    w0[w] = float((p_BL - origin).dot(*axes[w]));
+    top[w] = float(limit[w]);
+    const double weight = a.cwiseAbs().sum();
+    for (int k = 0; k < 3; ++k) {
+      positive[k][w] = float(std::max(a[k], 0.0));
+      negative[k][w] = float(std::min(a[k], 0.0));
+    }
+    const double reach = std::abs(w0[w]) + weight * extent;
+    slack[w] = float(margin[w] + weight * target.box_margin + 1e-6 * reach);
+  }
+  GridCull cull;
+  for (int k = 0; k < 3; ++k) {
+    cull.positive[k] = _mm_load_ps(positive[k]);
+    cull.negative[k] = _mm_load_ps(negative[k]);
+  }
+  cull.w0 = _mm_load_ps(w0);
+  cull.margin = _mm_load_ps(slack);
+  cull.limit = _mm_load_ps(top);
+  cull.integral =
+      _mm_castsi128_ps(integral_first_two ? _mm_setr_epi32(-1, -1, 0, 0) : _mm_setzero_si128());
+  return cull;
+}
+
+// NodeMeetsGrid for child c of one of the object's own nodes.
+inline bool ChildMeetsGrid(const scene::TriangleBvh::Node& node, int c, const GridCull& cull) {
+  __m128 from = cull.w0, to = cull.w0;
+  for (int k = 0; k < 3; ++k) {
+    const __m128 lower = _mm_set1_ps(node.lower[k][c]), upper = _mm_set1_ps(node.upper[k][c]);
+    from = Add(from, Add(Mul(lower, cull.positive[k]), Mul(upper, cull.negative[k])));
+    to = Add(to, Add(Mul(upper, cull.positive[k]), Mul(lower, cull.negative[k])));
+  }
+  const __m128 low = _mm_max_ps(Sub(from, cull.margin), _mm_setzero_ps());
+  const __m128 high = _mm_min_ps(Add(to, cull.margin), cull.limit);
+  const __m128 whole = _mm_cvtepi32_ps(_mm_cvttps_epi32(high));
+  return _mm_movemask_ps(_mm_cmpge_ps(Select(cull.integral, whole, high), low)) == 0xF;
+}
+
+// Calls visit(corners) (the Bullet frame, as Corners() places them) for each
+// triangle of `target` in a leaf of its own hierarchy whose box meets the grid.
+template <typename Visit>
+void ForEachTriangleOverGridWide(const Target& target, const GridCull& cull, Visit&& visit) {
+  const scene::TriangleBvh& bvh = *target.bvh;
+  if (bvh.root == scene::TriangleBvh::kEmpty) return;
+  WalkStack<std::int32_t, kStackInPlace> stack;
+  stack.Push(bvh.root);
+  while (!stack.empty()) {
+    const std::int32_t ref = stack.Pop();
+    if (ref < 0) {
+      const scene::TriangleBvh::Leaves& leaf = bvh.leaves[std::size_t(-1 - ref)];
+      for (int i = 0; i < leaf.count; ++i) {
+        Eigen::Vector3f corners[3];
+        for (int k = 0; k < 3; ++k) {
+          const Eigen::Vector3f p(leaf.corner[3 * k][i], leaf.corner[3 * k + 1][i],
+                                  leaf.corner[3 * k + 2][i]);
+          corners[k] = target.identity ? p : ToEigen(target.X_BL * btVector3(p.x(), p.y(), p.z()));
+        }
+        visit(corners);
+      }
+      continue;
+    }
+    const scene::TriangleBvh::Node& node = bvh.nodes[std::size_t(ref)];
+    for (int c = scene::TriangleBvh::kWidth - 1; c >= 0; --c) {
+      if (node.child[c] != scene::TriangleBvh::kEmpty && ChildMeetsGrid(node, c, cull)) {
+        stack.Push(node.child[c]);
+      }
+    }
+  }
+}
+
 // A sweep tile's channels as elevation bands about its anchor: a region
 // whose elevations (seen from the anchor, in the middle step's frame) meet
 // none of them holds no point its rays can reach. The bands are each
@@ -661,25 +748,6 @@ struct ChannelBands {
     return false;
   }
 };
-
-// Calls visit(part, triangle) for each triangle of `target` whose BVH
-// leaf box meets the grid (NodeMeetsGrid): a stackless walk of the node array
-// that skips every subtree whose box falls between grid points.
-template <typename Visit>
-void ForEachTriangleOverGrid(const Target& target, const GridCull& cull, Visit&& visit) {
-  const btQuantizedBvhNode* nodes = target.nodes;
-  const int end = nodes[0].isLeafNode() ? 1 : nodes[0].getEscapeIndex();
-  for (int i = 0; i < end;) {
-    const btQuantizedBvhNode& node = nodes[i];
-    const bool meets = NodeMeetsGrid(node, cull);
-    const bool leaf = node.isLeafNode();
-    if (leaf && meets) {
-      const int packed = node.m_escapeIndexOrTriangleIndex;
-      visit(packed >> 21, packed & ((1 << 21) - 1));
-    }
-    i += meets || leaf ? 1 : node.getEscapeIndex();
-  }
-}
 
 // The squared distance in metres from a point to a node's box (grown by a
 // quantum), both in one object's quantized coordinates.
@@ -1070,10 +1138,8 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
       const Eigen::Vector3d* axes[3] = {&to_column, &to_row, &direction};
       const double limit[3] = {double(cols - 1), double(rows - 1), double(length)};
       const double margins[3] = {margin_columns, margin_rows, margin};
-      const GridCull cull = CullFor(target, corner, axes, 3, limit, margins, true);
-      ForEachTriangleOverGrid(target, cull, [&](int part, int triangle) {
-        Eigen::Vector3f corners[3];
-        Corners(target, part, triangle, corners);
+      const GridCull cull = CullForWide(target, corner, axes, 3, limit, margins, true);
+      ForEachTriangleOverGridWide(target, cull, [&](const Eigen::Vector3f* corners) {
         // Columns u, rows v and depths s of the corners (SSE, a lane each).
         const __m128 x =
             Sub(_mm_setr_ps(corners[0].x(), corners[1].x(), corners[2].x(), corners[2].x()),
