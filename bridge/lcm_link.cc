@@ -227,6 +227,11 @@ LatestInput::LatestInput(LcmLink& link, std::string channel, MessageCheck check,
   subscription_ = subscription;
 }
 
+void LatestInput::set_queue(bool queue) {
+  queue_ = queue;
+  static_cast<lcm::Subscription*>(subscription_)->setQueueCapacity(queue ? 0 : kQueueCapacity);
+}
+
 LatestInput::~LatestInput() {
   link_.impl().lcm.unsubscribe(static_cast<lcm::Subscription*>(subscription_));
 }

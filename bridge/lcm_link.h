@@ -171,8 +171,10 @@ class LatestInput {
   // The newest good message that arrived since the last call, or nullptr.
   const std::vector<std::uint8_t>* TakeNewest();
 
-  // Lock-step mode: keep every good message in arrival order instead of the newest.
-  void set_queue(bool queue) { queue_ = queue; }
+  // Lock-step mode: keep every good message in arrival order instead of the
+  // newest, and LCM's queue for the channel unbounded (a loop held up for a
+  // while delays its inputs, it does not lose them).
+  void set_queue(bool queue);
   std::size_t queued() const { return queue_messages_.size(); }
   // The oldest queued message (nullptr when none), and dropping it.
   const std::vector<std::uint8_t>* Peek();

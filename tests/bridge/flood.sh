@@ -53,7 +53,10 @@ flood_pid=$!
 wait "$flood_pid"
 wait "$check_pid" || status=1
 stop "$sandbox_pid"
+cat "$run_log"
 states=$("$sandbox" topics --log "$record" | awk '$1 == "ELAHA/STATE" { print $3 }')
 echo "lock-step: $states states for 300 poses published"
 [ "${states:-0}" -eq 300 ] || { echo "lock-step: not one tick per good pose"; status=1; }
+# Datagrams the kernel dropped for full receive buffers (this namespace's own count).
+awk '/^Udp:/ && ++n == 2 { print "udp: " $6 " datagrams dropped for full receive buffers" }' /proc/net/snmp
 exit "$status"

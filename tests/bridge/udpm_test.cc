@@ -70,6 +70,28 @@ TEST_F(UdpmTest, TheNewestOfAThousandPosesBetweenTwoTicksWins) {
   EXPECT_EQ(inputs.pose().superseded(), 999);
 }
 
+TEST_F(UdpmTest, LockstepKeepsEveryPoseThatArrivedWhileTheLoopWasHeldUp) {
+  const scene::Level level = scene::LoadLevel(testing::SampleLevel());
+  scene::CollisionWorld world(level);
+  scene::RobotState state(level.robots.at(0));
+  LcmLink link(kUrl);
+  RobotInputs inputs(link, level, 0);
+  inputs.set_lockstep(true);
+  // Three times the free-running queue arrives while the loop is held up (a
+  // busy machine): a lock-step run applies every one, in order.
+  const int count = 3 * LatestInput::kQueueCapacity;
+  for (int seq = 1; seq <= count; ++seq) Publish(link, "ELAHA/POSE", Pose(seq));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  DrainUntil(link, inputs.pose(), count);
+  EXPECT_EQ(inputs.pose().received(), count);
+  for (int seq = 1; seq <= count; ++seq) {
+    const RobotInputs::Applied applied = inputs.ApplyNext(&state, &world);
+    ASSERT_TRUE(applied.pose) << "pose " << seq;
+    ASSERT_EQ(applied.pose_seq, seq);
+  }
+  EXPECT_FALSE(inputs.ApplyNext(&state, &world).pose);
+}
+
 TEST_F(UdpmTest, AFragmentedOversizedMessageIsRejectedAndTheGoodPoseStays) {
   const scene::Level level = scene::LoadLevel(testing::SampleLevel());
   scene::CollisionWorld world(level);
