@@ -1,6 +1,7 @@
 #include "app/demo_command.h"
 
 #include <fcntl.h>
+#include <sched.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -79,9 +80,18 @@ pid_t StartFlyWing(double duration_s, const std::string& log_file) {
   std::vector<char*> argv;
   for (std::string& s : argv_strings) argv.push_back(s.data());
   argv.push_back(nullptr);
+  // Started from the loop's thread, which may run at real-time priority: the
+  // model runs at normal priority.
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSCHEDULER);
+  posix_spawnattr_setschedpolicy(&attributes, SCHED_OTHER);
+  const sched_param normal{};
+  posix_spawnattr_setschedparam(&attributes, &normal);
   pid_t pid = -1;
-  const int error = posix_spawn(&pid, kFlyWingBinary, &actions, nullptr, argv.data(), environ);
+  const int error = posix_spawn(&pid, kFlyWingBinary, &actions, &attributes, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
+  posix_spawnattr_destroy(&attributes);
   if (error != 0)
     throw CommandError(std::string("cannot start the example model ") + kFlyWingBinary);
   return pid;
@@ -191,11 +201,19 @@ int RunDemo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       };
       out << "sandbox demo: flying the example model in-process for " << duration_s << " s\n";
     } else {
-      hooks.before_tick = [&status](bridge::LcmLink& link, double) { status.Poll(link); };
+      // The model takes off at the loop's first tick: the level's loading
+      // (seconds on a slow machine) does not eat into its flight.
       const std::string model_log = (std::filesystem::path(out_dir) / "fly_wing.log").string();
-      model = StartFlyWing(duration_s, model_log);
-      out << "sandbox demo: the example model (" << kFlyWingBinary << ", pid " << model
-          << ") flies the wing over LCM for " << duration_s << " s\n";
+      hooks.before_tick = [&status, &model, &out, duration_s, model_log](bridge::LcmLink& link,
+                                                                         double) {
+        if (model < 0) {
+          model = StartFlyWing(duration_s, model_log);
+          out << "sandbox demo: the example model (" << kFlyWingBinary << ", pid " << model
+              << ") flies the wing over LCM for " << duration_s << " s\n"
+              << std::flush;
+        }
+        status.Poll(link);
+      };
     }
     out << std::flush;
     const int code = RunLoop(run_args, out, err, hooks);  // 0, or 3: some output lost
