@@ -554,7 +554,32 @@ struct BandFrame {
 struct GridCull {
   __m128 positive[3], negative[3];  // per axis k: the weights a_k, split by sign
   __m128 w0, margin, limit, integral;
+
+  // From per-coordinate lanes (coordinates a lane; integral: the first two).
+  static GridCull Of(const float positive[3][4], const float negative[3][4], const float w0[4],
+                     const float margin[4], const float limit[4], bool integral_first_two) {
+    GridCull cull;
+    for (int k = 0; k < 3; ++k) {
+      cull.positive[k] = _mm_loadu_ps(positive[k]);
+      cull.negative[k] = _mm_loadu_ps(negative[k]);
+    }
+    cull.w0 = _mm_loadu_ps(w0);
+    cull.margin = _mm_loadu_ps(margin);
+    cull.limit = _mm_loadu_ps(limit);
+    cull.integral = _mm_castsi128_ps(integral_first_two ? _mm_setr_epi32(-1, -1, 0, 0)
+                                                        : _mm_setzero_si128());
+    return cull;
+  }
 };
+
+// An object's placement X_BL in the Bullet frame, in double.
+void ObjectFrame(const Target& target, Eigen::Matrix3d* R_BL, Eigen::Vector3d* p_BL) {
+  const btTransform& X_BL = target.X_BL;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) (*R_BL)(r, c) = double(X_BL.getBasis()[r][c]);
+  }
+  *p_BL = Eigen::Vector3d(X_BL.getOrigin().x(), X_BL.getOrigin().y(), X_BL.getOrigin().z());
+}
 
 // The cull for coordinates w = (p - origin) . axes[w] (p in the Bullet frame)
 // that must lie in [0, limit[w]] to within margin[w]; lanes beyond `count`
@@ -563,12 +588,9 @@ GridCull CullFor(const Target& target, const Eigen::Vector3d& origin,
                  const Eigen::Vector3d* const axes[], int count, const double limit[],
                  const double margin[], bool integral_first_two) {
   // w = (X_BL (q / quantization + bvh_min) - origin) . axis: linear in q.
-  const btTransform& X_BL = target.X_BL;
   Eigen::Matrix3d R_BL;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) R_BL(r, c) = double(X_BL.getBasis()[r][c]);
-  }
-  const Eigen::Vector3d p_BL(X_BL.getOrigin().x(), X_BL.getOrigin().y(), X_BL.getOrigin().z());
+  Eigen::Vector3d p_BL;
+  ObjectFrame(target, &R_BL, &p_BL);
   const Eigen::Vector3d offset = R_BL * target.bvh_min.cast<double>() + p_BL - origin;
   alignas(16) float positive[3][4] = {}, negative[3][4] = {}, w0[4] = {}, slack[4] = {};
   alignas(16) float top[4] = {};
@@ -587,17 +609,7 @@ GridCull CullFor(const Target& target, const Eigen::Vector3d& origin,
     const double quantum = std::abs(a[0]) + std::abs(a[1]) + std::abs(a[2]);
     slack[w] = float(margin[w] + quantum + 1e-6 * reach);
   }
-  GridCull cull;
-  for (int k = 0; k < 3; ++k) {
-    cull.positive[k] = _mm_load_ps(positive[k]);
-    cull.negative[k] = _mm_load_ps(negative[k]);
-  }
-  cull.w0 = _mm_load_ps(w0);
-  cull.margin = _mm_load_ps(slack);
-  cull.limit = _mm_load_ps(top);
-  cull.integral =
-      _mm_castsi128_ps(integral_first_two ? _mm_setr_epi32(-1, -1, 0, 0) : _mm_setzero_si128());
-  return cull;
+  return GridCull::Of(positive, negative, w0, slack, top, integral_first_two);
 }
 
 // The spans [low, high] of a cull's coordinates over a node's box (widened
@@ -633,12 +645,9 @@ inline bool NodeMeetsGrid(const btQuantizedBvhNode& node, const GridCull& cull) 
 GridCull CullForWide(const Target& target, const Eigen::Vector3d& origin,
                      const Eigen::Vector3d* const axes[], int count, const double limit[],
                      const double margin[], bool integral_first_two) {
-  const btTransform& X_BL = target.X_BL;
   Eigen::Matrix3d R_BL;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) R_BL(r, c) = double(X_BL.getBasis()[r][c]);
-  }
-  const Eigen::Vector3d p_BL(X_BL.getOrigin().x(), X_BL.getOrigin().y(), X_BL.getOrigin().z());
+  Eigen::Vector3d p_BL;
+  ObjectFrame(target, &R_BL, &p_BL);
   const double extent =
       std::max(target.bvh->lower.cwiseAbs().maxCoeff(), target.bvh->upper.cwiseAbs().maxCoeff());
   alignas(16) float positive[3][4] = {}, negative[3][4] = {}, w0[4] = {}, slack[4] = {};
@@ -655,17 +664,7 @@ GridCull CullForWide(const Target& target, const Eigen::Vector3d& origin,
     const double reach = std::abs(w0[w]) + weight * extent;
     slack[w] = float(margin[w] + weight * target.box_margin + 1e-6 * reach);
   }
-  GridCull cull;
-  for (int k = 0; k < 3; ++k) {
-    cull.positive[k] = _mm_load_ps(positive[k]);
-    cull.negative[k] = _mm_load_ps(negative[k]);
-  }
-  cull.w0 = _mm_load_ps(w0);
-  cull.margin = _mm_load_ps(slack);
-  cull.limit = _mm_load_ps(top);
-  cull.integral =
-      _mm_castsi128_ps(integral_first_two ? _mm_setr_epi32(-1, -1, 0, 0) : _mm_setzero_si128());
-  return cull;
+  return GridCull::Of(positive, negative, w0, slack, top, integral_first_two);
 }
 
 // NodeMeetsGrid for child c of one of the object's own nodes.

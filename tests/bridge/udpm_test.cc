@@ -43,6 +43,16 @@ void DrainUntil(LcmLink& link, const LatestInput& input, std::int64_t count) {
   }
 }
 
+// The sample level's robot with its inputs on UDP multicast (made in a test
+// body, after SetUp has checked for the namespace).
+struct Robot {
+  scene::Level level = scene::LoadLevel(testing::SampleLevel());
+  scene::CollisionWorld world{level};
+  scene::RobotState state{level.robots.at(0)};
+  LcmLink link{kUrl};
+  RobotInputs inputs{link, level, 0};
+};
+
 class UdpmTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -54,11 +64,8 @@ class UdpmTest : public ::testing::Test {
 };
 
 TEST_F(UdpmTest, TheNewestOfAThousandPosesBetweenTwoTicksWins) {
-  const scene::Level level = scene::LoadLevel(testing::SampleLevel());
-  scene::CollisionWorld world(level);
-  scene::RobotState state(level.robots.at(0));
-  LcmLink link(kUrl);
-  RobotInputs inputs(link, level, 0);
+  Robot robot;
+  auto& [level, world, state, link, inputs] = robot;
   // A thousand poses while the loop sleeps between two ticks (100 kHz at 100
   // ticks a second); LCM's default queue of 30 kept the oldest 30.
   for (int seq = 1; seq <= 1000; ++seq) Publish(link, "ELAHA/POSE", Pose(seq));
@@ -71,11 +78,8 @@ TEST_F(UdpmTest, TheNewestOfAThousandPosesBetweenTwoTicksWins) {
 }
 
 TEST_F(UdpmTest, LockstepKeepsEveryPoseThatArrivedWhileTheLoopWasHeldUp) {
-  const scene::Level level = scene::LoadLevel(testing::SampleLevel());
-  scene::CollisionWorld world(level);
-  scene::RobotState state(level.robots.at(0));
-  LcmLink link(kUrl);
-  RobotInputs inputs(link, level, 0);
+  Robot robot;
+  auto& [level, world, state, link, inputs] = robot;
   inputs.set_lockstep(true);
   // Three times the free-running queue arrives while the loop is held up (a
   // busy machine): a lock-step run applies every one, in order.
@@ -93,11 +97,8 @@ TEST_F(UdpmTest, LockstepKeepsEveryPoseThatArrivedWhileTheLoopWasHeldUp) {
 }
 
 TEST_F(UdpmTest, AFragmentedOversizedMessageIsRejectedAndTheGoodPoseStays) {
-  const scene::Level level = scene::LoadLevel(testing::SampleLevel());
-  scene::CollisionWorld world(level);
-  scene::RobotState state(level.robots.at(0));
-  LcmLink link(kUrl);
-  RobotInputs inputs(link, level, 0);
+  Robot robot;
+  auto& [level, world, state, link, inputs] = robot;
   Publish(link, "ELAHA/POSE", Pose(5));
   // 2 MB in LCM fragments, then 2 MB on the bones channel.
   const std::vector<std::uint8_t> big(2u << 20, 0x5a);
