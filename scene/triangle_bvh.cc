@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cmath>
 #include <limits>
 
 namespace sandbox::scene {
@@ -120,11 +119,8 @@ class Builder {
     for (std::size_t i = begin; i < end; ++i) centres.Extend(items_[i].centre);
     const Eigen::Vector3f extent = centres.upper - centres.lower;
     Eigen::Vector3f scale;
-    // An extent too small for its reciprocal (a denormal) bins like none.
-    for (int a = 0; a < 3; ++a) {
-      scale[a] = extent[a] > 0.f ? float(kBins) / extent[a] : 0.f;
-      if (!std::isfinite(scale[a])) scale[a] = 0.f;
-    }
+    // (A denormal extent gives an infinite scale: BinOf copes.)
+    for (int a = 0; a < 3; ++a) scale[a] = extent[a] > 0.f ? float(kBins) / extent[a] : 0.f;
     // The axes tried: all three for small ranges, the longest extent's for
     // large ones (where the others rarely win and binning costs most).
     int longest = 0;
@@ -207,7 +203,8 @@ class Builder {
     return box;
   }
 
-  // Clamped as a float (one beyond int's range has no int), NaN to bin 0.
+  // Clamped as a float (one beyond int's range, e.g. infinite, has no int),
+  // NaN (0 times an infinite scale) to bin 0.
   static int BinOf(float value, float low, float scale) {
     const float bin = (value - low) * scale;
     return bin > 0.f ? int(std::min(bin, float(kBins - 1))) : 0;

@@ -107,8 +107,8 @@ TEST(TriangleBvhTest, TrianglesOnOnePointAndOutOfRangeIndices) {
 }
 
 TEST(TriangleBvhTest, CentresApartByADenormalOnOneAxis) {
-  // 8 / 1e-44 overflows to infinity: the binning must not turn that into an
-  // int (undefined; the sanitizer build aborted on a skinned glTF model).
+  // The bins' scale, 16 / 1e-44, overflows to infinity: the binning must not
+  // turn that into an int (undefined; UBSan aborted on a glTF model in CI).
   Mesh mesh = Scattered(200, 4);
   for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
     mesh.positions[i].z() = (i / 3) % 2 ? 1e-44f : 0.f;
