@@ -84,6 +84,47 @@ CollisionWorld::CollisionWorld(const Level& level) : impl_(std::make_unique<Impl
     }
     w.Place(body, p_WO_);
   }
+  w.MergeStatic(p_WO_);
+}
+
+void CollisionWorld::Impl::MergeStatic(const Eigen::Vector3d& p_WO) {
+  std::vector<MeshObject*> statics;
+  std::size_t triangles = 0;
+  for (MeshObject& object : objects) {
+    const int group = object.object->getBroadphaseHandle()->m_collisionFilterGroup;
+    if (object.tile != 0 || group != static_cast<int>(kWorldStatic)) continue;
+    statics.push_back(&object);
+    for (int p = 0; p < object.mesh_interface->getNumSubParts(); ++p) {
+      triangles += std::size_t(object.mesh_interface->getIndexedMeshArray()[p].m_numTriangles);
+    }
+  }
+  if (statics.size() < 2 || triangles > kMaxMergedTriangles) return;
+  // Each part's corners placed as Bullet places them (its float transform).
+  std::vector<std::vector<Eigen::Vector3f>> positions;
+  std::vector<TriangleSoup> soups;
+  merged_static.holds_actor.assign(std::size_t(num_actors), false);
+  for (MeshObject* object : statics) {
+    const btTransform& X = object->object->getWorldTransform();
+    const int body = object->object->getUserIndex();
+    const IndexedMeshArray& parts = object->mesh_interface->getIndexedMeshArray();
+    for (int k = 0; k < parts.size(); ++k) {
+      const btIndexedMesh& part = parts[k];
+      std::vector<Eigen::Vector3f>& placed = positions.emplace_back(std::size_t(part.m_numVertices));
+      const auto* in = reinterpret_cast<const Eigen::Vector3f*>(part.m_vertexBase);
+      for (std::size_t v = 0; v < placed.size(); ++v) {
+        const btVector3 p = X * btVector3(in[v].x(), in[v].y(), in[v].z());
+        placed[v] = {p.x(), p.y(), p.z()};
+      }
+      soups.push_back({placed.data(), placed.size(),
+                       reinterpret_cast<const std::uint32_t*>(part.m_triangleIndexBase),
+                       std::size_t(part.m_numTriangles)});
+      merged_static.body_of_part.push_back(body);
+    }
+    merged_static.holds_actor[std::size_t(body)] = true;
+    object->merged = true;
+  }
+  merged_static.bvh = std::make_shared<const TriangleBvh>(BuildTriangleBvh(soups));
+  merged_static.p_WO = p_WO;
 }
 
 CollisionWorld::~CollisionWorld() = default;

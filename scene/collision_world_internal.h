@@ -51,6 +51,20 @@ struct MeshObject {
   std::shared_ptr<const TriangleBvh> bvh;
   Eigen::Isometry3d X_BO{Eigen::Isometry3d::Identity()};  // in its body's frame
   std::uint64_t tile{0};  // a terrain tile's key (TileId::key() + 1), 0 for the rest
+  bool merged{false};     // its triangles are in CollisionWorld::Impl::merged_static too
+};
+
+// One hierarchy over the triangles of the static actors' objects (not the
+// terrain tiles), corners as Bullet placed them with the floating origin at
+// p_WO: a ray walks one tree instead of one per object, nearest first across
+// them all (the objects of a game level overlap: those of the Quake 3 map of
+// ../shared/assets, 61, cover each other's boxes). Leaf lanes name their
+// triangle's part, body_of_part its body (an actor).
+struct MergedStatic {
+  std::shared_ptr<const TriangleBvh> bvh;
+  std::vector<std::int32_t> body_of_part;
+  std::vector<bool> holds_actor;  // by actor
+  Eigen::Vector3d p_WO{Eigen::Vector3d::Zero()};
 };
 
 // A terrain tile's objects, built off the loop thread; the tile's arrays are
@@ -91,6 +105,7 @@ struct CollisionWorld::Impl {
   // Robots: their models and rigid pieces (Bullet reads the pieces' arrays).
   std::vector<const RobotModel*> robot_models;
   std::vector<std::vector<std::unique_ptr<RobotPiece>>> robot_pieces;
+  MergedStatic merged_static;  // its bvh is null when not worth it (MergeStatic)
 
   ~Impl() {
     for (MeshObject& object : objects) world.removeCollisionObject(object.object.get());
@@ -193,6 +208,11 @@ struct CollisionWorld::Impl {
     }
     return made;
   }
+
+  // Builds merged_static over the static actors' objects placed at p_WO when
+  // there are two or more and at most kMaxMergedTriangles triangles in all.
+  void MergeStatic(const Eigen::Vector3d& p_WO);
+  static constexpr std::size_t kMaxMergedTriangles = std::size_t{1} << 20;
 
   void Place(int body, const Eigen::Vector3d& p_WO) {
     const Eigen::Isometry3d& X_WB = X_W[static_cast<std::size_t>(body)];

@@ -43,6 +43,10 @@ struct Target {
   // for the rounding of rays taken into that frame.
   const scene::TriangleBvh* bvh{nullptr};
   float box_margin{0.f};
+  // The merged static objects' target (scene::MergedStatic) has a body per
+  // leaf part (BodyOf); any other, its one body.
+  const std::int32_t* body_of_part{nullptr};
+  int BodyOf(int part) const { return body_of_part != nullptr ? body_of_part[part] : body; }
   struct Part {
     const unsigned char* vertices;
     int vertex_stride;
@@ -53,6 +57,38 @@ struct Target {
 };
 
 Eigen::Vector3f ToEigen(const btVector3& v) { return {float(v.x()), float(v.y()), float(v.z())}; }
+
+// The margin of a target's boxes: a few thousand ulps of the coordinates
+// involved (the boxes' and the placement's).
+float BoxMargin(const scene::TriangleBvh& bvh, const Eigen::Vector3f& p_LB,
+                const Eigen::Vector3f& p_BL) {
+  const float scale = std::max({bvh.lower.cwiseAbs().maxCoeff(), bvh.upper.cwiseAbs().maxCoeff(),
+                                p_LB.cwiseAbs().maxCoeff(), p_BL.cwiseAbs().maxCoeff()});
+  return 1e-5f * scale + 1e-6f;
+}
+
+// The target of the world's merged static objects, placed for the world's
+// origin now (its corners are where Bullet placed them at the origin it was
+// built at: a whole-metre shift moves them as a translation).
+Target MergedTarget(const scene::CollisionWorld& world) {
+  const scene::MergedStatic& merged = world.internals().merged_static;
+  Target t;
+  t.body = -2;  // none: each lane's is BodyOf its part
+  t.group = scene::kWorldStatic;
+  t.bvh = merged.bvh.get();
+  t.body_of_part = merged.body_of_part.data();
+  const btVector3 offset = scene::ToBullet(merged.p_WO - world.origin());
+  t.X_BL.setIdentity();
+  t.X_BL.setOrigin(offset);
+  t.identity = offset == btVector3(0, 0, 0);
+  t.R_LB.setIdentity();
+  t.p_LB = -ToEigen(offset);
+  t.box_margin = BoxMargin(*t.bvh, t.p_LB, ToEigen(offset));
+  t.aabb_min = t.bvh->lower - t.p_LB - Eigen::Vector3f::Constant(t.box_margin);
+  t.aabb_max = t.bvh->upper - t.p_LB + Eigen::Vector3f::Constant(t.box_margin);
+  t.body_min = t.aabb_min, t.body_max = t.aabb_max;
+  return t;
+}
 
 // Every object of the world, in the world's order (a body's objects next to
 // each other), with the boxes around each run of one body's objects.
@@ -82,13 +118,7 @@ std::vector<Target> CollectTargets(const scene::CollisionWorld& world) {
     t.quantization = 65534.0f * (ToEigen(bvh->unQuantize(top)) - t.bvh_min).cwiseInverse();
     t.bvh = object.bvh.get();
     if (t.bvh == nullptr) throw std::logic_error("RayCaster: an object without its hierarchy");
-    {
-      // A few thousand ulps of the coordinates involved: the boxes' and the placement's.
-      const float scale =
-          std::max({t.bvh->lower.cwiseAbs().maxCoeff(), t.bvh->upper.cwiseAbs().maxCoeff(),
-                    t.p_LB.cwiseAbs().maxCoeff(), ToEigen(X.getOrigin()).cwiseAbs().maxCoeff()});
-      t.box_margin = 1e-5f * scale + 1e-6f;
-    }
+    t.box_margin = BoxMargin(*t.bvh, t.p_LB, ToEigen(X.getOrigin()));
     const IndexedMeshArray& meshes = object.mesh_interface->getIndexedMeshArray();
     for (int m = 0; m < meshes.size(); ++m) {
       t.parts.push_back({meshes[m].m_vertexBase, meshes[m].m_vertexStride,
@@ -681,8 +711,8 @@ inline bool ChildMeetsGrid(const scene::TriangleBvh::Node& node, int c, const Gr
   return _mm_movemask_ps(_mm_cmpge_ps(Select(cull.integral, whole, high), low)) == 0xF;
 }
 
-// Calls visit(corners) (the Bullet frame, as Corners() places them) for each
-// triangle of `target` in a leaf of its own hierarchy whose box meets the grid.
+// Calls visit(corners, body) (the Bullet frame, as Corners() places them) for
+// each triangle of `target` in a leaf of its own hierarchy whose box meets the grid.
 template <typename Visit>
 void ForEachTriangleOverGridWide(const Target& target, const GridCull& cull, Visit&& visit) {
   const scene::TriangleBvh& bvh = *target.bvh;
@@ -700,7 +730,7 @@ void ForEachTriangleOverGridWide(const Target& target, const GridCull& cull, Vis
                                   leaf.corner[3 * k + 2][i]);
           corners[k] = target.identity ? p : ToEigen(target.X_BL * btVector3(p.x(), p.y(), p.z()));
         }
-        visit(corners);
+        visit(corners, target.BodyOf(leaf.part[i]));
       }
       continue;
     }
@@ -878,6 +908,19 @@ inline bool Cut(const Eigen::Vector3f corners[3], const SweepStep& s, float m, f
 struct RayCaster::Targets {
   std::uint64_t instance{0}, revision{0};
   std::vector<Target> all;
+  // The merged static objects' target and every other, or empty when the
+  // world has no merged objects (scene::MergedStatic).
+  std::vector<Target> merged;
+  const std::vector<bool>* merged_actors{nullptr};  // by actor: in the merged target
+
+  // The kernels that walk the objects' own hierarchies read `merged` unless
+  // the filter leaves out one of its actors.
+  const std::vector<Target>& For(const RayFilter& filter) const {
+    const bool ignores_merged = filter.ignore_actor >= 0 && merged_actors != nullptr &&
+                                std::size_t(filter.ignore_actor) < merged_actors->size() &&
+                                (*merged_actors)[std::size_t(filter.ignore_actor)];
+    return merged.empty() || ignores_merged ? all : merged;
+  }
 };
 
 const char* RayCaster::kernel() {
@@ -906,6 +949,15 @@ const RayCaster::Targets& RayCaster::TargetsOf(const scene::CollisionWorld& worl
   if (!targets_) targets_ = std::make_unique<Targets>();
   if (targets_->instance != world.instance() || targets_->revision != world.revision()) {
     targets_->all = CollectTargets(world);
+    targets_->merged.clear();
+    const scene::CollisionWorld::Impl& w = world.internals();
+    if (w.merged_static.bvh != nullptr) {
+      targets_->merged.push_back(MergedTarget(world));
+      for (std::size_t i = 0; i < w.objects.size(); ++i) {
+        if (!w.objects[i].merged) targets_->merged.push_back(targets_->all[i]);
+      }
+      targets_->merged_actors = &w.merged_static.holds_actor;
+    }
     targets_->instance = world.instance();
     targets_->revision = world.revision();
   }
@@ -920,38 +972,57 @@ void RayCaster::Cast(const scene::CollisionWorld& world, const RayBatch& rays,
   if (n == 0) return;
   // The batch in Bullet's frame (world minus the floating origin).
   const Eigen::Vector3f origin_B = (rays.origin_W - world.origin()).cast<float>();
+  // (Without SSE2 the rays walk Bullet's trees, which the merged target has not.)
+#if defined(__SSE2__)
+  const std::vector<Target>& all_targets = TargetsOf(world).For(filter);
+#else
   const std::vector<Target>& all_targets = TargetsOf(world).all;
+#endif
   const Visible wanted{filter, world.internals().num_actors};
+  // The objects the rays may see; when they are a few bodies (a packet
+  // tests each body's box, then each object's), every chunk takes them all.
+  std::vector<const Target*> seen;
+  int bodies_seen = 0;
+  for (const Target& target : all_targets) {
+    if (!wanted(target)) continue;
+    bodies_seen += seen.empty() || seen.back()->body != target.body;
+    seen.push_back(&target);
+  }
+  constexpr int kFewBodies = 8;
 
   const std::function<void(int)> job = [&](int chunk) {
     const std::size_t first = std::size_t(chunk) * kRaysPerChunk;
     const std::size_t end = std::min(n, first + kRaysPerChunk);
-    // Only the objects whose bounds meet this chunk's rays' bounds.
-    Eigen::Vector3f chunk_min = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
-    Eigen::Vector3f chunk_max = -chunk_min;
-    for (std::size_t r = first; r < end; ++r) {
-      const Eigen::Vector3f a = origin_B + rays.start[r];
-      const Eigen::Vector3f b = a + rays.length_m[r] * rays.direction[r];
-      chunk_min = chunk_min.cwiseMin(a.cwiseMin(b));
-      chunk_max = chunk_max.cwiseMax(a.cwiseMax(b));
-    }
+    const Target* const* targets = seen.data();
+    std::size_t num_targets = seen.size();
     const Target* targets_here[64];
     std::vector<const Target*> many;
-    std::size_t count = 0;
-    for (const Target& target : all_targets) {
-      if (!wanted(target) || (target.aabb_min.array() > chunk_max.array()).any() ||
-          (target.aabb_max.array() < chunk_min.array()).any()) {
-        continue;
+    if (bodies_seen > kFewBodies) {
+      // Only the objects whose bounds meet this chunk's rays' bounds.
+      Eigen::Vector3f chunk_min = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
+      Eigen::Vector3f chunk_max = -chunk_min;
+      for (std::size_t r = first; r < end; ++r) {
+        const Eigen::Vector3f a = origin_B + rays.start[r];
+        const Eigen::Vector3f b = a + rays.length_m[r] * rays.direction[r];
+        chunk_min = chunk_min.cwiseMin(a.cwiseMin(b));
+        chunk_max = chunk_max.cwiseMax(a.cwiseMax(b));
       }
-      if (count < 64) {
-        targets_here[count++] = &target;
-      } else {
-        if (many.empty()) many.assign(targets_here, targets_here + 64);
-        many.push_back(&target);
+      std::size_t count = 0;
+      for (const Target* target : seen) {
+        if ((target->aabb_min.array() > chunk_max.array()).any() ||
+            (target->aabb_max.array() < chunk_min.array()).any()) {
+          continue;
+        }
+        if (count < 64) {
+          targets_here[count++] = target;
+        } else {
+          if (many.empty()) many.assign(targets_here, targets_here + 64);
+          many.push_back(target);
+        }
       }
+      targets = many.empty() ? targets_here : many.data();
+      num_targets = many.empty() ? count : many.size();
     }
-    const Target* const* targets = many.empty() ? targets_here : many.data();
-    const std::size_t num_targets = many.empty() ? count : many.size();
     std::size_t i = first;
 #if defined(__SSE2__)
     if (kHasAvx512) {
@@ -1062,7 +1133,7 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
   SizeHits(n, hits);
   if (n == 0) return;
   const Eigen::Vector3f origin_B = (rays.origin_W - world.origin()).cast<float>();
-  const std::vector<Target>& all_targets = TargetsOf(world).all;
+  const std::vector<Target>& all_targets = TargetsOf(world).For(filter);
   const Visible wanted{filter, world.internals().num_actors};
   // Bands of rows, each a chunk of work: four a thread over all blocks
   // (each band walks the BVH from its root), at least four rows each.
@@ -1138,7 +1209,7 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
       const double limit[3] = {double(cols - 1), double(rows - 1), double(length)};
       const double margins[3] = {margin_columns, margin_rows, margin};
       const GridCull cull = CullForWide(target, corner, axes, 3, limit, margins, true);
-      ForEachTriangleOverGridWide(target, cull, [&](const Eigen::Vector3f* corners) {
+      ForEachTriangleOverGridWide(target, cull, [&](const Eigen::Vector3f* corners, int body) {
         // Columns u, rows v and depths s of the corners (SSE, a lane each).
         const __m128 x =
             Sub(_mm_setr_ps(corners[0].x(), corners[1].x(), corners[2].x(), corners[2].x()),
@@ -1162,7 +1233,7 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
         if (r0 > r1 || c0 > c1) return;
         const float near = s_min - frame.margin;
         auto add = [&](int r, int c) {
-          band.Add(corners, target.body, r * cols + c, near, HitPairs);
+          band.Add(corners, body, r * cols + c, near, HitPairs);
         };
         if ((r1 - r0 + 1) * (c1 - c0 + 1) <= 4) {  // the box's few cells
           for (int r = r0; r <= r1; ++r) {

@@ -87,6 +87,48 @@ TEST_F(RayCasterTest, AgreesWithBulletsRayTest) {
   EXPECT_LE(mismatches, 2);
 }
 
+// The sample level's static actors share one hierarchy (scene::MergedStatic);
+// a filter that leaves one of them out still sees the others as Bullet does.
+TEST_F(RayCasterTest, IgnoringAStaticActorAgreesWithBullet) {
+  const int tower = level_->FindActor("tower");
+  ASSERT_GE(tower, 0);
+  // Rays from around the tower towards it, many of which it stops.
+  RayBatch rays;
+  rays.origin_W = Vector3d(-30, 45, 15);
+  std::mt19937 random(5);
+  std::uniform_real_distribution<float> unit(-1.f, 1.f);
+  for (int i = 0; i < 4000; ++i) {
+    const Vector3f start(20.f * unit(random), 20.f * unit(random), 10.f * unit(random) + 5.f);
+    rays.start.push_back(start);
+    rays.direction.push_back((-start + Vector3f(3.f * unit(random), 3.f * unit(random), 0.f))
+                                 .normalized());
+    rays.length_m.push_back(60.f);
+  }
+  RayFilter ignore;
+  ignore.ignore_actor = tower;
+  RayCaster caster(2);
+  RayHits seen, ignored;
+  caster.Cast(*world_, rays, {}, &seen);
+  caster.Cast(*world_, rays, ignore, &ignored);
+  int on_tower = 0, mismatches = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    on_tower += seen.body[i] == tower;
+    ASSERT_NE(ignored.body[i], tower) << "ray " << i;
+    const Vector3d from = rays.origin_W + rays.start[i].cast<double>();
+    const Vector3d to = from + 60.0 * rays.direction[i].cast<double>();
+    const auto expected = world_->CastRay(from, to, scene::kAllGroups, tower);
+    if (expected.has_value() != (ignored.body[i] != RayHits::kNoHit)) {
+      ++mismatches;  // grazing an edge can go either way
+      continue;
+    }
+    if (expected) {
+      EXPECT_NEAR(ignored.distance_m[i], expected->distance_m, 1e-3) << "ray " << i;
+    }
+  }
+  EXPECT_GT(on_tower, 1000);
+  EXPECT_LE(mismatches, 2);
+}
+
 TEST_F(RayCasterTest, VerticalRaysHitTheAnalyticTerrain) {
   namespace sample = assets::sample;
   RayBatch rays;

@@ -197,6 +197,62 @@ TEST(StructuredScanTest, SameHitsWhereRaysRunThroughVerticesAndAlongEdges) {
   EXPECT_GT(hits, 2 * 51 * 51);
 }
 
+// Two actors made of the same file lie one in the other: every ray meets
+// both at one distance, and each kernel, whatever order it meets their
+// triangles in (the static actors share one hierarchy), reports the actor
+// listed first.
+TEST(StructuredScanTest, ATieBetweenActorsGoesToTheFirstInEveryKernel) {
+  testing::TempDir dir;
+  {
+    std::ofstream obj(dir.path() / "floor.obj");
+    const int n = 40;
+    for (int r = 0; r <= n; ++r) {
+      for (int c = 0; c <= n; ++c) obj << "v " << c - 20 << " " << r - 20 << " 0\n";
+    }
+    for (int r = 0; r < n; ++r) {
+      for (int c = 0; c < n; ++c) {
+        const int a = r * (n + 1) + c + 1, b = a + 1, d = a + n + 1, e = d + 1;
+        obj << "f " << a << " " << b << " " << e << "\nf " << a << " " << e << " " << d << "\n";
+      }
+    }
+    std::ofstream(dir.path() / "level.toml")
+        << "[[actor]]\nname = \"first\"\nfile = \"floor.obj\"\n"
+        << "[[actor]]\nname = \"second\"\nfile = \"floor.obj\"\n";
+  }
+  const scene::Level level = scene::LoadLevel(dir.path() / "level.toml");
+  const scene::CollisionWorld world(level);
+  ASSERT_EQ(level.FindActor("first"), 0);
+  RayCaster caster(2);
+  FaceScannerConfig face;
+  face.refresh = Refresh::kFull;
+  face.alignment = Alignment::kWorld;
+  face.half_extent_m = 8.0;
+  face.resolution_m = 0.4;
+  RayBatch face_rays;
+  std::vector<RayGrid> grids;
+  FaceScanner(face).GridRays(0, Isometry3d(Eigen::Translation3d(0.1, 0.2, 3.0)), &face_rays,
+                             &grids);
+  const LidarConfig lidar = LidarConfig::Uniform(16, -60, -10, 256, 40.0);
+  RaySweep sweep;
+  const Isometry3d X_WS(Eigen::Translation3d(0.3, -0.2, 4.0));
+  const RayBatch lidar_rays = Lidar(lidar).Rays(X_WS, X_WS, &sweep);
+  RayHits hits;
+  auto expect_first = [&](const char* kernel) {
+    int on_floor = 0, second = 0;
+    for (const std::int32_t body : hits.body) on_floor += body >= 0, second += body == 1;
+    EXPECT_GT(on_floor, 1000) << kernel;
+    EXPECT_EQ(second, 0) << kernel;
+  };
+  caster.Cast(world, face_rays, {}, &hits);
+  expect_first("Cast, face scan");
+  caster.CastGrids(world, face_rays, grids, {}, &hits);
+  expect_first("CastGrids");
+  caster.Cast(world, lidar_rays, {}, &hits);
+  expect_first("Cast, sweep");
+  caster.CastSweep(world, lidar_rays, sweep, {}, &hits);
+  expect_first("CastSweep");
+}
+
 TEST(StructuredScanTest, BadBlocksAreRefused) {
   const scene::Level level = scene::LoadLevel(testing::SampleLevel());
   const scene::CollisionWorld world(level);
