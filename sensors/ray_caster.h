@@ -1,7 +1,8 @@
 #pragma once
 // Batched ray casting over the Bullet world, split over worker threads.
 // Thread-safe by construction: every ray walks each object's own hierarchy
-// (scene::TriangleBvh; the structured kernels, Bullet's quantized BVH) and the
+// (scene::TriangleBvh, one over all static actors where the scene merged them:
+// scene::MergedStatic; the lidar sweep kernel, Bullet's quantized BVH) and the
 // level's triangle arrays read-only, with its own stack; nothing of Bullet's
 // mutable query state (btCollisionWorld::rayTest) is used.
 //
@@ -76,7 +77,8 @@ struct RayFilter {
 };
 
 // One entry per ray. A ray that hits nothing has distance_m = length_m and
-// body = -1 (kNoHit).
+// body = -1 (kNoHit). A ray that meets surfaces of two bodies at one distance
+// reports the lower body, in every kernel.
 struct RayHits {
   static constexpr int kNoHit = -1;
   std::vector<float> distance_m;
