@@ -6,6 +6,22 @@
 #
 #   live_view.sh SANDBOX
 set -euo pipefail
+# On a virtual display of its own (xvfb-run picks a free number), which
+# never resets (by default Xvfb resets each time its last client leaves,
+# and in CI a display answered once and then no more); Xvfb's own messages
+# are shown when the display fails.
+if [ -z "${LIVE_VIEW_XVFB_LOG:-}" ]; then
+  xvfb_log=$(mktemp /tmp/sandbox-live-view-xvfb-XXXXXX.log)
+  status=0
+  LIVE_VIEW_XVFB_LOG=$xvfb_log xvfb-run -a -e "$xvfb_log" -s "-noreset -screen 0 1280x1024x24" \
+    bash "$0" "$@" || status=$?
+  rm -f "$xvfb_log"
+  exit "$status"
+fi
+xvfb_failed() {
+  echo "$1 (display $DISPLAY; Xvfb's messages follow)"
+  cat "$LIVE_VIEW_XVFB_LOG"
+}
 # No session bus on the virtual display: Qt's accessibility would have
 # libdbus autolaunch one, forking the threaded sandbox; under the sanitizers
 # that fork's child deadlocked in the allocator and the window never came.
@@ -22,8 +38,12 @@ grep -q -- "--view needs a display" "$out" || { cat "$out"; status=1; }
 
 # The virtual display answers first (once, in CI under the sanitizers, the
 # sandbox found no server at xvfb-run's display and aborted at once).
-for _ in $(seq 300); do xdotool getdisplaygeometry > /dev/null 2>&1 && break; sleep 0.1; done
-xdotool getdisplaygeometry > /dev/null 2>&1 || { echo "the virtual display $DISPLAY does not answer"; exit 1; }
+answered=0
+for _ in $(seq 300); do
+  xdotool getdisplaygeometry > /dev/null 2>&1 && { answered=1; break; }
+  sleep 0.1
+done
+[ "$answered" -eq 1 ] || { xvfb_failed "the virtual display does not answer"; exit 1; }
 
 # Long enough that only the q key can have ended it.
 "$sandbox" run --view --duration 600 --lcm-url memq:// > "$out" 2>&1 &
@@ -36,7 +56,7 @@ done
 if [ -z "$window" ]; then
   # The sandbox's own words (kill fails when it is gone already).
   echo "no window appeared"; kill "$pid" 2> /dev/null || true; wait "$pid" || echo "exit status $?"
-  cat "$out"; exit 1
+  cat "$out"; xvfb_failed "the display at the end"; exit 1
 fi
 sleep 1
 for key in c o q; do xdotool key --window "$window" "$key" 2> /dev/null; sleep 0.3; done
