@@ -479,8 +479,8 @@ namespace avx512_kernel {
 }  // namespace avx512_kernel
 
 // The FMA kernel where the CPU has the unit, unless SANDBOX_RAY_KERNEL=sse2
-// asks for the portable one; Cast()'s packets of sixteen rays where it has
-// AVX-512 too, unless SANDBOX_RAY_KERNEL=fma or sse2 asks for packets of four
+// asks for the portable one; Cast()'s packets of sixteen rays (and the
+// structured kernels' sixteen pairs a test) where it has AVX-512 too, unless SANDBOX_RAY_KERNEL=fma or sse2 asks for packets of four
 // (tests run each; the results are the same).
 const bool kHasFma = [] {
   const char* kernel = std::getenv("SANDBOX_RAY_KERNEL");
@@ -512,7 +512,9 @@ inline void WalkWide4(const Target& target, Packet* packet) {
 }
 
 inline void HitPairs(GridBand* band) {
-  if (kHasFma) {
+  if (kHasAvx512) {
+    avx512_kernel::HitPairs16(band);
+  } else if (kHasFma) {
     fma_kernel::HitPairs(band);
   } else {
     sse2_kernel::HitPairs(band);

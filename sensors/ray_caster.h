@@ -132,7 +132,8 @@ class RayCaster {
   // Entries a BVH walk keeps on its own stack before it grows on the heap
   // (a deeper tree costs an allocation per walk, never a dropped node).
   static constexpr int kStackInPlace = 32;
-  // The packet kernel in use: "avx512" (sixteen rays a packet in Cast(), the
+  // The packet kernel in use: "avx512" (sixteen rays a packet in Cast(),
+  // sixteen triangle-ray pairs a test in CastGrids() and CastSweep(); the
   // FMA kernel's arithmetic), "fma" (the CPU's fused multiply-add unit, four
   // rays; SANDBOX_RAY_KERNEL=fma forces it), "sse2" (fused operations emulated
   // where they decide; SANDBOX_RAY_KERNEL=sse2) or "scalar" (no SSE2). All
