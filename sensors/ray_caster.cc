@@ -1137,23 +1137,45 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
   const Eigen::Vector3f origin_B = (rays.origin_W - world.origin()).cast<float>();
   const std::vector<Target>& all_targets = TargetsOf(world).For(filter);
   const Visible wanted{filter, world.internals().num_actors};
-  // Bands of rows, each a chunk of work: four a thread over all blocks
-  // (each band walks the BVH from its root), at least four rows each.
+  // Bands of rows, each a chunk of work (each band walks the BVH from its
+  // root, so fewer is less work; at least four rows each). Without a history:
+  // four a thread over all blocks. After a call over the same blocks (a
+  // scanner's next scan), by what each block took then: a block gets as many
+  // bands as it took threads' shares of the total (rounded up), and the
+  // costliest bands are taken first, so that the threads end together.
   struct Band {
     const RayGrid* grid;
-    int row_begin, row_end;
+    int block, row_begin, row_end;
+    double cost;
   };
   std::vector<Band> bands;
-  const int bands_per_block =
+  bool known = threads() > 1 && grid_costs_.size() == grids.size();
+  double total = 0.0;
+  for (std::size_t b = 0; known && b < grids.size(); ++b) {
+    known = grid_costs_[b].rows == grids[b].rows;
+    total += grid_costs_[b].seconds;
+  }
+  known = known && total > 0.0;
+  const int even_split =
       (4 * threads() + int(grids.size()) - 1) / std::max(1, int(grids.size()));
-  for (const RayGrid& grid : grids) {
-    const int rows_per_band = std::max(4, (grid.rows + bands_per_block - 1) / bands_per_block);
+  for (std::size_t b = 0; b < grids.size(); ++b) {
+    const RayGrid& grid = grids[b];
+    const double cost = known ? grid_costs_[b].seconds : 1.0;
+    const int split = known ? int(std::ceil(cost / (total / threads()))) : even_split;
+    const int rows_per_band = std::max(4, (grid.rows + split - 1) / std::max(1, split));
     for (int r = 0; r < grid.rows; r += rows_per_band) {
-      bands.push_back({&grid, r, std::min(grid.rows, r + rows_per_band)});
+      const int end = std::min(grid.rows, r + rows_per_band);
+      bands.push_back({&grid, int(b), r, end, cost * (end - r) / std::max(1, grid.rows)});
     }
   }
+  if (known) {
+    std::stable_sort(bands.begin(), bands.end(),
+                     [](const Band& a, const Band& b) { return a.cost > b.cost; });
+  }
+  std::vector<double> band_seconds(bands.size(), 0.0);
 
   const std::function<void(int)> job = [&](int band_index) {
+    const auto started = std::chrono::steady_clock::now();
     const Band& this_band = bands[std::size_t(band_index)];
     const RayGrid& grid = *this_band.grid;
     const int row_begin = this_band.row_begin;
@@ -1260,8 +1282,15 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
         WriteHit(first + i, band.t_max[i], band.body[i], band.normal[i], d, hits);
       }
     }
+    band_seconds[std::size_t(band_index)] =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   };
   RunParallel(static_cast<int>(bands.size()), job);
+  grid_costs_.assign(grids.size(), GridCost{0, 0.0});
+  for (std::size_t b = 0; b < grids.size(); ++b) grid_costs_[b].rows = grids[b].rows;
+  for (std::size_t i = 0; i < bands.size(); ++i) {
+    grid_costs_[std::size_t(bands[i].block)].seconds += band_seconds[i];
+  }
 #endif
 }
 

@@ -155,6 +155,13 @@ class RayCaster {
   struct Targets;
   std::unique_ptr<Targets> targets_;
   const Targets& TargetsOf(const scene::CollisionWorld& world);
+  // What each block of the last CastGrids() call took (its rows and seconds):
+  // the next call over the same blocks splits and orders its bands by it.
+  struct GridCost {
+    int rows;
+    double seconds;
+  };
+  std::vector<GridCost> grid_costs_;
 };
 
 }  // namespace sandbox::sensors
