@@ -1224,6 +1224,11 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
     }
     const Eigen::Vector3f box_min = (box.min().array() - margin).cast<float>();
     const Eigen::Vector3f box_max = (box.max().array() + margin).cast<float>();
+    // Per lane (column, row, depth): the margins, and the bounds of the
+    // cells' columns and rows and of the rays' depths (the fourth lane: none).
+    const __m128 lane_margins = _mm_setr_ps(frame.margin_columns, frame.margin_rows, frame.margin, 0.0f);
+    const __m128 cap = _mm_setr_ps(float(cols), float(rows), kHuge, kHuge);
+    const __m128 top = _mm_setr_ps(float(cols - 1), float(rows - 1), length, kHuge);
     for (const Target& target : all_targets) {
       if (!wanted(target) || (target.aabb_min.array() > box_max.array()).any() ||
           (target.aabb_max.array() < box_min.array()).any()) {
@@ -1244,18 +1249,29 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
         const __m128 z =
             Sub(_mm_setr_ps(corners[0].z(), corners[1].z(), corners[2].z(), corners[2].z()),
                 frame.corner[2]);
-        alignas(16) float u[4], v[4], s[4];
-        _mm_store_ps(u, frame.Along(0, x, y, z));
-        _mm_store_ps(v, frame.Along(1, x, y, z));
-        _mm_store_ps(s, frame.Along(2, x, y, z));
-        const float s_min = std::min({s[0], s[1], s[2]}), s_max = std::max({s[0], s[1], s[2]});
-        if (s_max < -frame.margin || s_min > length + frame.margin) return;
-        const int r0 = CeilNotBelowZero(std::min({v[0], v[1], v[2]}) - frame.margin_rows, rows);
-        const int r1 = FloorNotAbove(std::max({v[0], v[1], v[2]}) + frame.margin_rows, rows - 1);
-        const int c0 = CeilNotBelowZero(std::min({u[0], u[1], u[2]}) - frame.margin_columns, cols);
-        const int c1 = FloorNotAbove(std::max({u[0], u[1], u[2]}) + frame.margin_columns, cols - 1);
-        if (r0 > r1 || c0 > c1) return;
-        const float near = s_min - frame.margin;
+        const __m128 column = frame.Along(0, x, y, z), row = frame.Along(1, x, y, z);
+        // A corner a vector (column, row, depth, depth), then their least and
+        // greatest coordinates, widened by the margins.
+        __m128 p0 = column, p1 = row, p2 = frame.Along(2, x, y, z), p3 = p2;
+        _MM_TRANSPOSE4_PS(p0, p1, p2, p3);
+        const __m128 low = Sub(_mm_min_ps(_mm_min_ps(p0, p1), p2), lane_margins);
+        const __m128 high = Add(_mm_max_ps(_mm_max_ps(p0, p1), p2), lane_margins);
+        // The columns, rows and depths within the grid that it spans, if any:
+        // from the least whole column and row at or above `span_from`, to the
+        // greatest at or below `span_to`.
+        const __m128 span_from = _mm_min_ps(_mm_max_ps(low, _mm_setzero_ps()), cap);
+        const __m128 span_to = _mm_min_ps(top, high);
+        if ((_mm_movemask_ps(_mm_cmpge_ps(span_to, span_from)) & 7) != 7) return;
+        const __m128i whole = _mm_cvttps_epi32(span_from);
+        const __m128i least = _mm_sub_epi32(
+            whole, _mm_castps_si128(_mm_cmplt_ps(_mm_cvtepi32_ps(whole), span_from)));
+        const __m128i last = _mm_cvttps_epi32(span_to);
+        if (_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpgt_epi32(least, last))) & 3) return;
+        alignas(16) std::int32_t firsts[4], lasts[4];
+        _mm_store_si128(reinterpret_cast<__m128i*>(firsts), least);
+        _mm_store_si128(reinterpret_cast<__m128i*>(lasts), last);
+        const int c0 = firsts[0], r0 = firsts[1], c1 = lasts[0], r1 = lasts[1];
+        const float near = _mm_cvtss_f32(_mm_movehl_ps(low, low));
         auto add = [&](int r, int c) {
           band.Add(corners, body, r * cols + c, near, HitPairs);
         };
@@ -1266,6 +1282,8 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
           return;
         }
         // Row by row, the cells within the triangle's span.
+        alignas(16) float u[4], v[4];
+        _mm_store_ps(u, column), _mm_store_ps(v, row);
         for (int r = r0; r <= r1; ++r) {
           float from, to;
           if (!RowSpan(u, v, float(r), frame.margin_rows, &from, &to)) continue;
