@@ -480,8 +480,9 @@ namespace avx512_kernel {
 
 // The FMA kernel where the CPU has the unit, unless SANDBOX_RAY_KERNEL=sse2
 // asks for the portable one; Cast()'s packets of sixteen rays (and the
-// structured kernels' sixteen pairs a test) where it has AVX-512 too, unless SANDBOX_RAY_KERNEL=fma or sse2 asks for packets of four
-// (tests run each; the results are the same).
+// structured kernels' sixteen pairs a test) where it has AVX-512 too, unless
+// SANDBOX_RAY_KERNEL=fma or sse2 asks for packets of four (tests run each;
+// the results are the same).
 const bool kHasFma = [] {
   const char* kernel = std::getenv("SANDBOX_RAY_KERNEL");
   return __builtin_cpu_supports("fma") && !(kernel != nullptr && std::string(kernel) == "sse2");
