@@ -1227,7 +1227,8 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
     const Eigen::Vector3f box_max = (box.max().array() + margin).cast<float>();
     // Per lane (column, row, depth): the margins, and the bounds of the
     // cells' columns and rows and of the rays' depths (the fourth lane: none).
-    const __m128 lane_margins = _mm_setr_ps(frame.margin_columns, frame.margin_rows, frame.margin, 0.0f);
+    const __m128 lane_margins =
+        _mm_setr_ps(frame.margin_columns, frame.margin_rows, frame.margin, 0.0f);
     const __m128 cap = _mm_setr_ps(float(cols), float(rows), kHuge, kHuge);
     const __m128 top = _mm_setr_ps(float(cols - 1), float(rows - 1), length, kHuge);
     for (const Target& target : all_targets) {
