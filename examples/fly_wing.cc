@@ -18,6 +18,7 @@
 // --replay FILE` then runs the same inputs again).
 // --robot: the channel prefix (default ELAHA, QUAD1 for left, QUAD2 for right).
 // It stops after --duration seconds or after --poses poses, whichever comes first.
+// Exit status 1 when LCM reported a send as failed (the count is on stderr).
 
 #include <chrono>
 #include <cmath>
@@ -85,9 +86,10 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
+  long long failed = 0;  // sends LCM reported as failed
   auto publish = [&](const std::string& channel, std::vector<std::uint8_t>* bytes,
                      std::int64_t utime) {
-    if (!offline) lcm.publish(channel, bytes->data(), unsigned(bytes->size()));
+    if (!offline && lcm.publish(channel, bytes->data(), unsigned(bytes->size())) != 0) ++failed;
     if (!log) return;
     lcm::LogEvent event{};
     event.timestamp = utime;
@@ -137,5 +139,9 @@ int main(int argc, char** argv) {
     std::this_thread::sleep_until(next);
   }
   std::printf("fly_wing: published %lld poses\n", static_cast<long long>(seq));
+  if (failed > 0) {
+    std::fprintf(stderr, "fly_wing: %lld sends failed\n", failed);
+    return 1;
+  }
   return 0;
 }

@@ -47,9 +47,9 @@ awk -v t="$ticks" -v s="$seconds" 'BEGIN { exit !(t >= 10 * s) }' ||
 start_sandbox "$run_log" "$sandbox" run "$level" --lockstep --record "$record"
 "$state_check" ELAHA --seq 299 --seconds 120 &
 check_pid=$!
-"$flood" ELAHA --seconds 4 --rate 2000 > /dev/null &
+"$flood" ELAHA --seconds 4 --rate 2000 &
 flood_pid=$!
-"$fly_wing" --poses 300 --rate 100 > /dev/null
+"$fly_wing" --poses 300 --rate 100
 wait "$flood_pid"
 wait "$check_pid" || status=1
 stop "$sandbox_pid"

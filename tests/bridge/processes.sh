@@ -13,10 +13,13 @@ wait_for() {
 
 # Starts `sandbox run ...` in the background with its output in LOG, and
 # returns once its loop runs (its first line is out). Sets sandbox_pid.
+# LOG is emptied first, here: the background command truncates it only when
+# it gets to run, and until then a reused LOG still shows the last run's line.
 #   start_sandbox LOG SANDBOX ARGS...
 start_sandbox() {
   local log=$1
   shift
+  : > "$log"
   "$@" > "$log" 2>&1 &
   sandbox_pid=$!
   wait_for 120 grep -q "^sandbox run:" "$log" || { echo "the sandbox did not start:"; cat "$log"; return 1; }
