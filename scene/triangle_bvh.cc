@@ -11,14 +11,26 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr int kBins = 16;
 constexpr int kLeafSize = TriangleBvh::kWidth;
 
+// Plain floats rather than Eigen's expressions: building is most of loading
+// a level, and sanitizer builds (which inline little) build every test's world.
+using Vec3 = std::array<float, 3>;
+
 struct Box {
-  Eigen::Vector3f lower{Eigen::Vector3f::Constant(kInf)}, upper{Eigen::Vector3f::Constant(-kInf)};
-  void Extend(const Box& b) { lower = lower.cwiseMin(b.lower), upper = upper.cwiseMax(b.upper); }
-  void Extend(const Eigen::Vector3f& p) { lower = lower.cwiseMin(p), upper = upper.cwiseMax(p); }
+  Vec3 lower{kInf, kInf, kInf}, upper{-kInf, -kInf, -kInf};
+  void Extend(const Box& b) {
+    for (int a = 0; a < 3; ++a) {
+      lower[a] = std::min(lower[a], b.lower[a]), upper[a] = std::max(upper[a], b.upper[a]);
+    }
+  }
+  void Extend(const Vec3& p) {
+    for (int a = 0; a < 3; ++a) {
+      lower[a] = std::min(lower[a], p[a]), upper[a] = std::max(upper[a], p[a]);
+    }
+  }
   float HalfArea() const {
-    if (!(lower.array() <= upper.array()).all()) return 0.f;
-    const Eigen::Vector3f e = upper - lower;
-    return e.x() * e.y() + e.y() * e.z() + e.z() * e.x();
+    if (!(lower[0] <= upper[0] && lower[1] <= upper[1] && lower[2] <= upper[2])) return 0.f;
+    const float x = upper[0] - lower[0], y = upper[1] - lower[1], z = upper[2] - lower[2];
+    return x * y + y * z + z * x;
   }
 };
 
@@ -26,7 +38,7 @@ struct Box {
 // which part it is.
 struct Item {
   Box box;
-  Eigen::Vector3f centre;
+  Vec3 centre;
   std::int32_t part, index;
 };
 
@@ -39,7 +51,8 @@ class Builder {
     if (!items_.empty()) {
       Box all;
       for (const Item& item : items_) all.Extend(item.box);
-      bvh_.lower = all.lower, bvh_.upper = all.upper;
+      bvh_.lower = Eigen::Vector3f(all.lower.data());
+      bvh_.upper = Eigen::Vector3f(all.upper.data());
       bvh_.root = Subtree({0, items_.size(), all}, &bvh_.depth);
       bvh_.nodes.shrink_to_fit();
       bvh_.leaves.shrink_to_fit();
@@ -117,8 +130,8 @@ class Builder {
     const std::size_t begin = first->begin, end = first->end;
     Box centres;
     for (std::size_t i = begin; i < end; ++i) centres.Extend(items_[i].centre);
-    const Eigen::Vector3f extent = centres.upper - centres.lower;
-    Eigen::Vector3f scale;
+    Vec3 extent, scale;
+    for (int a = 0; a < 3; ++a) extent[a] = centres.upper[a] - centres.lower[a];
     // (A denormal extent gives an infinite scale: BinOf copes.)
     for (int a = 0; a < 3; ++a) scale[a] = extent[a] > 0.f ? float(kBins) / extent[a] : 0.f;
     // The axes tried: all three for small ranges, the longest extent's for
@@ -232,8 +245,11 @@ TriangleBvh BuildTriangleBvh(const std::vector<TriangleSoup>& parts) {
       }
       Item item;
       item.part = std::int32_t(p), item.index = std::int32_t(t);
-      for (int k = 0; k < 3; ++k) item.box.Extend(part.positions[index[k]]);
-      item.centre = 0.5f * (item.box.lower + item.box.upper);
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector3f& corner = part.positions[index[k]];
+        item.box.Extend(Vec3{corner.x(), corner.y(), corner.z()});
+      }
+      for (int a = 0; a < 3; ++a) item.centre[a] = 0.5f * (item.box.lower[a] + item.box.upper[a]);
       items.push_back(item);
     }
   }
