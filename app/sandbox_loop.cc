@@ -55,12 +55,12 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
       hooks_(std::move(hooks)),
       out_(out),
       err_(err),
-      loaded_(LoadCheckedLevel(options.level, {},
-                               options.isolate ? Isolation::kAlways : Isolation::kSceneFiles)),
-      world_(level_),
       log_(options.replay() ? std::make_unique<bridge::LogReader>(options.replay_file) : nullptr),
       // A replay feeds its inputs through an in-process link: nothing on the network.
       link_(options.replay() ? "memq://" : options.lcm_url),
+      loaded_(LoadCheckedLevel(options.level, {},
+                               options.isolate ? Isolation::kAlways : Isolation::kSceneFiles)),
+      world_(level_),
       reject_log_(&err),
       cameras_(level_, loaded_.cameras),
       stats_(PrepareOutDir(options)) {

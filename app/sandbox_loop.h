@@ -113,13 +113,14 @@ class SandboxLoop {
   std::ostream& out_;
   std::ostream& err_;
   StopRequest stop_;
+  // The replayed log and the link before the level: a bad file or URL fails at once.
+  std::unique_ptr<bridge::LogReader> log_;
+  bridge::LcmLink link_;
   const LoadedLevel loaded_;
   const scene::Level& level_{loaded_.level};
   scene::CollisionWorld world_;
   std::unique_ptr<scene::TerrainStreamer> terrain_;  // when the level has [[terrain]]
   std::vector<Eigen::Vector3d> robot_positions_;
-  std::unique_ptr<bridge::LogReader> log_;
-  bridge::LcmLink link_;
   sensors::RayCaster caster_;
   bridge::RejectLog reject_log_;
   std::vector<RobotRun> robots_;

@@ -375,6 +375,10 @@ TEST(RunCommandTest, BadFrameOptionsFailClearly) {
   const auto url = RunSandbox("run --duration 0.1 --lcm-url bogus://nowhere");
   EXPECT_EQ(url.exit_code, 1);
   EXPECT_NE(url.out.find("bogus://nowhere"), std::string::npos) << url.out;
+  // The URL is opened before the level loads: a mistyped URL fails at once, whatever the level.
+  const auto first = RunSandbox("run /nonexistent/level.toml --lcm-url bogus://nowhere");
+  EXPECT_EQ(first.exit_code, 1);
+  EXPECT_NE(first.out.find("bogus://nowhere"), std::string::npos) << first.out;
   const auto level = RunSandbox("run /nonexistent/level.toml --duration 0.1");
   EXPECT_EQ(level.exit_code, 1);
   EXPECT_NE(level.out.find("/nonexistent/level.toml"), std::string::npos) << level.out;
