@@ -30,6 +30,7 @@ struct LoadFigures {
   double collision_world_s{0.0};  // Bullet shapes and BVHs built
   double peak_memory_mib{0.0};
   int collision_objects{0};
+  std::size_t merged_static_triangles{0};  // CollisionWorld::merged_static_triangles
 };
 
 std::string JsonString(const std::string& text) {
@@ -105,6 +106,7 @@ void PrintJson(const Level& level, const std::vector<sensors::MountedSensor>& se
       << ", \"vertices\": " << vertices << ", \"materials\": " << level.materials.size()
       << ", \"textures\": " << level.textures.size()
       << ", \"collision_objects\": " << figures.collision_objects
+      << ", \"merged_static_triangles\": " << figures.merged_static_triangles
       << ", \"bounds_min\": " << JsonVector(Lo(level.bounds_W()))
       << ", \"bounds_max\": " << JsonVector(Hi(level.bounds_W())) << "},\n";
   out << std::fixed << std::setprecision(4) << "  \"load\": {\"level_s\": " << figures.level_s
@@ -167,6 +169,12 @@ void PrintText(const Level& level, const std::vector<sensors::MountedSensor>& se
   out << "\ntotal " << level.actors.size() << " actors, " << level.num_triangles() << " triangles, "
       << level.materials.size() << " materials, " << level.textures.size() << " embedded textures, "
       << figures.collision_objects << " collision objects\n";
+  out << "rays  " << (figures.merged_static_triangles > 0
+                          ? "the static actors' " + std::to_string(figures.merged_static_triangles) +
+                                " triangles in one hierarchy"
+                          : std::string("a hierarchy per object (fewer than two static objects, "
+                                        "or over 2^20 static triangles)"))
+      << "\n";
   out << "size  " << size.x() << " x " << size.y() << " x " << size.z() << " m, from ("
       << Lo(bounds).x() << ", " << Lo(bounds).y() << ", " << Lo(bounds).z() << ") to ("
       << Hi(bounds).x() << ", " << Hi(bounds).y() << ", " << Hi(bounds).z() << ")\n";
@@ -244,6 +252,7 @@ int RunInfo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     figures.collision_world_s = std::chrono::duration<double>(built - loaded).count();
     figures.peak_memory_mib = PeakResidentMiB();
     figures.collision_objects = world.num_collision_objects();
+    figures.merged_static_triangles = world.merged_static_triangles();
     if (json) {
       PrintJson(level, sensors, figures, out);
     } else {

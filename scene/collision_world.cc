@@ -248,4 +248,13 @@ int CollisionWorld::num_collision_objects() const {
 
 int CollisionWorld::num_parts() const { return impl_->num_parts; }
 
+std::size_t CollisionWorld::merged_static_triangles() const {
+  const std::shared_ptr<const TriangleBvh>& bvh = impl_->merged_static.bvh;
+  std::size_t triangles = 0;
+  if (bvh != nullptr) {
+    for (const TriangleBvh::Leaves& leaf : bvh->leaves) triangles += std::size_t(leaf.count);
+  }
+  return triangles;
+}
+
 }  // namespace sandbox::scene

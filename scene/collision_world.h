@@ -94,6 +94,10 @@ class CollisionWorld {
 
   int num_collision_objects() const;
   int num_parts() const;  // Bullet mesh parts over all shapes
+  // The static actors' triangles that rays walk in one hierarchy, or 0 when
+  // each object walks its own (fewer than two static objects, or over 2^20
+  // static triangles: then rays are slower).
+  std::size_t merged_static_triangles() const;
 
   // A number no other world of this process has, and one counting the
   // changes to its placements and origin: together they name the world's

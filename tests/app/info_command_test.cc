@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,36 @@ TEST(InfoCommandTest, JsonListsActorsTotalsAndLoadFigures) {
   EXPECT_NE(run.out.find("\"peak_memory_mib\": "), std::string::npos);
   EXPECT_EQ(Count(run.out, "{"), Count(run.out, "}"));
   EXPECT_EQ(Count(run.out, "["), Count(run.out, "]"));
+}
+
+// Whether the rays walk the static actors in one hierarchy: the count is the
+// static collision actors' triangles as the actor list gives them.
+TEST(InfoCommandTest, SaysWhetherTheStaticActorsShareOneHierarchy) {
+  const CommandRun json = Sandbox("info " + sandbox::testing::SampleLevel().string() + " --json");
+  ASSERT_EQ(json.exit_code, 0) << json.out;
+  const std::regex actor(
+      "\"triangles\": ([0-9]+), \"vertices\": [0-9]+, \"collision\": (true|false), "
+      "\"movable\": (true|false)");
+  std::size_t static_triangles = 0;
+  for (std::sregex_iterator it(json.out.begin(), json.out.end(), actor), end; it != end; ++it) {
+    if ((*it)[2] == "true" && (*it)[3] == "false") static_triangles += std::stoul((*it)[1]);
+  }
+  EXPECT_GT(static_triangles, 0u);
+  EXPECT_NE(json.out.find("\"merged_static_triangles\": " + std::to_string(static_triangles)),
+            std::string::npos)
+      << json.out;
+  const CommandRun text = Sandbox("info");
+  EXPECT_NE(text.out.find("rays  the static actors' " + std::to_string(static_triangles) +
+                          " triangles in one hierarchy"),
+            std::string::npos)
+      << text.out;
+  // One static actor: nothing to merge.
+  sandbox::testing::TempDir dir;
+  dir.Write("one.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const auto one = dir.Write("one.toml", "[[actor]]\nname = \"a\"\nfile = \"one.obj\"\n");
+  const CommandRun single = Sandbox("info " + one.string());
+  ASSERT_EQ(single.exit_code, 0) << single.out;
+  EXPECT_NE(single.out.find("rays  a hierarchy per object"), std::string::npos) << single.out;
 }
 
 TEST(InfoCommandTest, BadLevelsExitOneWithOneMessage) {

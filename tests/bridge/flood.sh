@@ -49,7 +49,7 @@ start_sandbox "$run_log" "$sandbox" run "$level" --lockstep --record "$record"
 check_pid=$!
 "$flood" ELAHA --seconds 4 --rate 2000 &
 flood_pid=$!
-"$fly_wing" --poses 300 --rate 100
+"$fly_wing" --poses 300 --rate 100 || status=1
 wait "$flood_pid"
 wait "$check_pid" || status=1
 stop "$sandbox_pid"
