@@ -121,8 +121,8 @@ void WriteFlyingWing(const std::filesystem::path& file) {
       const auto v0 = std::uint32_t(s * around + a),
                  v1 = std::uint32_t(s * around + (a + 1) % around);
       const auto w0 = v0 + around, w1 = v1 + around;
-      wing.AddTriangle(v0, v1, w1);
-      wing.AddTriangle(v0, w1, w0);
+      wing.AddTriangle(v0, w1, v1);  // counter-clockwise seen from outside
+      wing.AddTriangle(v0, w0, w1);
     }
   }
   for (const int end : {0, stations - 1}) {
@@ -133,9 +133,9 @@ void WriteFlyingWing(const std::filesystem::path& file) {
       const auto v0 = std::uint32_t(end * around + a),
                  v1 = std::uint32_t(end * around + (a + 1) % around);
       if (end == 0) {
-        wing.AddTriangle(centre, v1, v0);
-      } else {
         wing.AddTriangle(centre, v0, v1);
+      } else {
+        wing.AddTriangle(centre, v1, v0);
       }
     }
   }
