@@ -94,6 +94,13 @@ int BenchLooks(int rounds) {
     add(std::string(name) + " (color)", look(quality, color));
   }
   for (const auto& [name, quality] :
+       {std::pair{"plain", Quality::kPlain}, std::pair{"fast", Quality::kFast},
+        std::pair{"high", Quality::kHigh}}) {
+    render::RenderSettings every_face = look(quality, color);
+    every_face.cull_hidden_back_faces = false;
+    add(std::string(name) + ", every back face drawn", every_face);
+  }
+  for (const auto& [name, quality] :
        {std::pair{"fast", Quality::kFast}, std::pair{"high", Quality::kHigh}}) {
     render::RenderSettings forward = look(quality, color);
     forward.deferred = false;

@@ -19,6 +19,7 @@
 
 #include "sensors/render/deferred_shading.h"
 #include "sensors/render/detail_textures.h"
+#include "sensors/render/hidden_faces.h"
 #include "sensors/render/mesh_lods.h"
 #include "sensors/render/segmentation.h"
 #include "sensors/render/shaders.h"
@@ -104,6 +105,7 @@ struct GpuMesh {
   // what stays, its last level in colour.
   bool moving{false};
   mutable std::size_t level{0};
+  HiddenBackFaces hidden;  // where its back faces cannot be seen, in its own frame
   int material{-1};
   int surface{-1};  // a scene::Surface over the material's, -1: the material's
   std::uint32_t segment_base{0};
@@ -221,6 +223,7 @@ struct StaticChunk {
   std::vector<Eigen::Vector4f> colors;
   std::vector<std::uint32_t> segments, indices;
   Eigen::AlignedBox3f bounds;
+  HiddenBackFaces hidden;  // of the meshes it holds pieces of (one kind, see MergeStatic)
   bool any_uvs{false}, any_lightmap_uvs{false}, any_colors{false};
 };
 constexpr double kChunkCell_m = 128.0;
@@ -341,6 +344,9 @@ class OsMesaRenderer : public Renderer {
         gpu.surface = level.actors[a].surface ? int(*level.actors[a].surface) : -1;
         gpu.segment_base = legend_->actor(int(a));
         gpu.moving = true;
+        if (DrawnWhole(mesh.material, gpu.surface)) {
+          gpu.hidden = HiddenBackFaces::Of(mesh.positions_A, mesh.indices);
+        }
         actor_meshes_.push_back({int(a), gpu});
       }
     }
@@ -404,12 +410,14 @@ class OsMesaRenderer : public Renderer {
 
     // Camera-centred world: rotation only in the view; positions relative to the camera.
     camera_ = view.X_WC.translation();
+    cull_hidden_back_faces_ = settings.cull_hidden_back_faces;
     Eigen::Matrix3d R_EyeCam;
     R_EyeCam << 0, -1, 0, 0, 0, 1, -1, 0, 0;  // camera x forward, y left, z up -> GL eye
     Eigen::Matrix4d view_rotation = Eigen::Matrix4d::Identity();
     view_rotation.topLeftCorner<3, 3>() = R_EyeCam * view.X_WC.linear().transpose();
     const double f = 1.0 / std::tan(0.5 * view.fov_y_rad),
                  aspect = double(view.width) / view.height;
+    near_reach_m_ = view.near_m * std::sqrt(1.0 + (1.0 + aspect * aspect) / (f * f));
     // Reversed depth: 1 at near, 0 at far (with a float buffer, even precision over the range).
     const double n = view.near_m, fa = view.far_m;
     Eigen::Matrix4d projection = Eigen::Matrix4d::Zero();
@@ -853,20 +861,30 @@ class OsMesaRenderer : public Renderer {
     const bool moving = pass != Pass::kShadow || shadow_casters_ != Casters::kStill;
     const bool still = pass != Pass::kShadow || shadow_casters_ != Casters::kMoving;
     if (moving) {
-      for (const auto& [pose, meshes] : posed_robots_) {
-        for (const GpuMesh* mesh : meshes)
+      for (std::size_t r = 0; r < posed_robots_.size(); ++r) {
+        const auto& [pose, meshes] = posed_robots_[r];
+        // Its closed meshes as posed: the eye outside the robot's box.
+        const bool outside = robot_bounds_W_[r].exteriorDistance(camera_) > near_reach_m_;
+        for (const GpuMesh* mesh : meshes) {
+          CullBackFacesIf(outside && mesh->hidden.shape() == HiddenBackFaces::Shape::kSolid);
           Draw(*mesh, Relative(Eigen::Affine3d(pose.matrix()), camera_));
+        }
       }
       for (const auto& [actor, mesh] : actor_meshes_) {
-        if (!IsTranslucent(mesh)) Draw(mesh, actor_model(actor));
+        if (IsTranslucent(mesh)) continue;
+        CullHiddenBackFaces(mesh, (ActorPose(actor).inverse() * camera_).cast<float>());
+        Draw(mesh, actor_model(actor));
       }
     }
     if (still) {
       for (const auto& [distance, i] : static_order_) {
         const GpuMesh& mesh = static_meshes_[i].second;
         lod_error_m_ = chunk_error(i);
-        if (!IsTranslucent(mesh)) Draw(mesh, static_model);
+        if (IsTranslucent(mesh)) continue;
+        CullHiddenBackFaces(mesh, eye_S);
+        Draw(mesh, static_model);
       }
+      glDisable(GL_CULL_FACE);
       DrawTerrain();
     }
     if (horizon_.index_count > 0 && pass != Pass::kShadow) {
@@ -930,6 +948,31 @@ class OsMesaRenderer : public Renderer {
       if (depth <= cascades.back().far_m) error = std::min(error, float(cascades[c].texel_m) / 5.f);
     }
     return error;
+  }
+
+  // Whether meshes of this material and surface are drawn opaque and whole
+  // (not water, not cut out, not see-through): their back faces hide behind
+  // their front faces.
+  bool DrawnWhole(int material, int surface) const {
+    if (surface == int(scene::Surface::kWater)) return false;
+    if (material < 0 || material >= int(level_->materials.size())) return true;
+    const scene::Material& m = level_->materials[std::size_t(material)];
+    return m.surface != scene::Surface::kWater && m.alpha_mode != scene::AlphaMode::kMask &&
+           m.base_color.w() >= 0.999f;
+  }
+
+  // Back faces culled in a mesh's next draw where they cannot be seen from
+  // `eye` (in the mesh's frame; its axes keep their handedness). Not in
+  // shadow maps: the sun's view is not the eye's.
+  void CullHiddenBackFaces(const GpuMesh& mesh, const Eigen::Vector3f& eye) {
+    CullBackFacesIf(mesh.hidden.HiddenFrom(eye, float(near_reach_m_)));
+  }
+  void CullBackFacesIf(bool hidden) {
+    if (cull_hidden_back_faces_ && pass_ != Pass::kShadow && hidden) {
+      glEnable(GL_CULL_FACE);
+    } else {
+      glDisable(GL_CULL_FACE);
+    }
   }
 
   bool IsTranslucent(const GpuMesh& mesh) const {
@@ -1316,6 +1359,10 @@ class OsMesaRenderer : public Renderer {
                      bind.material, GL_DYNAMIC_DRAW));
           const int r = RobotIndex(model);
           meshes.back().moving = true;
+          // (Closed as made; its volume as first posed.)
+          if (DrawnWhole(bind.material, -1)) {
+            meshes.back().hidden = HiddenBackFaces::Of(state->positions_B(int(m)), bind.indices);
+          }
           meshes.back().segment_base = r >= 0 ? legend_->bone(r, 0) : 0xffffu;
           const auto groups = robot_groups_.find(&model);
           if (r >= 0 && groups != robot_groups_.end())
@@ -1370,7 +1417,10 @@ class OsMesaRenderer : public Renderer {
   void MergeStatic(const scene::Level& level) {
     origin_ = level.bounds_W().isEmpty() ? Eigen::Vector3d(Eigen::Vector3d::Zero())
                                          : Eigen::Vector3d(level.bounds_W().center());
-    std::map<std::tuple<int, int, long, long>, StaticChunk> chunks;
+    // By material, surface, ground cell and which back faces may go
+    // (-1: none, 0: those of solids, k + 1: those of height field k).
+    std::map<std::tuple<int, int, long, long, int>, StaticChunk> chunks;
+    int height_fields = 0;
     for (std::size_t a = 0; a < level.actors.size(); ++a) {
       const scene::Actor& actor = level.actors[a];
       if (actor.movable) continue;
@@ -1378,7 +1428,18 @@ class OsMesaRenderer : public Renderer {
       const Eigen::Matrix3d R = actor.X_WA.linear();
       for (const scene::Mesh& mesh : actor.meshes) {
         // This mesh's vertices already copied into each chunk.
-        std::map<std::tuple<int, int, long, long>, std::vector<std::int64_t>> copied;
+        std::map<std::tuple<int, int, long, long, int>, std::vector<std::int64_t>> copied;
+        std::vector<Eigen::Vector3f> positions_S(mesh.positions_A.size());  // the chunks' frame
+        for (std::size_t v = 0; v < positions_S.size(); ++v) {
+          positions_S[v] =
+              (actor.X_WA * mesh.positions_A[v].cast<double>() - origin_).cast<float>();
+        }
+        const HiddenBackFaces hidden = DrawnWhole(mesh.material, surface)
+                                           ? HiddenBackFaces::Of(positions_S, mesh.indices)
+                                           : HiddenBackFaces();
+        const int kind = hidden.shape() == HiddenBackFaces::Shape::kSolid         ? 0
+                         : hidden.shape() == HiddenBackFaces::Shape::kHeightField ? ++height_fields
+                                                                                  : -1;
         const bool has_uvs = mesh.uvs.size() == mesh.positions_A.size();
         const bool has_lightmap_uvs = mesh.lightmap_uvs.size() == mesh.positions_A.size();
         const bool has_colors = mesh.colors.size() == mesh.positions_A.size();
@@ -1389,12 +1450,17 @@ class OsMesaRenderer : public Renderer {
                    origin_;
           }
           const Eigen::Vector3d c = (p[0] + p[1] + p[2]) / 3.0;
-          const std::tuple<int, int, long, long> key{mesh.material, surface,
-                                                     std::lround(std::floor(c.x() / kChunkCell_m)),
-                                                     std::lround(std::floor(c.y() / kChunkCell_m))};
+          const std::tuple<int, int, long, long, int> key{
+              mesh.material, surface, std::lround(std::floor(c.x() / kChunkCell_m)),
+              std::lround(std::floor(c.y() / kChunkCell_m)), kind};
           StaticChunk& chunk = chunks[key];
           std::vector<std::int64_t>& map = copied[key];
-          if (map.empty()) map.assign(mesh.positions_A.size(), -1);
+          if (map.empty()) {
+            map.assign(mesh.positions_A.size(), -1);
+            // (A chunk of solids culls while the eye is outside all of their boxes.)
+            chunk.hidden =
+                chunk.indices.empty() ? hidden : HiddenBackFaces::Union(chunk.hidden, hidden);
+          }
           chunk.any_uvs = chunk.any_uvs || has_uvs;
           chunk.any_lightmap_uvs = chunk.any_lightmap_uvs || has_lightmap_uvs;
           chunk.any_colors = chunk.any_colors || has_colors;
@@ -1428,6 +1494,7 @@ class OsMesaRenderer : public Renderer {
                             &chunk.colors, &chunk.segments, nullptr, &lods},
                            std::get<0>(key), GL_STATIC_DRAW);
       gpu.surface = std::get<1>(key);
+      gpu.hidden = chunk.hidden;
       static_meshes_.push_back({chunk.bounds, gpu});
     }
   }
@@ -1832,6 +1899,8 @@ class OsMesaRenderer : public Renderer {
   std::vector<std::string> warnings_;
   // The frame being drawn.
   Pass pass_{Pass::kColor};
+  bool cull_hidden_back_faces_{true};
+  double near_reach_m_{0.0};  // from the eye to the near plane's corners
   Eigen::Matrix4f view_proj_{Eigen::Matrix4f::Identity()};
   Eigen::Vector3d camera_{Eigen::Vector3d::Zero()};
   const std::vector<Eigen::Isometry3d>* actor_poses_{nullptr};

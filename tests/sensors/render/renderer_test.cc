@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "app/images.h"
+#include "assets/generators/sample_terrain.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
 #include "sensors/face_scanner.h"
@@ -852,6 +853,68 @@ TEST(RendererLookTest, DeferredShadingMatchesForwardShading) {
     const int q = int(quality);
     EXPECT_LT(sum / (3.0 * double(pixels)), 1.5) << q;
     EXPECT_LT(double(far_off) / double(pixels), 0.005) << q;
+  }
+}
+
+// Culling the back faces that cannot be seen (hidden_faces.h) changes no
+// pixel but a few on silhouettes' edges. The sample level (its terrain a
+// height field; rocks, wall, tower, boulder, gate and the wing solids) with
+// every back face drawn is the reference: from the chase view, from half a
+// metre above the wing (culled, close by), and from where back faces do show
+// (each of these fails when culling ignores the eye): under the ground,
+// beside the terrain below its edge, 2 cm above the grass (the near plane
+// cuts it), inside the boulder and inside the wing.
+TEST(RendererLookTest, CullingHiddenBackFacesChangesNoPixel) {
+  const scene::Level level = scene::LoadLevel(testing::SampleLevel());
+  auto renderer = MakeRenderer();
+  renderer->SetLevel(level, {});
+  scene::RobotState wing(level.robots[0]);
+  wing.SetPose(Eigen::Translation3d(-40, -30, 25) * Eigen::AngleAxisd(0.6, Vector3d::UnitZ()));
+  wing.Update();
+  const double ground = assets::sample::TerrainHeight(60, 20);
+  struct Case {
+    std::string name;
+    Isometry3d X_WC;
+  };
+  const std::vector<Case> cases = {
+      {"chase", ChaseCamera({}).Update(wing.pose(), 0.0)},
+      {"under the ground", LookAt(Vector3d(10, 10, -40), Vector3d(30, 40, 20))},
+      {"beside the terrain", LookAt(Vector3d(260, 0, -2), Vector3d(150, 0, 6))},
+      {"a hair above the grass", LookAt(Vector3d(60, 20, ground + 0.02), Vector3d(90, 40, ground))},
+      {"inside the boulder", LookAt(Vector3d(70, -60, 22.6), Vector3d(80, -55, 22))},
+      {"inside the wing", LookAt(wing.pose() * Vector3d(0, 0, 0), wing.pose() * Vector3d(0, 5, 0))},
+      {"above the wing",
+       LookAt(wing.pose() * Vector3d(0, 0, 0.5), wing.pose() * Vector3d(-2, 8, 0))}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    CameraView view;
+    view.X_WC = c.X_WC;
+    for (const Quality quality : {Quality::kPlain, Quality::kFast}) {
+      // Colour alone (levels of detail, deferred shading in the fast look)
+      // and the measurement images (drawn as given).
+      for (const ImageKinds kinds :
+           {ImageKinds(kColorImage), ImageKinds(kDepthImage | kSegmentationImage)}) {
+        RenderSettings settings = RenderSettings::Preset(quality);
+        settings.images = kinds;
+        Frame culled, every_face;
+        renderer->Render(view, {}, {&wing}, settings, &culled);
+        settings.cull_hidden_back_faces = false;
+        renderer->Render(view, {}, {&wing}, settings, &every_face);
+        std::size_t differ = 0;
+        for (std::size_t i = 0; i < culled.rgb.size(); ++i) {
+          differ += culled.rgb[i] != every_face.rgb[i];
+        }
+        for (std::size_t i = 0; i < culled.depth_m.size(); ++i) {
+          differ += culled.depth_m[i] != every_face.depth_m[i];
+        }
+        for (std::size_t i = 0; i < culled.segment.size(); ++i) {
+          differ += culled.segment[i] != every_face.segment[i];
+        }
+        // (A pixel whose centre lies on a silhouette's edge may have gone to
+        // the back face there: a few at most.)
+        EXPECT_LE(differ, 15u) << int(quality) << " " << kinds;
+      }
+    }
   }
 }
 
