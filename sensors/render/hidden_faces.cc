@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <iterator>
 #include <map>
 #include <numeric>
-#include <unordered_map>
 
 #include "sensors/render/mesh_lods.h"
 
@@ -67,8 +67,9 @@ HiddenBackFaces HiddenBackFaces::Of(const std::vector<Eigen::Vector3f>& position
     if (a != b && b != c && c != a) triangles.push_back({a, b, c});
   }
   if (triangles.empty()) return {};
-  // Per edge (lower vertex first), how often it is run upwards and downwards.
-  std::unordered_map<std::uint64_t, std::array<int, 2>> edges;
+  // The edges (lower vertex first) run upwards and downwards, sorted.
+  std::vector<std::uint64_t> up, down;
+  up.reserve(3 * triangles.size()), down.reserve(3 * triangles.size());
   std::vector<std::uint32_t> piece(positions.size());
   std::iota(piece.begin(), piece.end(), 0u);
   auto find = [&](std::uint32_t v) {
@@ -79,16 +80,16 @@ HiddenBackFaces HiddenBackFaces::Of(const std::vector<Eigen::Vector3f>& position
   for (const auto& t : triangles) {
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t a = t[std::size_t(k)], b = t[std::size_t((k + 1) % 3)];
-      ++edges[std::uint64_t(std::min(a, b)) << 32 | std::max(a, b)][a < b ? 0 : 1];
+      (a < b ? up : down).push_back(std::uint64_t(std::min(a, b)) << 32 | std::max(a, b));
       piece[find(a)] = find(b);
       out.box_.extend(positions[a]);
     }
   }
-  bool balanced = true, at_most_once = true;
-  for (const auto& [edge, runs] : edges) {
-    balanced = balanced && runs[0] == runs[1];
-    at_most_once = at_most_once && runs[0] <= 1 && runs[1] <= 1;
-  }
+  std::sort(up.begin(), up.end());
+  std::sort(down.begin(), down.end());
+  const bool balanced = up == down;
+  const bool at_most_once = std::adjacent_find(up.begin(), up.end()) == up.end() &&
+                            std::adjacent_find(down.begin(), down.end()) == down.end();
   auto p = [&](std::uint32_t v) { return Vector3d(positions[v].cast<double>()); };
   if (balanced) {
     // Each piece's volume, from a corner of its own (small sums, little cancellation).
@@ -114,15 +115,22 @@ HiddenBackFaces HiddenBackFaces::Of(const std::vector<Eigen::Vector3f>& position
   }
   // ... the open edges on the footprint's hull, ...
   std::vector<Vector2d> points;
+  std::vector<bool> taken(positions.size(), false);
   for (const auto& t : triangles) {
-    for (const std::uint32_t v : t) points.push_back(p(v).head<2>());
+    for (const std::uint32_t v : t) {
+      if (!taken[v]) points.push_back(p(v).head<2>());
+      taken[v] = true;
+    }
   }
   const std::vector<Vector2d> hull = Hull(std::move(points));
   if (hull.size() < 3) return {};
   const Eigen::Vector3f extent = out.box_.sizes();
   const double tolerance = 1e-5 * double(std::max(extent.x(), extent.y()));
-  for (const auto& [edge, runs] : edges) {
-    if (runs[0] + runs[1] != 1) continue;
+  // (Run once: in one list and not the other.)
+  std::vector<std::uint64_t> open;
+  std::set_symmetric_difference(up.begin(), up.end(), down.begin(), down.end(),
+                                std::back_inserter(open));
+  for (const std::uint64_t edge : open) {
     const Vector2d a = p(std::uint32_t(edge >> 32)).head<2>(),
                    b = p(std::uint32_t(edge & 0xffffffffu)).head<2>();
     for (const Vector2d& q : {a, b, Vector2d(0.5 * (a + b))}) {
