@@ -28,7 +28,8 @@ CameraKind ParseCameraKind(const scene::SensorSpec& spec) {
                           scene::ChoiceList(types) + ", got '" + spec.type + "'");
 }
 
-// quality, shadows, fxaa, msaa, haze, anisotropy, lod_px, images: the camera's look.
+// quality, shadows, fxaa, msaa, haze, anisotropy, lod_px, cull_hidden_back_faces,
+// images: the camera's look.
 void ReadLook(const scene::SensorSpec& spec, scene::SettingsReader* read, RenderSettings* look) {
   try {
     *look = RenderSettings::Preset(ParseQuality(read->Text("quality", "fast")));
@@ -51,6 +52,8 @@ void ReadLook(const scene::SensorSpec& spec, scene::SettingsReader* read, Render
     read->Fail("lod_px", "'lod_px' must be 0 (meshes as given) to 8 pixels");
   }
   look->lod_px = float(lod_px);
+  look->cull_hidden_back_faces =
+      read->Flag("cull_hidden_back_faces", look->cull_hidden_back_faces);
   look->images = kColorImage;
   if (read->Has("images")) {
     look->images = 0;

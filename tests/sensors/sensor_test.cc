@@ -253,6 +253,9 @@ TEST(SensorTest, CameraMistakesNameTheCameraAndField) {
   EXPECT_EQ(CameraError("type = \"chase\"\nlod_px = -1\n"),
             "level.toml:9: camera 'c': 'lod_px' must be 0 (meshes as given) to 8 pixels");
   EXPECT_EQ(CameraError("type = \"chase\"\nlod_px = 0.5\n"), "no error");
+  EXPECT_EQ(CameraError("type = \"chase\"\ncull_hidden_back_faces = false\n"), "no error");
+  EXPECT_EQ(CameraError("type = \"chase\"\ncull_hidden_back_faces = 1\n"),
+            "level.toml:9: camera 'c': 'cull_hidden_back_faces' must be true or false");
   EXPECT_EQ(CameraError("type = \"payload\"\nmount = \"link6\"\noverlay = true\n"), "no error");
 }
 
