@@ -153,14 +153,8 @@ HiddenBackFaces HiddenBackFaces::Of(const std::vector<Eigen::Vector3f>& position
   for (const auto& t : triangles) {
     Eigen::AlignedBox3f box;
     for (const std::uint32_t v : t) box.extend(positions[v]);
-    const Eigen::Vector2f low =
-        (box.min().head<2>() - out.box_.min().head<2>()).cwiseQuotient(out.cell_size_);
-    const Eigen::Vector2f high =
-        (box.max().head<2>() - out.box_.min().head<2>()).cwiseQuotient(out.cell_size_);
-    const int x0 = std::clamp(int(std::floor(low.x())), 0, side - 1),
-              x1 = std::clamp(int(std::floor(high.x())), 0, side - 1);
-    const int y0 = std::clamp(int(std::floor(low.y())), 0, side - 1),
-              y1 = std::clamp(int(std::floor(high.y())), 0, side - 1);
+    int x0, x1, y0, y1;
+    out.Cells(box.min().head<2>(), box.max().head<2>(), &x0, &x1, &y0, &y1);
     for (int y = y0; y <= y1; ++y) {
       for (int x = x0; x <= x1; ++x) {
         float& top = out.top_[std::size_t(y * side + x)];
@@ -169,6 +163,17 @@ HiddenBackFaces HiddenBackFaces::Of(const std::vector<Eigen::Vector3f>& position
     }
   }
   return out;
+}
+
+void HiddenBackFaces::Cells(const Eigen::Vector2f& low, const Eigen::Vector2f& high, int* x0,
+                            int* x1, int* y0, int* y1) const {
+  auto cell = [&](float v, float origin, float size, int count) {
+    return std::clamp(int(std::floor((v - origin) / size)), 0, count - 1);
+  };
+  *x0 = cell(low.x(), box_.min().x(), cell_size_.x(), cells_x_);
+  *x1 = cell(high.x(), box_.min().x(), cell_size_.x(), cells_x_);
+  *y0 = cell(low.y(), box_.min().y(), cell_size_.y(), cells_y_);
+  *y1 = cell(high.y(), box_.min().y(), cell_size_.y(), cells_y_);
 }
 
 HiddenBackFaces HiddenBackFaces::Union(const HiddenBackFaces& a, const HiddenBackFaces& b) {
@@ -192,15 +197,9 @@ bool HiddenBackFaces::HiddenFrom(const Eigen::Vector3f& eye, float near_reach) c
         if ((b - a).x() * (e - a).y() - (b - a).y() * (e - a).x() <= 0.f) return false;
       }
       // Higher than the surface anywhere within the near plane's reach.
-      const Eigen::Vector2f low = (e - Eigen::Vector2f::Constant(near_reach) - box_.min().head<2>())
-                                      .cwiseQuotient(cell_size_);
-      const Eigen::Vector2f high =
-          (e + Eigen::Vector2f::Constant(near_reach) - box_.min().head<2>())
-              .cwiseQuotient(cell_size_);
-      const int x0 = std::clamp(int(std::floor(low.x())), 0, cells_x_ - 1),
-                x1 = std::clamp(int(std::floor(high.x())), 0, cells_x_ - 1);
-      const int y0 = std::clamp(int(std::floor(low.y())), 0, cells_y_ - 1),
-                y1 = std::clamp(int(std::floor(high.y())), 0, cells_y_ - 1);
+      int x0, x1, y0, y1;
+      Cells(e - Eigen::Vector2f::Constant(near_reach), e + Eigen::Vector2f::Constant(near_reach),
+            &x0, &x1, &y0, &y1);
       for (int y = y0; y <= y1; ++y) {
         for (int x = x0; x <= x1; ++x) {
           if (!(eye.z() - near_reach > top_[std::size_t(y * cells_x_ + x)])) return false;

@@ -46,6 +46,10 @@ class HiddenBackFaces {
   bool HiddenFrom(const Eigen::Vector3f& eye, float near_reach) const;
 
  private:
+  // The range of cells (clamped to the grid) under the x, y box [low, high].
+  void Cells(const Eigen::Vector2f& low, const Eigen::Vector2f& high, int* x0, int* x1, int* y0,
+             int* y1) const;
+
   Shape shape_{Shape::kNone};
   Eigen::AlignedBox3f box_;
   // Height fields: the footprint's hull (counter-clockwise) and the highest

@@ -816,18 +816,29 @@ TEST(RendererWingTest, BendingMovesTheSilhouetteToTheAnalyticTip) {
   EXPECT_TRUE(is_sky(frame_straight)) << px.transpose();  // the straight wing is not
 }
 
+// The sample level with its wing mid-turn, as bench_render's looks show it.
+struct SampleWithWing {
+  SampleWithWing()
+      : level(scene::LoadLevel(testing::SampleLevel())), renderer(MakeRenderer()),
+        wing(level.robots[0]) {
+    renderer->SetLevel(level, {});
+    wing.SetPose(Eigen::Translation3d(-40, -30, 25) * Eigen::AngleAxisd(0.6, Vector3d::UnitZ()));
+    wing.Update();
+  }
+  scene::Level level;
+  std::unique_ptr<Renderer> renderer;
+  scene::RobotState wing;
+};
+
 // Deferred shading (the CPU's lighting of the G-buffer) against forward
 // shading (llvmpipe's, as the scene programs draw) on the sample level's chase
 // view: terrain, lake, tower, wing, their shadows, haze and sky. The two
 // implement one look; they differ by rounding, by the detail texture's level
 // at silhouettes and by the shadow lookups' levels-of-detail offset.
 TEST(RendererLookTest, DeferredShadingMatchesForwardShading) {
-  const scene::Level level = scene::LoadLevel(testing::SampleLevel());
-  auto renderer = MakeRenderer();
-  renderer->SetLevel(level, {});
-  scene::RobotState wing(level.robots[0]);
-  wing.SetPose(Eigen::Translation3d(-40, -30, 25) * Eigen::AngleAxisd(0.6, Vector3d::UnitZ()));
-  wing.Update();
+  SampleWithWing sample;
+  scene::RobotState& wing = sample.wing;
+  Renderer* renderer = sample.renderer.get();
   CameraView view;
   view.X_WC = ChaseCamera({}).Update(wing.pose(), 0.0);
   for (const Quality quality : {Quality::kFast, Quality::kHigh}) {
@@ -865,12 +876,9 @@ TEST(RendererLookTest, DeferredShadingMatchesForwardShading) {
 // beside the terrain below its edge, 2 cm above the grass (the near plane
 // cuts it), inside the boulder and inside the wing.
 TEST(RendererLookTest, CullingHiddenBackFacesChangesNoPixel) {
-  const scene::Level level = scene::LoadLevel(testing::SampleLevel());
-  auto renderer = MakeRenderer();
-  renderer->SetLevel(level, {});
-  scene::RobotState wing(level.robots[0]);
-  wing.SetPose(Eigen::Translation3d(-40, -30, 25) * Eigen::AngleAxisd(0.6, Vector3d::UnitZ()));
-  wing.Update();
+  SampleWithWing sample;
+  scene::RobotState& wing = sample.wing;
+  Renderer* renderer = sample.renderer.get();
   const double ground = assets::sample::TerrainHeight(60, 20);
   struct Case {
     std::string name;
