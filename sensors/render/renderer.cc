@@ -1429,10 +1429,12 @@ class OsMesaRenderer : public Renderer {
       for (const scene::Mesh& mesh : actor.meshes) {
         // This mesh's vertices already copied into each chunk.
         std::map<std::tuple<int, int, long, long, int>, std::vector<std::int64_t>> copied;
-        std::vector<Eigen::Vector3f> positions_S(mesh.positions_A.size());  // the chunks' frame
-        for (std::size_t v = 0; v < positions_S.size(); ++v) {
-          positions_S[v] =
-              (actor.X_WA * mesh.positions_A[v].cast<double>() - origin_).cast<float>();
+        // Its vertices in the chunks' frame, once each.
+        std::vector<Eigen::Vector3d> p_S(mesh.positions_A.size());
+        std::vector<Eigen::Vector3f> positions_S(p_S.size());
+        for (std::size_t v = 0; v < p_S.size(); ++v) {
+          p_S[v] = actor.X_WA * mesh.positions_A[v].cast<double>() - origin_;
+          positions_S[v] = p_S[v].cast<float>();
         }
         const HiddenBackFaces hidden = DrawnWhole(mesh.material, surface)
                                            ? HiddenBackFaces::Of(positions_S, mesh.indices)
@@ -1444,12 +1446,9 @@ class OsMesaRenderer : public Renderer {
         const bool has_lightmap_uvs = mesh.lightmap_uvs.size() == mesh.positions_A.size();
         const bool has_colors = mesh.colors.size() == mesh.positions_A.size();
         for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
-          Eigen::Vector3d p[3];
-          for (int k = 0; k < 3; ++k) {
-            p[k] = actor.X_WA * mesh.positions_A[mesh.indices[t + std::size_t(k)]].cast<double>() -
-                   origin_;
-          }
-          const Eigen::Vector3d c = (p[0] + p[1] + p[2]) / 3.0;
+          const Eigen::Vector3d c = (p_S[mesh.indices[t]] + p_S[mesh.indices[t + 1]] +
+                                     p_S[mesh.indices[t + 2]]) /
+                                    3.0;
           const std::tuple<int, int, long, long, int> key{
               mesh.material, surface, std::lround(std::floor(c.x() / kChunkCell_m)),
               std::lround(std::floor(c.y() / kChunkCell_m)), kind};
@@ -1468,7 +1467,7 @@ class OsMesaRenderer : public Renderer {
             const std::uint32_t v = mesh.indices[t + std::size_t(k)];
             if (map[v] < 0) {
               map[v] = std::int64_t(chunk.positions.size());
-              chunk.positions.push_back(p[k].cast<float>());
+              chunk.positions.push_back(positions_S[v]);
               chunk.normals.push_back((R * mesh.normals_A[v].cast<double>()).cast<float>());
               chunk.uvs.push_back(has_uvs ? mesh.uvs[v] : Eigen::Vector2f::Zero());
               chunk.lightmap_uvs.push_back(has_lightmap_uvs ? mesh.lightmap_uvs[v]
