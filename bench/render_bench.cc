@@ -13,7 +13,9 @@
 //     without levels of detail), and each image kind, against the plain look
 //     in the same run (ratio); the looks take turns a frame at a time.
 //
-//   bench_render [--seconds S] [--looks [--rounds N]]   (--looks: section 4 only)
+//   bench_render [--seconds S] [--looks [--rounds N] [--only NAME]]
+//   (--looks: section 4 only; --only: the look of that row name alone, beside
+//   plain colour: a quick A/B or a profile of one look)
 
 #include <algorithm>
 #include <atomic>
@@ -63,7 +65,7 @@ struct LookRow {
   std::vector<double> ms;
 };
 
-int BenchLooks(int rounds) {
+int BenchLooks(int rounds, const std::string& only) {
   const scene::Level level =
       scene::LoadLevel(std::string(SANDBOX_SOURCE_DIR) + "/assets/sample/level.toml");
   scene::RobotState wing(level.robots[0]);
@@ -81,7 +83,11 @@ int BenchLooks(int rounds) {
   const render::ImageKinds color_depth(render::kColorImage | render::kDepthImage);
   std::vector<std::pair<std::string, render::RenderSettings>> settings;
   std::vector<double> steps;
+  std::vector<std::string> names;
   auto add = [&](const std::string& name, const render::RenderSettings& s, double step_m = 0.0) {
+    names.push_back(name);
+    // --only NAME: that row alone after the first (plain colour, the ratios' base).
+    if (!settings.empty() && !only.empty() && name != only) return;
     settings.emplace_back(name, s);
     steps.push_back(step_m);
   };
@@ -131,6 +137,11 @@ int BenchLooks(int rounds) {
         std::pair{"depth only", render::ImageKinds(render::kDepthImage)},
         std::pair{"segmentation only", render::ImageKinds(render::kSegmentationImage)}}) {
     add(name, look(Quality::kHigh, kinds));
+  }
+  if (!only.empty() && settings.size() == 1 && only != names.front()) {
+    std::fprintf(stderr, "bench_render: --only '%s' names no look; the looks are:\n", only.c_str());
+    for (const std::string& name : names) std::fprintf(stderr, "  %s\n", name.c_str());
+    return 2;
   }
   std::printf(
       "looks: sample level, chase camera, wing mid-turn; the rows take turns a frame at a "
@@ -196,12 +207,14 @@ int main(int argc, char** argv) {
   double seconds = 5.0;
   bool looks_only = false;
   int rounds = 15;
+  std::string only;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--seconds") && i + 1 < argc) seconds = std::atof(argv[++i]);
     if (!std::strcmp(argv[i], "--looks")) looks_only = true;
     if (!std::strcmp(argv[i], "--rounds") && i + 1 < argc) rounds = std::atoi(argv[++i]);
+    if (!std::strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
   }
-  if (looks_only) return BenchLooks(std::max(rounds, 1));
+  if (looks_only) return BenchLooks(std::max(rounds, 1), only);
   // 1. Chase camera, render thread + encoder thread.
   {
     const scene::Level level =
