@@ -396,8 +396,12 @@ struct FaceCase {
   double resolution_m{1.0}, half_extent_m{25.0};
 };
 
+// Face scans at X_WS; lidar sweeps at X_WL (where each beam meets a surface
+// some way off, not at its start).
 void RunLevel(const char* name, const fs::path& file, const Eigen::Isometry3d& X_WS,
-              const FaceCase& face_case, double seconds, int show) {
+              const FaceCase& face_case, double seconds, int show,
+              const Eigen::Isometry3d* X_WL = nullptr) {
+  const Eigen::Isometry3d& X_WLidar = X_WL != nullptr ? *X_WL : X_WS;
   const scene::Level level = scene::LoadLevel(file);
   const scene::CollisionWorld world(level);
   const EmbreeScene fast(world, false), watertight(world, true);
@@ -414,11 +418,11 @@ void RunLevel(const char* name, const fs::path& file, const Eigen::Isometry3d& X
   Compare(name, "face, grid", world, embree, face_rays, seconds, show, &face_grids);
   sensors::RaySweep sweep;
   const sensors::Lidar lidar16(sensors::LidarConfig::Uniform(16, -15, 15, 1024, 100.0));
-  const sensors::RayBatch rays16 = lidar16.Rays(X_WS, X_WS, &sweep);
+  const sensors::RayBatch rays16 = lidar16.Rays(X_WLidar, X_WLidar, &sweep);
   Compare(name, "lidar 16x1024", world, embree, rays16, seconds, show);
   Compare(name, "16x1024, sweep", world, embree, rays16, seconds, show, nullptr, &sweep);
   const sensors::Lidar lidar64(sensors::LidarConfig::Uniform(64, -25, 15, 2048, 100.0));
-  const sensors::RayBatch rays64 = lidar64.Rays(X_WS, X_WS, &sweep);
+  const sensors::RayBatch rays64 = lidar64.Rays(X_WLidar, X_WLidar, &sweep);
   Compare(name, "lidar 64x2048", world, embree, rays64, seconds, show);
   Compare(name, "64x2048, sweep", world, embree, rays64, seconds, show, nullptr, &sweep);
 }
@@ -538,8 +542,11 @@ int main(int argc, char** argv) {
       const fs::path q3 = fs::path(SANDBOX_SHARED_ASSETS) / "q3-de4th-run1/de4th_run1.pk3";
       if (fs::exists(q3)) {
         const Eigen::Vector3d middle = scene::LoadLevel(q3).bounds_W().center();
+        // The middle lies on a wall's plane (every beam from it hits at 0 m);
+        // the lidar stands in the hall below, where every beam hits 7-56 m off.
+        const Eigen::Isometry3d hall(Eigen::Translation3d(middle + Eigen::Vector3d(0, -10, -30)));
         RunLevel("quake3-map", q3, Eigen::Isometry3d(Eigen::Translation3d(middle)), face_case,
-                 seconds, show);
+                 seconds, show, &hall);
       }
     }
   } catch (const std::exception& error) {
