@@ -4,9 +4,25 @@
 // its trees within about log_1.5(triangles) levels (37 for its 2^21-triangle
 // limit), so the heap is the exception.
 
+#include <cstdint>
 #include <vector>
 
 namespace sandbox::sensors {
+
+// A packet walk's stack entry: a hierarchy reference and the lanes that
+// entered its box, in one word, written and read whole (an entry stored in
+// two parts and loaded as one stalls the load until both stores retire).
+class WalkEntry {
+ public:
+  WalkEntry() = default;
+  WalkEntry(std::int32_t ref, std::uint32_t lanes)
+      : bits_(std::uint32_t(ref) | std::uint64_t(lanes) << 32) {}
+  std::int32_t ref() const { return std::int32_t(std::uint32_t(bits_)); }
+  std::uint32_t lanes() const { return std::uint32_t(bits_ >> 32); }
+
+ private:
+  std::uint64_t bits_{0};
+};
 
 template <typename T, int kInPlace>
 class WalkStack {
