@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <thread>
 
 #include "assets/generators/gltf_writer.h"
 
@@ -39,6 +40,20 @@ std::filesystem::path WriteMillionTriangleLevel(const std::filesystem::path& dir
 double Median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
   return values[values.size() / 2];
+}
+
+std::string Machine() {
+  std::string model = "unknown CPU";
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  for (std::string line; std::getline(cpuinfo, line);) {
+    const std::size_t colon = line.find(':');
+    if (line.rfind("model name", 0) != 0 || colon == std::string::npos) continue;
+    const std::size_t start = line.find_first_not_of(" \t", colon + 1);
+    if (start != std::string::npos) model = line.substr(start);
+    break;
+  }
+  return "machine: " + model + ", " + std::to_string(std::thread::hardware_concurrency()) +
+         " logical CPUs";
 }
 
 }  // namespace sandbox::bench

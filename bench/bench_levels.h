@@ -1,5 +1,6 @@
 #pragma once
-// What the benchmarks share: generated terrain levels and a median.
+// What the benchmarks share: generated terrain levels, a median and the
+// machine they ran on.
 
 #include <filesystem>
 #include <string>
@@ -17,5 +18,10 @@ std::filesystem::path WriteTerrainLevel(const std::filesystem::path& dir, const 
 std::filesystem::path WriteMillionTriangleLevel(const std::filesystem::path& dir);
 
 double Median(std::vector<double> values);
+
+// The machine, for the first line of a benchmark's output (figures differ
+// by about 2x between machines of one kind): "machine: <CPU model>, <n>
+// logical CPUs", the model from /proc/cpuinfo ("unknown CPU" without it).
+std::string Machine();
 
 }  // namespace sandbox::bench

@@ -107,6 +107,7 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  std::printf("%s\n", sandbox::bench::Machine().c_str());
   const fs::path dir = keep.empty() ? fs::temp_directory_path() / "sandbox-bench-load" : keep;
   std::printf("generating the 1M-triangle level in %s ...\n", dir.c_str());
   std::fflush(stdout);

@@ -69,6 +69,7 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  std::printf("%s\n", bench::Machine().c_str());
   std::printf("%-12s %8s %10s %10s %10s %10s %8s\n", "level", "objects", "move p50", "move max",
               "scan ms", "after move", "ratio");
   Run("sample", fs::path(SANDBOX_SOURCE_DIR) / "assets/sample/level.toml", {20, -25, 22}, moves);

@@ -518,7 +518,7 @@ int main(int argc, char** argv) {
                  "  --show N: print the first N rays that disagree with watertight Embree\n");
     return 2;
   }
-  std::printf("ray kernel: %s\n", sensors::RayCaster::kernel());
+  std::printf("%s\nray kernel: %s\n", bench::Machine().c_str(), sensors::RayCaster::kernel());
   std::printf("%-12s %-14s %7s %2s %7s %7s %7s %11s %7s %12s %8s %14s\n", "level", "rays", "count",
               "th", "ours", "Embree1", "ratio", "Embree best", "ratio", "mismatches", "diff mm",
               "rayTest");

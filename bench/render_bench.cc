@@ -214,6 +214,7 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--rounds") && i + 1 < argc) rounds = std::atoi(argv[++i]);
     if (!std::strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
   }
+  std::printf("%s\n", bench::Machine().c_str());
   if (looks_only) return BenchLooks(std::max(rounds, 1), only);
   // 1. Chase camera, render thread + encoder thread.
   {
