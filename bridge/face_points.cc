@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace sandbox::bridge {
 namespace {
@@ -54,7 +56,33 @@ void EncodeCompactFace(const sensors::FaceScan& scan, int f,
   }
 }
 
+void CheckCompactFace(const sandbox_msgs::scan_face_compact_t& message) {
+  const auto fail = [](const std::string& what) {
+    throw std::invalid_argument("bridge::DecodeCompactFace(): " + what);
+  };
+  if (message.face < 0 || message.face > 5)
+    fail("face " + std::to_string(message.face) + " is not 0..5");
+  if (message.encoding != 1 && message.encoding != 2)
+    fail("encoding " + std::to_string(message.encoding) + " is neither 1 (mm) nor 2 (m)");
+  const double E = message.half_extent_m, res = message.resolution_m;
+  if (!std::isfinite(E) || !std::isfinite(res) || E <= 0 || res <= 0)
+    fail("half_extent_m " + std::to_string(E) + " and resolution_m " + std::to_string(res) +
+         " must be finite and > 0");
+  // The data's size bounds n before anything is allocated: n^2 cells, as sent.
+  const std::int64_t sent = message.encoding == 1 ? message.num_mm : message.num_m;
+  const std::size_t held =
+      message.encoding == 1 ? message.distance_mm.size() : message.distance_m.size();
+  if (message.n < 1 || std::int64_t(message.n) * message.n != sent || std::size_t(sent) != held)
+    fail("n = " + std::to_string(message.n) + " needs n^2 distances, the message holds " +
+         std::to_string(held));
+  const double expected_n = 2.0 * E / res + 1.0;
+  if (std::abs(expected_n - message.n) > 0.5)
+    fail("n = " + std::to_string(message.n) + " does not match 2 half_extent_m / resolution_m + 1 = " +
+         std::to_string(expected_n));
+}
+
 FacePoints DecodeCompactFace(const sandbox_msgs::scan_face_compact_t& message) {
+  CheckCompactFace(message);
   const int n = message.n;
   const double E = message.half_extent_m, res = message.resolution_m;
   const Eigen::Vector3d p(message.sensor_position[0], message.sensor_position[1],
@@ -73,7 +101,6 @@ FacePoints DecodeCompactFace(const sandbox_msgs::scan_face_compact_t& message) {
   FacePoints out;
   out.points_W.assign(cells, Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
   out.occupancy.assign(cells, sensors::kUnvisited);
-  if (std::size_t(millimetres ? message.num_mm : message.num_m) != cells) return out;
   for (int r = 0; r < n; ++r) {
     for (int c = 0; c < n; ++c) {
       const std::size_t k = std::size_t(r) * std::size_t(n) + std::size_t(c);

@@ -27,6 +27,11 @@ struct FacePoints {
   std::vector<Eigen::Vector3d> points_W;
   std::vector<std::int8_t> occupancy;
 };
+// Throws std::invalid_argument naming the field when the message is not a
+// face (face not 0..5, unknown encoding, n^2 not the number of distances
+// sent, n not 2 half_extent_m / resolution_m + 1): checked before anything
+// is allocated, so a lying n costs nothing.
+void CheckCompactFace(const sandbox_msgs::scan_face_compact_t& message);
 FacePoints DecodeCompactFace(const sandbox_msgs::scan_face_compact_t& message);
 
 }  // namespace sandbox::bridge

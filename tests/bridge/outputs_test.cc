@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "bridge/checked_decode.h"
 #include "bridge/face_points.h"
 #include "bridge/lcm_link.h"
 #include "sandbox_msgs/ground_map_t.hpp"
@@ -330,6 +331,55 @@ TEST(CompactFaceTest, DistancesBeyondTheMillimetreRangeAreMarkedNeverWrapped) {
     EXPECT_EQ(decoded.occupancy[k], sensors::kOccupied);
     EXPECT_TRUE(std::isnan(decoded.points_W[k].x()));
   }
+}
+
+// Crafted messages that pass the layout check (DecodeChecked) but are not
+// faces: refused by the decoder before it allocates, the field named.
+TEST(CompactFaceTest, AMessageThatIsNotAFaceIsRefusedBeforeAnythingIsAllocated) {
+  const auto through_the_wire = [](const sandbox_msgs::scan_face_compact_t& message) {
+    std::vector<std::uint8_t> bytes(std::size_t(message.getEncodedSize()));
+    message.encode(bytes.data(), 0, int(bytes.size()));
+    sandbox_msgs::scan_face_compact_t decoded;
+    EXPECT_EQ(DecodeChecked(bytes.data(), bytes.size(), &decoded), "");
+    return decoded;
+  };
+  const auto refusal = [&](const sandbox_msgs::scan_face_compact_t& message) -> std::string {
+    try {
+      DecodeCompactFace(through_the_wire(message));
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  sandbox_msgs::scan_face_compact_t good{};
+  good.face = 2, good.n = 3, good.resolution_m = 1.0, good.half_extent_m = 1.0;
+  good.encoding = 1, good.num_mm = 9, good.distance_mm.assign(9, std::int16_t(-1));
+  EXPECT_EQ(DecodeCompactFace(through_the_wire(good)).occupancy.size(), 9u);
+
+  auto huge = good;  // 2e9 per side with no data: 4e18 cells if trusted
+  huge.n = 2000000000, huge.num_mm = 0, huge.distance_mm.clear();
+  EXPECT_NE(refusal(huge).find("n = 2000000000 needs n^2 distances"), std::string::npos)
+      << refusal(huge);
+  auto negative = good;  // (-3)^2 = 9 would match the data
+  negative.n = -3;
+  EXPECT_NE(refusal(negative).find("n = -3"), std::string::npos);
+  auto face99 = good;
+  face99.face = 99;
+  EXPECT_NE(refusal(face99).find("face 99 is not 0..5"), std::string::npos);
+  auto encoding = good;
+  encoding.encoding = 7;
+  EXPECT_NE(refusal(encoding).find("encoding 7"), std::string::npos);
+  auto grid = good;  // 3 per side is 2 * 1 / 1 + 1; 2 m half extent needs 5
+  grid.half_extent_m = 2.0;
+  EXPECT_NE(refusal(grid).find("does not match"), std::string::npos);
+  auto resolution = good;
+  resolution.resolution_m = std::nan("");
+  EXPECT_NE(refusal(resolution).find("resolution_m"), std::string::npos);
+  auto wrong_array = good;  // the float array filled, the mm one announced
+  wrong_array.num_mm = 0, wrong_array.distance_mm.clear();
+  wrong_array.num_m = 9, wrong_array.distance_m.assign(9, 1.0f);
+  EXPECT_NE(refusal(wrong_array).find("needs n^2 distances, the message holds 0"),
+            std::string::npos);
 }
 
 TEST(CompactFaceTest, AScannerWithACompactEncodingPublishesCompactFaces) {
