@@ -143,6 +143,7 @@ Level LoadManifest(const fs::path& file, const LoadOptions& options) {
     }
     const TerrainSource source(spec);
     for (const std::string& problem : source.problems()) level.warnings.push_back(problem);
+    source.CheckBudgets();
     Actor actor;
     actor.name = spec.name;
     actor.source = spec.elevation.front().string();

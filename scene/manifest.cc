@@ -425,6 +425,13 @@ TerrainSpec ParseTerrain(const fs::path& file, const toml::table& table, int ind
   if (std::abs((*anchor)[0]) > 90.0 || std::abs((*anchor)[1]) > 180.0) {
     read.Fail(read.Find("anchor"), "'anchor' latitude must be within +-90 and longitude +-180");
   }
+  // The anchor is near the ground: between the deepest trench and the edge of space.
+  if (!(std::abs((*anchor)[2]) <= kMaxHeightAboveEllipsoid_m ||
+        ((*anchor)[2] > 0 && (*anchor)[2] <= kMaxAnchorHeight_m))) {
+    read.Fail(read.Find("anchor"), "'anchor' height must be from -" +
+                                       std::to_string(int(kMaxHeightAboveEllipsoid_m)) + " to " +
+                                       std::to_string(int(kMaxAnchorHeight_m)) + " m");
+  }
   terrain.anchor = {(*anchor)[0], (*anchor)[1], (*anchor)[2]};
   auto whole = [&](const char* key, int low, int high, int* value) {
     if (const auto set = read.Number(key)) {
@@ -441,17 +448,21 @@ TerrainSpec ParseTerrain(const fs::path& file, const toml::table& table, int ind
   if (terrain.tile_samples % terrain.coarse_factor != 0) {
     read.Fail(read.Find("coarse_factor"), "'tile_samples' must be a multiple of 'coarse_factor'");
   }
-  auto positive = [&](const char* key, double* value, bool zero_ok) {
+  auto positive = [&](const char* key, double* value, bool zero_ok, double most) {
     if (const auto set = read.Number(key)) {
       if (*set < 0.0 || (*set == 0.0 && !zero_ok)) {
         read.Fail(read.Find(key), std::string("'") + key + "' must be positive");
       }
+      if (!(*set <= most)) {
+        read.Fail(read.Find(key),
+                  std::string("'") + key + "' must be at most " + std::to_string(std::int64_t(most)));
+      }
       *value = *set;
     }
   };
-  positive("collision_radius_m", &terrain.collision_radius_m, false);
-  positive("view_radius_m", &terrain.view_radius_m, false);
-  positive("prefetch_s", &terrain.prefetch_s, true);
+  positive("collision_radius_m", &terrain.collision_radius_m, false, kMaxTerrainRadius_m);
+  positive("view_radius_m", &terrain.view_radius_m, false, kMaxTerrainRadius_m);
+  positive("prefetch_s", &terrain.prefetch_s, true, 3600.0);
   if (terrain.view_radius_m < terrain.collision_radius_m) {
     read.Fail(read.Find("view_radius_m"), "'view_radius_m' must not be below 'collision_radius_m'");
   }
@@ -533,7 +544,11 @@ LevelManifest ParseManifestText(std::string_view text, const fs::path& file) {
           {"max_texture_pixels", &limits.max_texture_pixels},
           {"max_triangles", &limits.max_triangles},
           {"max_import_mb", &limits.max_import_mb},
-          {"max_import_s", &limits.max_import_s}}) {
+          {"max_import_s", &limits.max_import_s},
+          {"max_terrain_tiles", &limits.max_terrain_tiles},
+          {"max_terrain_mb", &limits.max_terrain_mb},
+          {"max_tile_samples", &limits.max_tile_samples},
+          {"max_imagery_window_px", &limits.max_imagery_window_px}}) {
       if (const auto set = read.Count(key, kHuge)) *value = *set;
     }
     read.RejectUnknownKeys();
@@ -549,7 +564,10 @@ LevelManifest ParseManifestText(std::string_view text, const fs::path& file) {
               "one [[terrain]] table per level (list several rasters in its "
               "'elevation' instead)");
   }
-  if (!terrains.empty()) manifest.terrain = terrains.front();
+  if (!terrains.empty()) {
+    manifest.terrain = terrains.front();
+    manifest.terrain->limits = manifest.limits;
+  }
   if (const toml::node* horizon = top.Find("horizon")) {
     if (!horizon->is_table()) top.Fail(horizon, "'horizon' must be a table: [horizon]");
     TableReader read(file, *horizon->as_table(), "[horizon]: ");
@@ -562,8 +580,8 @@ LevelManifest ParseManifestText(std::string_view text, const fs::path& file) {
       spec.rgb = rgb->cast<float>();
     }
     if (const auto visibility = read.Number("visibility_m")) {
-      if (*visibility <= 0.0)
-        read.Fail(read.Find("visibility_m"), "'visibility_m' must be positive");
+      if (!(*visibility >= 1.0))
+        read.Fail(read.Find("visibility_m"), "'visibility_m' must be at least 1 m");
       spec.visibility_m = *visibility;
     }
     read.RejectUnknownKeys();

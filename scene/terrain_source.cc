@@ -1,6 +1,8 @@
 #include "scene/terrain_source.h"
 
 #include <cpl_conv.h>
+#include <cpl_minixml.h>
+#include <cpl_string.h>
 #include <cpl_error.h>
 #include <gdal.h>
 #include <ogr_srs_api.h>
@@ -12,6 +14,7 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "scene/files.h"
 #include "scene/level.h"
 
 namespace sandbox::scene {
@@ -35,6 +38,44 @@ struct QuietGdal {
   }
 };
 
+// Why a file GDAL would open for `file` is not a regular file, or "". A VRT
+// names other files (SourceFilename, nested VRTs too): GDAL opens them itself,
+// so each is checked here first, with GDAL's own XML reader. A FIFO among
+// them would block the open forever.
+std::string FileListProblem(const std::filesystem::path& file, int depth = 0) {
+  if (const std::string problem = RegularFileProblem(file); !problem.empty()) {
+    return (depth ? "it names " + file.string() + ", which " : std::string()) + problem;
+  }
+  if (LowerExtension(file) != ".vrt") return "";
+  if (depth > 8) return "VRTs nested more than 8 deep";
+  CPLXMLNode* root = CPLParseXMLFile(file.c_str());
+  if (root == nullptr) return "";  // GDAL's open says what is wrong
+  std::string problem;
+  std::vector<const CPLXMLNode*> stack{root};
+  while (!stack.empty() && problem.empty()) {
+    const CPLXMLNode* node = stack.back();
+    stack.pop_back();
+    for (; node != nullptr && problem.empty(); node = node->psNext) {
+      if (node->eType != CXT_Element) continue;
+      if (EQUAL(node->pszValue, "SourceFilename")) {
+        const char* name = CPLGetXMLValue(node, nullptr, "");
+        const bool relative = CPLTestBool(CPLGetXMLValue(node, "relativeToVRT", "0"));
+        std::filesystem::path source = name;
+        if (relative) source = file.parent_path() / source;
+        if (std::string(name).rfind("/vsi", 0) == 0 || std::string(name).find(':') != std::string::npos) {
+          problem = "it names '" + std::string(name) + "', which is not a plain file";
+        } else {
+          problem = FileListProblem(source, depth + 1);
+        }
+      } else if (node->psChild != nullptr) {
+        stack.push_back(node->psChild);
+      }
+    }
+  }
+  CPLDestroyXMLNode(root);
+  return problem;
+}
+
 }  // namespace
 
 struct TerrainSource::Raster {
@@ -48,6 +89,8 @@ struct TerrainSource::Raster {
   OGRSpatialReferenceH crs{nullptr}, wgs84{nullptr};
   OGRCoordinateTransformationH to_lonlat{nullptr}, from_lonlat{nullptr};
   Eigen::Vector2d metres_per_sample{1.0, 1.0};
+  bool geographic{false};  // its x is longitude in degrees
+  std::vector<double> overview_factors;  // each overview's decimation (band 1)
 
   ~Raster() {
     if (to_lonlat) OCTDestroyCoordinateTransformation(to_lonlat);
@@ -66,14 +109,28 @@ struct TerrainSource::Raster {
   // Opens `file`; "" or why it cannot serve.
   std::string Open(const std::filesystem::path& file) {
     path = file;
+    if (const std::string problem = FileListProblem(file); !problem.empty()) return problem;
     dataset = GDALOpen(file.c_str(), GA_ReadOnly);
     if (dataset == nullptr) return QuietGdal::Last("GDAL cannot read it");
+    // Every file the dataset reads (sidecars, a VRT's sources): regular files only.
+    if (char** files = GDALGetFileList(dataset)) {
+      std::string problem;
+      for (char** name = files; *name != nullptr && problem.empty(); ++name) {
+        if (const std::string why = RegularFileProblem(*name); !why.empty())
+          problem = std::string("it reads ") + *name + ", which " + why;
+      }
+      CSLDestroy(files);
+      if (!problem.empty()) return problem;
+    }
     cols = GDALGetRasterXSize(dataset);
     rows = GDALGetRasterYSize(dataset);
     bands = GDALGetRasterCount(dataset);
     if (bands < 1 || cols < 2 || rows < 2) return "no raster of at least 2 x 2 samples in it";
     if (GDALGetGeoTransform(dataset, gt) != CE_None) {
       return "it has no georeferencing (no geotransform): a world file or GeoTIFF tags are needed";
+    }
+    if (!std::all_of(gt, gt + 6, [](double g) { return std::isfinite(g); })) {
+      return "its geotransform is not finite (pixel size or tie point NaN or infinite)";
     }
     if (!GDALInvGeoTransform(gt, inverse)) return "its geotransform cannot be inverted";
     const OGRSpatialReferenceH own = GDALGetSpatialRef(dataset);
@@ -92,8 +149,28 @@ struct TerrainSource::Raster {
       return "its coordinate system cannot be transformed to WGS84 (" +
              QuietGdal::Last("no transformation") + ")";
     }
+    // Geographic rasters: longitudes may run past +-180 (read around the
+    // antimeridian), latitudes may not pass a pole.
+    geographic = OSRIsGeographic(crs) != 0;
+    if (geographic) {
+      for (const double row : {0.0, double(rows)}) {
+        for (const double col : {0.0, double(cols)}) {
+          const double latitude = gt[3] + col * gt[4] + row * gt[5];
+          if (std::abs(latitude) > 90.0) {
+            return "it reaches latitude " + std::to_string(latitude) +
+                   ", beyond the pole: a geographic raster must stay within +-90";
+          }
+        }
+      }
+    }
+    const GDALRasterBandH band = GDALGetRasterBand(dataset, 1);
+    for (int o = 0; o < GDALGetOverviewCount(band); ++o) {
+      const GDALRasterBandH overview = GDALGetOverview(band, o);
+      if (overview != nullptr && GDALGetRasterBandXSize(overview) > 0)
+        overview_factors.push_back(double(cols) / GDALGetRasterBandXSize(overview));
+    }
     int has = 0;
-    nodata = GDALGetRasterNoDataValue(GDALGetRasterBand(dataset, 1), &has);
+    nodata = GDALGetRasterNoDataValue(band, &has);
     has_nodata = has != 0;
     return "";
   }
@@ -165,15 +242,35 @@ Eigen::Vector3d TerrainSource::SampleToWorld(int file, int col, int row, double 
 
 Eigen::Vector2d TerrainSource::ToSample(const Raster& raster, const Eigen::Vector3d& p_W) const {
   const GeodeticPoint point = plane_.ToGeodetic(p_W);
-  double x = point.longitude_deg, y = point.latitude_deg;
-  int ok = 0;
-  OCTTransformEx(raster.from_lonlat, 1, &x, &y, nullptr, &ok);
-  if (!ok) return {std::numeric_limits<double>::quiet_NaN(), 0.0};
-  const double* g = raster.inverse;
-  return {g[0] + x * g[1] + y * g[2] - 0.5, g[3] + x * g[4] + y * g[5] - 0.5};
+  Eigen::Vector2d best{std::numeric_limits<double>::quiet_NaN(), 0.0};
+  // A geographic raster across the antimeridian holds the point at longitude
+  // +-360 too: the candidate nearest the raster's middle wins.
+  const int turns = raster.geographic ? 1 : 0;
+  for (int turn = -turns; turn <= turns; ++turn) {
+    double x = point.longitude_deg + 360.0 * turn, y = point.latitude_deg;
+    int ok = 0;
+    OCTTransformEx(raster.from_lonlat, 1, &x, &y, nullptr, &ok);
+    if (!ok) continue;
+    const double* g = raster.inverse;
+    const Eigen::Vector2d s{g[0] + x * g[1] + y * g[2] - 0.5, g[3] + x * g[4] + y * g[5] - 0.5};
+    const double off = std::abs(s.x() - 0.5 * raster.cols);
+    if (!std::isfinite(best.x()) || off < std::abs(best.x() - 0.5 * raster.cols)) best = s;
+  }
+  return best;
 }
 
 namespace {
+
+// The pixels GDAL reads for a `w` x `h` window drawn into a `size`-pixel
+// texture: from the coarsest overview still at least as fine as the texture.
+double ImageryPixelsRead(const std::vector<double>& overview_factors, double w, double h,
+                         int size) {
+  double factor = 1.0;
+  for (const double overview : overview_factors) {
+    if (overview > factor && w / overview >= size && h / overview >= size) factor = overview;
+  }
+  return (w / factor) * (h / factor);
+}
 
 int TileSpan(const TerrainSpec& spec, int lod) {
   return spec.tile_samples * (lod == 0 ? 1 : spec.coarse_factor);
@@ -195,10 +292,12 @@ void TerrainSource::TilesNear(const Eigen::Vector3d& p_W, int lod, double radius
     const double rx = radius_m / raster->metres_per_sample.x(),
                  ry = radius_m / raster->metres_per_sample.y();
     const int nx = TileCount(raster->cols, span), ny = TileCount(raster->rows, span);
-    const int x0 = std::max(0, int(std::floor((s.x() - rx) / span))),
-              x1 = std::min(nx - 1, int(std::floor((s.x() + rx) / span)));
-    const int y0 = std::max(0, int(std::floor((s.y() - ry) / span))),
-              y1 = std::min(ny - 1, int(std::floor((s.y() + ry) / span)));
+    // In double, clamped to the raster before any int: radii far beyond it stay in range.
+    auto clamp_tile = [](double t, int last) { return int(std::clamp(std::floor(t), 0.0, double(last))); };
+    if (s.x() + rx < 0 || s.y() + ry < 0 || (s.x() - rx) / span > nx || (s.y() - ry) / span > ny)
+      continue;
+    const int x0 = clamp_tile((s.x() - rx) / span, nx - 1), x1 = clamp_tile((s.x() + rx) / span, nx - 1);
+    const int y0 = clamp_tile((s.y() - ry) / span, ny - 1), y1 = clamp_tile((s.y() + ry) / span, ny - 1);
     for (int ty = y0; ty <= y1; ++ty) {
       for (int tx = x0; tx <= x1; ++tx) {
         const TileId id{lod, int(f), tx, ty};
@@ -258,6 +357,72 @@ double TerrainSource::fine_tile_m() const {
   return 0.0;
 }
 
+void TerrainSource::CheckBudgets() const {
+  const LoadLimits& limits = spec_.limits;
+  const std::filesystem::path& file = spec_.elevation.front();
+  const std::uint64_t s = std::uint64_t(spec_.tile_samples);
+  LoadLimits::Check(file,
+                    "tile_samples " + std::to_string(s) + " makes tiles of " +
+                        std::to_string((s + 1) * (s + 1)) + " samples",
+                    (s + 1) * (s + 1), limits.max_tile_samples, "max_tile_samples");
+  // A tile's memory: vertices (position, normal, uv), indices, the collision
+  // shape's 32 bytes a triangle, the texture; drawn tiles again in the renderer.
+  const double vertex_bytes = double((s + 1) * (s + 1) + 8 * s) * 32.0;
+  const double index_bytes = 6.0 * double(s * s + 4 * s) * 4.0;
+  const double texture_bytes =
+      imagery_.empty() ? 0.0 : 4.0 * double(spec_.texture_px) * double(spec_.texture_px);
+  const double drawn = 2.0 * (vertex_bytes + index_bytes + texture_bytes);
+  const double collision = 2.0 * double(s * s) * 32.0;
+  double tiles = 0.0, bytes = 0.0, fine_window_px = 0.0;
+  for (const auto& raster : elevation_) {
+    if (raster == nullptr) continue;
+    const double side_m = raster->metres_per_sample.minCoeff() * double(s);
+    // Tiles whose squares meet a circle of radius r: at most (2 r / side + 2)^2,
+    // and no more than the raster has.
+    auto near = [&](double radius_m, double tile_m, int span) {
+      const double across = 2.0 * radius_m / tile_m + 2.0;
+      const double have = double(TileCount(raster->cols, span)) * TileCount(raster->rows, span);
+      return std::min(across * across, have);
+    };
+    const double fine = near(spec_.collision_radius_m, side_m, int(s));
+    const double coarse = near(spec_.view_radius_m, side_m * spec_.coarse_factor,
+                               int(s) * spec_.coarse_factor);
+    tiles += fine + coarse;
+    bytes += fine * (drawn + collision) + coarse * drawn;
+    for (const auto& image : imagery_) {
+      // The image's pixels over a fine tile, from its spacing at its middle.
+      const double c = 0.5 * image->cols, r = 0.5 * image->rows;
+      const Eigen::Vector3d p = SampleToWorldOf(*image, c, r),
+                            px = SampleToWorldOf(*image, c + 1, r),
+                            py = SampleToWorldOf(*image, c, r + 1);
+      const double w = std::min(double(image->cols), side_m / (px - p).norm()),
+                   h = std::min(double(image->rows), side_m / (py - p).norm());
+      if (std::isfinite(w) && std::isfinite(h))
+        fine_window_px = std::max(fine_window_px, ImageryPixelsRead(image->overview_factors, w,
+                                                                    h, spec_.texture_px));
+    }
+  }
+  LoadLimits::Check(file,
+                    "about " + std::to_string(std::llround(tiles)) +
+                        " tiles near a robot at once (collision_radius_m and view_radius_m over "
+                        "tiles of tile_samples)",
+                    std::uint64_t(std::min(tiles, 1e18)), limits.max_terrain_tiles,
+                    "max_terrain_tiles");
+  const double mb = bytes / double(1 << 20);
+  LoadLimits::Check(file,
+                    "about " + std::to_string(std::llround(std::min(mb, 1e18))) +
+                        " MB of tiles near a robot at once (tile_samples, texture_px and the radii)",
+                    std::uint64_t(std::min(mb, 1e18)), limits.max_terrain_mb, "max_terrain_mb");
+  if (!imagery_.empty()) {
+    LoadLimits::Check(spec_.imagery.front(),
+                      "a fine tile's texture reads a window of about " +
+                          std::to_string(std::llround(std::min(fine_window_px, 1e18))) +
+                          " px (add overviews with gdaladdo, or fewer tile_samples)",
+                      std::uint64_t(std::min(fine_window_px, 1e18)),
+                      limits.max_imagery_window_px, "max_imagery_window_px");
+  }
+}
+
 std::vector<int> TerrainSource::SampleSpan(int first, int last, int step) const {
   std::vector<int> span;
   for (int i = first; i <= last; i += step) span.push_back(i);
@@ -303,16 +468,19 @@ TerrainTile TerrainSource::Build(const TileId& id) const {
   raster->ToLonLat(&x, &y, &ok);
   std::vector<Eigen::Vector3d> p_W(n);
   std::vector<char> valid(n);
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   int valid_count = 0;
+  Eigen::AlignedBox3d valid_W;
   for (std::size_t v = 0; v < n; ++v) {
-    valid[v] = ok[v] && std::isfinite(height[v]) &&
-               !(raster->has_nodata && double(height[v]) == raster->nodata);
+    const bool nodata = raster->has_nodata && double(height[v]) == raster->nodata;
+    const bool physical = std::abs(double(height[v])) <= kMaxHeightAboveEllipsoid_m;
+    if (!nodata && std::isfinite(height[v]) && !physical) ++tile.heights_out_of_bound;
+    valid[v] = ok[v] && std::isfinite(height[v]) && !nodata && physical;
     p_W[v] = plane_.ToWorld({y[v], x[v], valid[v] ? double(height[v]) : 0.0});
-    if (valid[v]) sum += p_W[v], ++valid_count;
+    if (valid[v]) valid_W.extend(p_W[v]), ++valid_count;
   }
   if (valid_count == 0) return tile;
-  tile.origin_W = (sum / valid_count).array().round().matrix();  // whole metres
+  // The middle of the valid samples, in whole metres: no one sample moves it far.
+  tile.origin_W = valid_W.center().array().round().matrix();
   tile.positions.resize(n);
   tile.normals.resize(n);
   for (std::size_t v = 0; v < n; ++v) {
@@ -374,6 +542,15 @@ TerrainTile TerrainSource::Build(const TileId& id) const {
       continue;
     }
     const int size = spec_.texture_px;
+    const double read_px = ImageryPixelsRead(image->overview_factors, x1 - x0, y1 - y0, size);
+    if (read_px > double(spec_.limits.max_imagery_window_px)) {
+      tile.imagery_problem = image->path.string() + ": a tile's texture reads a window of " +
+                             std::to_string(std::llround(read_px)) +
+                             " px, over the limit of " +
+                             std::to_string(spec_.limits.max_imagery_window_px) +
+                             " ([level] max_imagery_window_px; overviews, gdaladdo, read fewer)";
+      break;
+    }
     std::vector<std::uint8_t> rgb(std::size_t(size) * std::size_t(size) * 3);
     GDALRasterIOExtraArg extra;
     INIT_RASTERIO_EXTRA_ARG(extra);
@@ -382,8 +559,10 @@ TerrainTile TerrainSource::Build(const TileId& id) const {
     if (GDALDatasetRasterIOEx(image->dataset, GF_Read, int(x0), int(y0), int(x1 - x0), int(y1 - y0),
                               rgb.data(), size, size, GDT_Byte, 3, band_map, 3, 3 * size, 1,
                               &extra) != CE_None) {
-      throw std::runtime_error(image->path.string() + ": cannot read imagery (" +
-                               QuietGdal::Last("read error") + ")");
+      // The tile keeps its ground and base colour.
+      tile.imagery_problem =
+          image->path.string() + ": cannot read imagery (" + QuietGdal::Last("read error") + ")";
+      break;
     }
     tile.texture_width = tile.texture_height = size;
     tile.texture_rgba.resize(std::size_t(size) * std::size_t(size) * 4);

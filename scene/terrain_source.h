@@ -46,8 +46,17 @@ class TerrainSource {
   // A fine tile's side in metres (about: the raster's sample spacing times tile_samples).
   double fine_tile_m() const;
 
+  // The terrain's work against spec().limits, estimated from the rasters:
+  // one tile's samples, the tiles near one robot at once (fine within
+  // collision_radius_m, coarse within view_radius_m) and their memory, a
+  // fine tile's imagery window. Throws LevelError naming the figure, the
+  // limit and its [level] key.
+  void CheckBudgets() const;
+
   // Builds one tile: its surface, its skirts, its imagery. Throws
-  // std::runtime_error naming the file when the raster cannot be read there.
+  // std::runtime_error naming the file when the elevation cannot be read
+  // there; imagery that cannot be read leaves the tile in its base colour
+  // (TerrainTile::imagery_problem says why).
   TerrainTile Build(const TileId& id) const;
 
   // The world point of raster sample (col, row) of elevation raster `file`

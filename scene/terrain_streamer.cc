@@ -80,6 +80,8 @@ void TerrainStreamer::Work() {
   };
   std::map<std::uint64_t, Resident> resident;
   std::set<std::uint64_t> failed;
+  std::set<int> heights_said;
+  std::set<std::string> imagery_said;
   std::vector<char> off_raster;
   std::uint64_t handled = 0;
   while (true) {
@@ -175,12 +177,31 @@ void TerrainStreamer::Work() {
         double ms = 0.0;
         try {
           const auto start = Clock::now();
-          std::optional<TerrainTile> kept = cache.Load(id);
-          cached = kept.has_value();
-          auto tile = std::make_shared<TerrainTile>(cached ? std::move(*kept) : source->Build(id));
+          TerrainCache::Loaded kept = cache.Load(id);
+          if (!kept.damage.empty()) {
+            say("terrain '" + spec.name + "': cache file " + kept.damage +
+                "; built again from the rasters");
+          }
+          cached = kept.tile.has_value();
+          auto tile =
+              std::make_shared<TerrainTile>(cached ? std::move(*kept.tile) : source->Build(id));
           if (!cached && cache.enabled()) {
             cache.Store(*tile);
             if (!cache.enabled()) say(cache.problem());
+          }
+          // What the build left out: said once per raster.
+          if (tile->heights_out_of_bound > 0 && heights_said.insert(id.file).second) {
+            say("terrain '" + spec.name + "': " + spec.elevation[std::size_t(id.file)].string() +
+                ": " + std::to_string(tile->heights_out_of_bound) +
+                " heights in a tile lie beyond " +
+                std::to_string(int(kMaxHeightAboveEllipsoid_m / 1000)) +
+                " km of the ellipsoid: taken as no data (said once for this raster)");
+          }
+          if (!tile->imagery_problem.empty() &&
+              imagery_said.insert(tile->imagery_problem.substr(0, tile->imagery_problem.find(": ")))
+                  .second) {
+            say("terrain '" + spec.name + "': " + tile->imagery_problem +
+                "; tiles without it keep their ground and base colour (said once for this raster)");
           }
           if (id.lod == 0 && !tile->indices.empty())
             event.collision = CollisionWorld::PrepareTile(tile);

@@ -12,8 +12,19 @@
 #include <vector>
 
 #include "scene/geodetic.h"
+#include "scene/load_limits.h"
 
 namespace sandbox::scene {
+
+// Heights farther than this from the WGS84 ellipsoid (above or below) are
+// not the Earth's surface: a raster's undeclared no-data value (-3.4e38, -9999
+// is within reach of neither) or a damaged sample. They are taken as no data.
+inline constexpr double kMaxHeightAboveEllipsoid_m = 12000.0;
+
+// A terrain's radii reach at most half the way round the Earth; its anchor
+// lies at most at the edge of space (the Karman line).
+inline constexpr double kMaxTerrainRadius_m = 2.0e7;
+inline constexpr double kMaxAnchorHeight_m = 100000.0;
 
 // One [[terrain]] table (docs/large-worlds.md).
 struct TerrainSpec {
@@ -28,6 +39,7 @@ struct TerrainSpec {
   double prefetch_s{10.0};                       // also around where each robot will be this soon
   int texture_px{256};                           // a tile's imagery texture, a side
   std::filesystem::path cache;  // built tiles kept here (terrain_cache.h); empty: none
+  LoadLimits limits;            // the level's ([level] table): the terrain's budgets
   int line{0};
 };
 
@@ -62,6 +74,11 @@ struct TerrainTile {
   std::vector<std::uint8_t> texture_rgba;  // row 0 at v = 0
   Eigen::AlignedBox3d bounds_W;
   double build_ms{0.0};  // reading, reprojecting and meshing (as when it was built)
+  // What building it left out (not kept in the tile cache): heights beyond
+  // kMaxHeightAboveEllipsoid_m taken as no data, and why the imagery was not
+  // draped ("FILE: why"; the tile keeps its ground and base colour).
+  std::int64_t heights_out_of_bound{0};
+  std::string imagery_problem;
 
   std::size_t bytes() const;
 };
