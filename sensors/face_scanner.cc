@@ -41,8 +41,9 @@ void FaceScannerConfig::ValidateOrThrow() const {
   if (!(std::isfinite(half_extent_m) && half_extent_m > 0.0)) {
     throw std::invalid_argument("half_extent_m must be positive, got " + Format(half_extent_m));
   }
-  if (!(sample_budget >= 6.0 && sample_budget <= 1e9)) {
-    throw std::invalid_argument("sample_budget must be 6 to 1e9, got " + Format(sample_budget));
+  if (!(sample_budget >= 6.0 && sample_budget <= kMaxSampleBudget)) {
+    throw std::invalid_argument("sample_budget must be 6 to " + Format(kMaxSampleBudget) +
+                                ", got " + Format(sample_budget));
   }
   const double steps = 2.0 * half_extent_m / resolution_m;
   const double samples = 6.0 * (steps + 1.0) * (steps + 1.0);

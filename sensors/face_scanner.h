@@ -47,6 +47,9 @@ struct FaceScannerConfig {
   // The most samples (6 n^2) a scan may have: a finer or larger grid is
   // refused at load. The default admits 6 x 501 x 501 (25 m at 0.1 m).
   double sample_budget{2e6};
+  // The most any scanner may be given: a run with one such scanner peaks at
+  // about 0.9 GB (docs/sensors.md).
+  static constexpr double kMaxSampleBudget = 2e7;
   FaceEncoding encoding{FaceEncoding::kPoints};
 
   // Throws std::invalid_argument naming the field and its value: a resolution

@@ -120,11 +120,27 @@ std::vector<MountedCamera> MakeRobotCameras(const scene::Level& level) {
       if (!(camera.overlay_stub_m >= 0.0 && camera.overlay_stub_m <= 100.0)) {
         throw scene::LevelError(spec.Where() + "overlay_stub_m must be 0 (points) to 100 m");
       }
+      // The pixels the camera may have: a documented default, raised to a bound.
+      const double pixel_budget =
+          read.Number("pixel_budget", double(CameraView::kDefaultPixelBudget));
       read.RejectUnknownKeys(spec.type + " camera");
       try {
         camera.view.ValidateOrThrow();
       } catch (const std::invalid_argument& error) {
         throw scene::LevelError(spec.Where() + error.what());
+      }
+      if (!(pixel_budget >= 1.0 && pixel_budget <= double(CameraView::kMaxPixelBudget))) {
+        throw scene::LevelError(spec.Where() + "pixel_budget must be 1 to " +
+                                std::to_string(CameraView::kMaxPixelBudget) + ", got " +
+                                std::to_string(pixel_budget));
+      }
+      const double pixels = double(camera.view.width) * double(camera.view.height);
+      if (pixels > pixel_budget) {
+        throw scene::LevelError(spec.Where() + std::to_string(camera.view.width) + " x " +
+                                std::to_string(camera.view.height) + " = " +
+                                std::to_string(std::int64_t(pixels)) +
+                                " pixels, over pixel_budget " +
+                                std::to_string(std::int64_t(pixel_budget)));
       }
       cameras.push_back(std::move(camera));
     }

@@ -25,10 +25,17 @@ void CameraView::ValidateOrThrow() const {
     throw std::invalid_argument("resolution must be 1 to 8192 pixels a side, got " +
                                 std::to_string(width) + " x " + std::to_string(height));
   }
-  if (!(fov_y_rad > 0.0 && fov_y_rad < M_PI)) {
-    throw std::invalid_argument("field of view must be between 0 and 180 degrees");
+  if (!(fov_y_rad >= kMinFov_rad && fov_y_rad < M_PI)) {
+    throw std::invalid_argument("fov_deg must be at least " +
+                                std::to_string(kMinFov_rad * 180.0 / M_PI).substr(0, 4) +
+                                " and below 180 degrees, got " +
+                                std::to_string(fov_y_rad * 180.0 / M_PI));
   }
-  if (!(near_m > 0.0 && far_m > near_m)) throw std::invalid_argument("need 0 < near_m < far_m");
+  if (!(near_m >= kMinNear_m && far_m > near_m && std::isfinite(far_m))) {
+    throw std::invalid_argument("need " + std::to_string(kMinNear_m).substr(0, 6) +
+                                " m <= near_m < far_m (finite), got near_m " +
+                                std::to_string(near_m) + ", far_m " + std::to_string(far_m));
+  }
   if (!X_WC.matrix().allFinite()) throw std::invalid_argument("non-finite camera pose");
 }
 

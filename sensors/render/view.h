@@ -3,6 +3,7 @@
 // (pose and lens), the debug overlay's marks and the rendered frame.
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -17,8 +18,16 @@ struct CameraView {
   double fov_y_rad{0.9};  // vertical field of view
   double near_m{0.1};
   double far_m{2000.0};
+  // Below these a frame is blank or all one depth: refused, not drawn.
+  static constexpr double kMinNear_m = 1e-4;
+  static constexpr double kMinFov_rad = 0.1 * M_PI / 180.0;
+  // The most pixels a camera may have unless its pixel_budget says more
+  // (3840 x 2160), and the most any may have (4096 x 4096: about 1.4 GB of
+  // buffers and images for one camera).
+  static constexpr std::int64_t kDefaultPixelBudget = 3840 * 2160;
+  static constexpr std::int64_t kMaxPixelBudget = std::int64_t(1) << 24;
   // Throws std::invalid_argument naming the field: sizes from 1 to 8192,
-  // a field of view in (0, pi), 0 < near < far.
+  // a field of view in [kMinFov_rad, pi), kMinNear_m <= near < far.
   void ValidateOrThrow() const;
 };
 

@@ -281,7 +281,9 @@ TEST(FaceScannerTest, BadConfigsNameTheField) {
   config.sample_budget = 6012006;
   EXPECT_EQ(message(config), "no error");
   config.sample_budget = 0;
-  EXPECT_EQ(message(config), "sample_budget must be 6 to 1e9, got 0");
+  EXPECT_EQ(message(config), "sample_budget must be 6 to 20000000, got 0");
+  config.sample_budget = 1e9;  // was allowed; a scan of that takes tens of gigabytes
+  EXPECT_EQ(message(config), "sample_budget must be 6 to 20000000, got 1000000000");
   config = FaceScannerConfig();
   config.half_extent_m = 25.3;
   EXPECT_NE(message(config).find("must be a whole number"), std::string::npos);

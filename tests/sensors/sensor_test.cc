@@ -242,7 +242,24 @@ TEST(SensorTest, CameraMistakesNameTheCameraAndField) {
       CameraError("type = \"chase\"\nheight = 100000\n"),
       "level.toml:6: camera 'c': resolution must be 1 to 8192 pixels a side, got 640 x 100000");
   EXPECT_EQ(CameraError("type = \"chase\"\nfov_deg = 180\n"),
-            "level.toml:6: camera 'c': field of view must be between 0 and 180 degrees");
+            "level.toml:6: camera 'c': fov_deg must be at least 0.10 and below 180 degrees, got "
+            "180.000000");
+  // Numbers that draw blank frames, and sizes beyond the pixel budget.
+  EXPECT_EQ(CameraError("type = \"chase\"\nfov_deg = 1e-300\n"),
+            "level.toml:6: camera 'c': fov_deg must be at least 0.10 and below 180 degrees, got "
+            "0.000000");
+  EXPECT_EQ(CameraError("type = \"chase\"\nnear_m = 1e-300\n"),
+            "level.toml:6: camera 'c': need 0.0001 m <= near_m < far_m (finite), got near_m "
+            "0.000000, far_m 2000.000000");
+  EXPECT_EQ(CameraError("type = \"chase\"\nfar_m = inf\n"),
+            "level.toml:9: camera 'c': 'far_m' must be finite, got inf");
+  EXPECT_EQ(CameraError("type = \"chase\"\nwidth = 8192\nheight = 8192\n"),
+            "level.toml:6: camera 'c': 8192 x 8192 = 67108864 pixels, over pixel_budget 8294400");
+  EXPECT_EQ(CameraError("type = \"chase\"\nwidth = 8192\nheight = 8192\npixel_budget = 1e9\n"),
+            "level.toml:6: camera 'c': pixel_budget must be 1 to 16777216, got 1000000000.000000");
+  EXPECT_EQ(CameraError("type = \"chase\"\nwidth = 4096\nheight = 4096\n"
+                        "pixel_budget = 16777216\n"),
+            "no error");
   EXPECT_EQ(CameraError("type = \"trailing\"\noverlay_stub_m = -1\n"),
             "level.toml:6: camera 'c': overlay_stub_m must be 0 (points) to 100 m");
   EXPECT_EQ(CameraError("type = \"chase\"\nzoom = 2\n"),
