@@ -262,14 +262,13 @@ double SandboxLoop::ApplyInputs(double wall_s, double drain_budget_s, std::int64
     record->inputs += changes.messages;
     if (options_.lockstep && changes.pose) {
       // Lock-step time is input time: the outputs depend on the inputs alone.
-      if (first_input_utime_ < 0) first_input_utime_ = changes.pose_utime;
+      input_clock_.Advance(changes.pose_utime);
       *now_utime = changes.pose_utime;
     }
+    for (const std::string& jump : changes.time_jumps) err_ << "sandbox: " << jump << "\n";
   }
   link_.set_record_utime(*now_utime);
-  const double t = options_.lockstep
-                       ? double(*now_utime - std::max<std::int64_t>(first_input_utime_, 0)) * 1e-6
-                       : wall_s;
+  const double t = options_.lockstep ? input_clock_.t_s() : wall_s;
   for (RobotRun& robot : robots_) robot.history.Add(t, robot.state->pose());
   return t;
 }

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "app/camera_director.h"
+#include "app/input_clock.h"
 #include "app/frame_pipeline.h"
 #include "app/live_view.h"
 #include "app/loaded_level.h"
@@ -140,7 +141,7 @@ class SandboxLoop {
   std::vector<bool> stale_, stale_now_;  // per robot and input: as last published, now
   CameraDirector::Shot shot_;
   bool recording_failure_reported_{false};
-  std::int64_t first_input_utime_{-1};
+  InputClock input_clock_;  // lock-step time
   double next_status_s_{0.0}, next_progress_s_{0.0};
   std::int64_t origin_moves_{0};
   double longest_origin_move_ms_{0.0};

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -43,6 +44,24 @@ std::string Json(const std::string& text) {
   return out.str();
 }
 
+// A channel name for the table: printable ASCII as it is, every other byte
+// (control characters, UTF-8, bytes that are not UTF-8) as \xNN, backslash as \\.
+std::string Escaped(const std::string& text) {
+  std::string out;
+  for (const unsigned char c : text) {
+    if (c == '\\') {
+      out += "\\\\";
+    } else if (c >= 0x20 && c < 0x7f) {
+      out += char(c);
+    } else {
+      char hex[5];
+      std::snprintf(hex, sizeof(hex), "\\x%02x", c);
+      out += hex;
+    }
+  }
+  return out;
+}
+
 // One table: per channel the totals, and rates over `window_s` (0: over the
 // time between each channel's first and last message).
 void PrintTable(const std::map<std::string, bridge::ChannelStats>& stats, double t_s,
@@ -67,21 +86,28 @@ void PrintTable(const std::map<std::string, bridge::ChannelStats>& stats, double
     out << "]}\n" << std::flush;
     return;
   }
-  out << std::left << std::setw(24) << "channel" << std::setw(20) << "type" << std::right
+  // Columns as wide as their longest entry: every name whole.
+  std::size_t channel_width = 24, type_width = 20;
+  for (const auto& [channel, s] : stats) {
+    channel_width = std::max(channel_width, Escaped(channel).size() + 2);
+    type_width = std::max(type_width, s.type.size() + 2);
+  }
+  const int cw = int(channel_width), tw = int(type_width);
+  out << std::left << std::setw(cw) << "channel" << std::setw(tw) << "type" << std::right
       << std::setw(10) << "messages" << std::setw(10) << "rate Hz" << std::setw(12) << "mean bytes"
       << std::setw(12) << "kB/s"
       << "\n";
   double total_Bps = 0.0;
   for (const auto& [channel, s] : stats) {
     total_Bps += bandwidth(s);
-    out << std::left << std::setw(24) << bridge::Printable(channel, 64) << std::setw(20) << s.type
+    out << std::left << std::setw(cw) << Escaped(channel) << std::setw(tw) << s.type
         << std::right << std::setw(10) << s.messages << std::setw(10) << std::fixed
         << std::setprecision(1) << rate(s) << std::setw(12) << std::setprecision(0)
         << double(s.bytes) / double(s.messages) << std::setw(12) << std::setprecision(1)
         << bandwidth(s) * 1e-3 << "\n";
   }
   if (!stats.empty()) {
-    out << std::left << std::setw(76) << "total" << std::right << std::setw(12) << std::fixed
+    out << std::left << std::setw(cw + tw + 32) << "total" << std::right << std::setw(12) << std::fixed
         << std::setprecision(1) << total_Bps * 1e-3 << "\n";
   }
   out << std::defaultfloat << std::flush;

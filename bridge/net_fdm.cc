@@ -73,6 +73,11 @@ std::string DecodeNetFdm(const std::uint8_t* bytes, std::size_t size, NetFdm* fd
       !std::isfinite(out.altitude_m)) {
     return "non-finite position";
   }
+  if (!(std::abs(out.latitude_rad) <= M_PI / 2)) return "latitude beyond +-pi/2 rad";
+  if (!(std::abs(out.longitude_rad) <= 2 * M_PI)) return "longitude beyond +-2 pi rad";
+  if (!(out.altitude_m >= -12000.0 && out.altitude_m <= 1e8)) {
+    return "altitude outside -12 km to 1e8 m";
+  }
   if (!std::isfinite(out.phi_rad) || !std::isfinite(out.theta_rad) || !std::isfinite(out.psi_rad)) {
     return "non-finite attitude";
   }

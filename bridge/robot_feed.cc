@@ -1,6 +1,29 @@
 #include "bridge/robot_feed.h"
 
+#include <cstdio>
+
 namespace sandbox::bridge {
+namespace {
+
+// Notes `utime` on `channel`; a time before the newest seen is a jump back.
+void WatchTime(const std::string& channel, std::int64_t utime, int* jumps_said, bool* seen,
+               std::int64_t* newest, std::vector<std::string>* out) {
+  constexpr int kSaid = 3;
+  if (*seen && utime < *newest && ++*jumps_said <= kSaid) {
+    char text[256];
+    std::snprintf(text, sizeof(text),
+                  "%s: input time jumped back by %.6f s (from %.6f s to %.6f s); the sensors keep "
+                  "the loop's schedule%s",
+                  channel.c_str(), double(*newest - utime) * 1e-6, double(*newest) * 1e-6,
+                  double(utime) * 1e-6,
+                  *jumps_said == kSaid ? " (further jumps on this channel are not said)" : "");
+    out->push_back(text);
+  }
+  *seen = true;
+  *newest = utime;
+}
+
+}  // namespace
 
 RobotFeed::RobotFeed(LcmLink& link, const scene::Level& level, int robot,
                      const RobotBridgeConfig& config, bool lockstep, RejectLog* log)
@@ -27,7 +50,11 @@ RobotFeed::Changes RobotFeed::Apply(std::int64_t now_utime, scene::RobotState* s
   changes.pose = applied.pose;
   changes.pose_utime = applied.pose_utime;
   changes.moved = applied.pose || applied.bones;
-  if (applied.pose) input_ = {applied.pose_seq, applied.pose_utime};
+  if (applied.pose) {
+    input_ = {applied.pose_seq, applied.pose_utime};
+    WatchTime(inputs_.pose().channel(), applied.pose_utime, &pose_time_.jumps, &pose_time_.seen,
+              &pose_time_.utime, &changes.time_jumps);
+  }
   // UDP inputs: the packet's own counter and time where its format has
   // them, else the receive counter and the arrival time.
   auto tag = [now_utime](const PacketTag& own, std::int64_t received) {
@@ -37,11 +64,19 @@ RobotFeed::Changes RobotFeed::Apply(std::int64_t now_utime, scene::RobotState* s
     changes.moved = true;
     ++changes.messages;
     input_ = tag(net_fdm_->last_tag(), net_fdm_->socket().received());
+    if (net_fdm_->last_tag().utime >= 0) {
+      WatchTime(net_fdm_->socket().name(), net_fdm_->last_tag().utime, &net_fdm_time_.jumps,
+                &net_fdm_time_.seen, &net_fdm_time_.utime, &changes.time_jumps);
+    }
   }
   if (doubles_ && doubles_->Apply(state)) {
     changes.moved = true;
     ++changes.messages;
     input_ = tag(doubles_->last_tag(), doubles_->socket().received());
+    if (doubles_->last_tag().utime >= 0) {
+      WatchTime(doubles_->socket().name(), doubles_->last_tag().utime, &doubles_time_.jumps,
+                &doubles_time_.seen, &doubles_time_.utime, &changes.time_jumps);
+    }
   }
   if (changes.moved) {
     state->Update();

@@ -36,6 +36,9 @@ class RobotFeed {
     bool moved{false};  // the pose or bones changed: the state and the world were updated
     bool pose{false};   // an LCM pose message was applied
     std::int64_t pose_utime{-1};
+    // Input times that went back (a model restarting its clock), one line
+    // each naming the channel and the jump; the first few per channel.
+    std::vector<std::string> time_jumps;
   };
   // After LcmLink::Drain(): applies the newest good input of each kind (lock-step:
   // the next pose message and what belongs to it, then the UDP inputs) to
@@ -64,6 +67,13 @@ class RobotFeed {
   std::unique_ptr<NetFdmInput> net_fdm_;
   std::unique_ptr<DoublesInput> doubles_;
   InputTag input_;
+  // The newest input time per channel (pose, net_fdm, doubles), and the jumps said.
+  struct TimeWatch {
+    bool seen{false};
+    std::int64_t utime{0};
+    int jumps{0};
+  };
+  TimeWatch pose_time_, net_fdm_time_, doubles_time_;
 };
 
 }  // namespace sandbox::bridge

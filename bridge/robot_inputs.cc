@@ -80,8 +80,10 @@ std::string RobotInputs::ParsePose(const std::uint8_t* data, std::size_t size, P
   const Eigen::Quaterniond q(message.orientation[0], message.orientation[1], message.orientation[2],
                              message.orientation[3]);
   if (std::abs(q.norm() - 1.0) > 1e-3) return "non-unit quaternion";
-  pose->X_WB = translation_.ToWorld(
-      Eigen::Vector3d(message.position[0], message.position[1], message.position[2]), q);
+  const Eigen::Vector3d position(message.position[0], message.position[1], message.position[2]);
+  if (std::string problem = PositionProblem(translation_, position); !problem.empty())
+    return problem;
+  pose->X_WB = translation_.ToWorld(position, q);
   pose->seq = message.seq;
   pose->utime = message.utime;
   return scene::PoseProblem(pose->X_WB);

@@ -85,7 +85,7 @@ double ChannelStats::bandwidth_Bps() const {
 }
 
 TopicMonitor::TopicMonitor(LcmLink& link) : link_(link) {
-  lcm::Subscription* subscription = link_.impl().lcm.subscribeFunction(".*", &Deliver, this);
+  lcm::Subscription* subscription = link_.impl().lcm.subscribeFunction("(?s).*", &Deliver, this);
   if (subscription == nullptr) throw std::runtime_error("sandbox topics: cannot subscribe");
   subscription->setQueueCapacity(LatestInput::kQueueCapacity);
   subscription_ = subscription;

@@ -90,4 +90,18 @@ void Translation::FromWorld(const Eigen::Isometry3d& X_WB, Eigen::Vector3d* posi
   }
 }
 
+std::string GeodeticProblem(double latitude_deg, double longitude_deg, double altitude_m) {
+  if (!(std::abs(latitude_deg) <= 90.0)) return "latitude beyond +-90 deg";
+  if (!(std::abs(longitude_deg) <= 360.0)) return "longitude beyond +-360 deg";
+  if (!(altitude_m >= kMinAltitude_m && altitude_m <= kMaxAltitude_m)) {
+    return "altitude outside -12 km to 1e8 m";
+  }
+  return "";
+}
+
+std::string PositionProblem(const Translation& translation, const Eigen::Vector3d& position) {
+  if (translation.convention != Convention::kGeodetic) return "";
+  return GeodeticProblem(position.x(), position.y(), position.z());
+}
+
 }  // namespace sandbox::bridge

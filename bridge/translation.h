@@ -41,6 +41,15 @@ struct Translation {
                  Eigen::Quaterniond* q) const;
 };
 
+// Why a geodetic position cannot be a robot's (a latitude beyond +-90, a
+// longitude beyond +-360, a height below the deepest trench or beyond
+// geostationary orbit: kMinAltitude_m to kMaxAltitude_m), or "".
+inline constexpr double kMinAltitude_m = -12000.0;
+inline constexpr double kMaxAltitude_m = 1e8;
+std::string GeodeticProblem(double latitude_deg, double longitude_deg, double altitude_m);
+// The position of `translation` (only kGeodetic has limits), as above.
+std::string PositionProblem(const Translation& translation, const Eigen::Vector3d& position);
+
 // Aerospace attitude: R = Rz(yaw) Ry(pitch) Rx(roll) of body FRD in NED, radians.
 Eigen::Quaterniond NedAttitude(double roll_rad, double pitch_rad, double yaw_rad);
 

@@ -183,6 +183,8 @@ std::string DecodeDoubles(const RobotBridgeConfig& config, int num_bone_values,
       at += std::size_t(num_bone_values);
     }
   }
+  if (std::string problem = PositionProblem(config.pose, position); !problem.empty())
+    return problem;
   *X_WB = config.pose.ToWorld(position, q);
   if (tag != nullptr) *tag = own;
   return scene::PoseProblem(*X_WB);

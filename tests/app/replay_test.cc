@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "tests/app/flight_log.h"
@@ -84,6 +85,45 @@ TEST(ReplayTest, PosesForRobotsTheLevelDoesNotHaveAreCountedAndReportedNotApplie
       << run.out;
 }
 
+// How many messages a recorded log holds on `channel`, from `sandbox topics --log`.
+int MessagesOn(const std::string& log, const std::string& channel) {
+  const auto json = RunSandbox("topics --log " + log + " --json");
+  EXPECT_EQ(json.exit_code, 0) << json.out;
+  const std::string key = "{\"channel\":\"" + channel + "\",";
+  const auto at = json.out.find(key);
+  if (at == std::string::npos) return 0;
+  const auto count = json.out.find("\"messages\":", at);
+  return std::stoi(json.out.substr(count + 11));
+}
+
+// A model that restarts its clock, and one whose clock starts below zero:
+// the altimeter (50 Hz) and the face scanner (every tick) keep the tick
+// schedule, one output per pose, and the jump is said once, naming the channel.
+TEST(ReplayTest, InputTimeThatJumpsBackOrIsNegativeKeepsTheSensorsOnTheTickSchedule) {
+  sandbox::testing::TempDir dir;
+  const std::string log = (dir.path() / "restart.lcmlog").string();
+  WriteFlightLog(log, 60);       // 1.00 .. 2.18 s
+  WriteFlightLog(log, 60, 20'000, 100.0, "a");  // 1.00 .. 2.18 s again: back by 1.18 s
+  const std::string out = (dir.path() / "out.lcmlog").string();
+  auto run = RunSandbox("run --replay " + log + " --record " + out);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("sandbox run: 120 ticks"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("ELAHA/POSE: input time jumped back by 1.180000 s (from 2.180000 s to "
+                         "1.000000 s); the sensors keep the loop's schedule"),
+            std::string::npos)
+      << run.out;
+  EXPECT_EQ(MessagesOn(out, "ELAHA/RANGE"), 120);
+  EXPECT_EQ(MessagesOn(out, "ELAHA/SCAN_FACE"), 120);
+
+  const std::string negative = (dir.path() / "negative.lcmlog").string();
+  WriteFlightLog(negative, 50, 20'000, 100.0, "w", "ELAHA/POSE", -2'000'000);
+  run = RunSandbox("run --replay " + negative + " --record " + out);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_EQ(run.out.find("jumped back"), std::string::npos) << run.out;
+  EXPECT_EQ(MessagesOn(out, "ELAHA/RANGE"), 50);
+  EXPECT_EQ(MessagesOn(out, "ELAHA/SCAN_FACE"), 50);
+}
+
 TEST(ReplayTest, TopicsOfALogGiveTypeRateSizeAndBandwidthAsTableOrJson) {
   sandbox::testing::TempDir dir;
   const std::string log = (dir.path() / "flight.lcmlog").string();
@@ -111,6 +151,35 @@ TEST(ReplayTest, TopicsOfALogGiveTypeRateSizeAndBandwidthAsTableOrJson) {
                     "\"bytes\":9600,\"rate_hz\":50,\"mean_bytes\":80,\"bandwidth_Bps\":4000}"),
       std::string::npos)
       << json.out;
+}
+
+// Names with control characters, bytes that are not UTF-8, and LCM's
+// longest (63): each listed once, escaped, the columns wide enough for all.
+TEST(ReplayTest, TopicsOfALogShowEveryChannelNameEscapedInColumnsThatFit) {
+  sandbox::testing::TempDir dir;
+  const std::string log = (dir.path() / "names.lcmlog").string();
+  const std::string longest(63, 'L');
+  WriteFlightLog(log, 3);
+  for (const std::string& name :
+       {std::string("bad\xff\xfe"), std::string("new\nline"), std::string("bell\x07"), longest}) {
+    WriteFlightLog(log, 3, 20'000, 100.0, "a", name);
+  }
+  const auto table = RunSandbox("topics --log " + log);
+  ASSERT_EQ(table.exit_code, 0) << table.out;
+  std::istringstream rows(table.out);
+  std::string line;
+  std::getline(rows, line);  // the header
+  std::set<std::string> listed;
+  std::set<std::size_t> type_columns;
+  while (std::getline(rows, line) && line.rfind("total", 0) != 0) {
+    listed.insert(line.substr(0, line.find(' ')));
+    type_columns.insert(line.find("robot_pose_t"));
+    for (const char c : line) EXPECT_TRUE(c >= 0x20 && c < 0x7f) << line;  // printable only
+  }
+  EXPECT_EQ(listed, (std::set<std::string>{"ELAHA/POSE", "bad\\xff\\xfe", "new\\x0aline",
+                                           "bell\\x07", longest}));
+  ASSERT_EQ(type_columns.size(), 1u) << table.out;  // one type column for every row
+  EXPECT_GT(*type_columns.begin(), longest.size()) << table.out;
 }
 
 TEST(ReplayTest, TruncatedLogIsReplayedUpToTheBreakAndNotALogIsRefused) {

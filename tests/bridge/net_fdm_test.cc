@@ -54,6 +54,26 @@ TEST(NetFdmTest, BadPacketsAreRejectedWithTheReason) {
   bytes = EncodeNetFdm(nan);
   EXPECT_EQ(DecodeNetFdm(bytes.data(), bytes.size(), &kept), "non-finite position");
   EXPECT_DOUBLE_EQ(kept.altitude_m, 7.0);  // untouched
+  // Finite but no place on Earth.
+  NetFdm far = NetFdm{};
+  far.latitude_rad = 1e300;
+  bytes = EncodeNetFdm(far);
+  EXPECT_EQ(DecodeNetFdm(bytes.data(), bytes.size(), &kept), "latitude beyond +-pi/2 rad");
+  far = NetFdm{};
+  far.longitude_rad = -7.0;
+  bytes = EncodeNetFdm(far);
+  EXPECT_EQ(DecodeNetFdm(bytes.data(), bytes.size(), &kept), "longitude beyond +-2 pi rad");
+  for (const double altitude_m : {1e308, -20000.0}) {
+    far = NetFdm{};
+    far.altitude_m = altitude_m;
+    bytes = EncodeNetFdm(far);
+    EXPECT_EQ(DecodeNetFdm(bytes.data(), bytes.size(), &kept), "altitude outside -12 km to 1e8 m");
+  }
+  far = NetFdm{};
+  far.latitude_rad = M_PI / 2, far.altitude_m = 35786e3;  // the pole; geostationary height
+  bytes = EncodeNetFdm(far);
+  EXPECT_EQ(DecodeNetFdm(bytes.data(), bytes.size(), &kept), "");
+  EXPECT_DOUBLE_EQ(kept.altitude_m, 35786e3);
 }
 
 }  // namespace

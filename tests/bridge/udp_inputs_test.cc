@@ -4,6 +4,8 @@
 
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
+
+#include <array>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -98,6 +100,23 @@ TEST(UdpInputsTest, NetFdmDrivesPoseAndControlSurfaces) {
   EXPECT_EQ(input.socket().last_reject_reason(), "version 24 expected, got 23");
   EXPECT_EQ(input.socket().rejected(), 2);
   EXPECT_NEAR(state.pose().translation().z(), 100.0, 0.01);
+  // Finite but nowhere: latitude 1e300 rad, altitude 1e308 m; counted, the pose kept.
+  NetFdm nowhere = fdm;
+  nowhere.latitude_rad = 1e300;
+  bytes = EncodeNetFdm(nowhere);
+  Send(port, bytes.data(), bytes.size());
+  usleep(20000);
+  EXPECT_FALSE(input.Apply(&state));
+  EXPECT_EQ(input.socket().last_reject_reason(), "latitude beyond +-pi/2 rad");
+  nowhere = fdm;
+  nowhere.altitude_m = 1e308;
+  bytes = EncodeNetFdm(nowhere);
+  Send(port, bytes.data(), bytes.size());
+  usleep(20000);
+  EXPECT_FALSE(input.Apply(&state));
+  EXPECT_EQ(input.socket().last_reject_reason(), "altitude outside -12 km to 1e8 m");
+  EXPECT_EQ(input.socket().rejected(), 4);
+  EXPECT_NEAR(state.pose().translation().z(), 100.0, 0.01);
 }
 
 TEST(UdpInputsTest, DoublesInTheConfiguredLayout) {
@@ -169,6 +188,34 @@ TEST(UdpInputsTest, DoublesCarryTheirOwnTimeAndSequenceNumber) {
   usleep(20000);
   EXPECT_FALSE(input.Apply(&state));
   EXPECT_EQ(input.socket().last_reject_reason(), "time must be 0 to 9.2e12 s");
+}
+
+TEST(UdpInputsTest, GeodeticDoublesBeyondTheEarthAreRejectedAndCounted) {
+  testing::TempDir dir;
+  const int port = testing::FreeUdpPort();
+  const scene::Level level = WingLevel(
+      dir, "udp_doubles_port = " + std::to_string(port) +
+               "\nudp_doubles_layout = [\"position\"]\npose_convention = \"geodetic\"\n"
+               "geodetic_origin = [47.0, 8.0, 500.0]\n");
+  DoublesInput input(RobotBridgeConfig::FromModel(level.robots[0]), level.robots[0]);
+  scene::RobotState state(level.robots[0]);
+  const double good[3] = {47.0, 8.0, 600.0};
+  Send(port, good, sizeof(good));
+  usleep(20000);
+  ASSERT_TRUE(input.Apply(&state));
+  EXPECT_NEAR(state.pose().translation().z(), 100.0, 0.01);
+  for (const auto& [packet, reason] :
+       {std::pair<std::array<double, 3>, std::string>{{1e300, 8.0, 600.0},
+                                                      "latitude beyond +-90 deg"},
+        {{47.0, 8.0, 1e308}, "altitude outside -12 km to 1e8 m"},
+        {{47.0, 1e5, 600.0}, "longitude beyond +-360 deg"}}) {
+    Send(port, packet.data(), sizeof(double) * 3);
+    usleep(20000);
+    EXPECT_FALSE(input.Apply(&state));
+    EXPECT_EQ(input.socket().last_reject_reason(), reason);
+  }
+  EXPECT_EQ(input.socket().rejected(), 3);
+  EXPECT_NEAR(state.pose().translation().z(), 100.0, 0.01);  // the last good pose
 }
 
 TEST(UdpInputsTest, BridgeSettingsMistakes) {
