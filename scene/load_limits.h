@@ -21,9 +21,9 @@ struct LoadLimits {
   std::uint64_t max_import_s{600};
   // A [[terrain]]'s work, checked when the level loads (estimated from the
   // rasters and the tile settings) and again for each tile as it is built.
-  std::uint64_t max_terrain_tiles{2000};        // tiles near one robot at once, fine and coarse
-  std::uint64_t max_terrain_mb{1536};           // their memory, with their collision shapes
-  std::uint64_t max_tile_samples{1u << 20};     // one tile's raster samples (1024 x 1024)
+  std::uint64_t max_terrain_tiles{2000};          // tiles near one robot at once, fine and coarse
+  std::uint64_t max_terrain_mb{1280};             // their memory, with their collision shapes
+  std::uint64_t max_tile_samples{1025 * 1025};    // one tile's raster samples (tile_samples 1024)
   std::uint64_t max_imagery_window_px{1u << 26};  // imagery pixels read for one tile's texture
 
   // Throws LevelError "FILE: WHAT, over the limit of LIMIT ([level] KEY)"

@@ -454,8 +454,8 @@ TerrainSpec ParseTerrain(const fs::path& file, const toml::table& table, int ind
         read.Fail(read.Find(key), std::string("'") + key + "' must be positive");
       }
       if (!(*set <= most)) {
-        read.Fail(read.Find(key),
-                  std::string("'") + key + "' must be at most " + std::to_string(std::int64_t(most)));
+        read.Fail(read.Find(key), std::string("'") + key + "' must be at most " +
+                                      std::to_string(std::int64_t(most)));
       }
       *value = *set;
     }

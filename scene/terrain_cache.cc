@@ -101,8 +101,8 @@ std::uint64_t TerrainCache::MaxFileBytes(const TerrainSpec& spec) {
   const std::uint64_t px = std::uint64_t(spec.texture_px);
   const std::uint64_t f = std::uint64_t(spec.coarse_factor);
   return sizeof(kMagic) + 7 * 8 + 8 + 9 * 8 + 2 * 4 + MaxVertices(spec) * (12 + 12 + 8) +
-         (MaxIndices(spec) + 24 * std::uint64_t(spec.tile_samples) + f * f + 1) * 4 +
-         px * px * 4 + 64;
+         (MaxIndices(spec) + 24 * std::uint64_t(spec.tile_samples) + f * f + 1) * 4 + px * px * 4 +
+         64;
 }
 
 std::string TerrainCache::Problem(const TerrainTile& tile, const TerrainSpec& spec) {
@@ -131,7 +131,8 @@ std::string TerrainCache::Problem(const TerrainTile& tile, const TerrainSpec& sp
     if (!Finite(n) || std::abs(n.norm() - 1.0f) > 1e-3f) return "a normal not of unit length";
   }
   for (const Eigen::Vector2f& uv : tile.uvs) {
-    if (!uv.allFinite() || uv.cwiseAbs().maxCoeff() > 2.0f) return "a uv not finite or out of range";
+    if (!uv.allFinite() || uv.cwiseAbs().maxCoeff() > 2.0f)
+      return "a uv not finite or out of range";
   }
   if (!tile.origin_W.allFinite() || tile.origin_W.cwiseAbs().maxCoeff() > 1e8)
     return "the origin not finite or far out";
@@ -186,6 +187,18 @@ TerrainCache::Loaded TerrainCache::Load(const TileId& id) const {
   std::ifstream file(path, std::ios::binary);
   std::string in(bytes, '\0');
   if (!file.read(in.data(), std::streamsize(bytes))) return damaged("cannot be read");
+  Loaded decoded = Decode(in, id, spec_);
+  if (!decoded.damage.empty()) return damaged(decoded.damage);
+  return decoded;
+}
+
+TerrainCache::Loaded TerrainCache::Decode(const std::string& in, const TileId& id,
+                                          const TerrainSpec& spec) {
+  Loaded loaded;
+  const auto damaged = [&](const std::string& why) {
+    loaded.damage = why;
+    return loaded;
+  };
   std::size_t at = sizeof(kMagic);
   TerrainTile tile;
   std::vector<std::uint64_t> key;
@@ -206,18 +219,17 @@ TerrainCache::Loaded TerrainCache::Load(const TileId& id) const {
     tile.bounds_W = Eigen::AlignedBox3d(Eigen::Vector3d(numbers[3], numbers[4], numbers[5]),
                                         Eigen::Vector3d(numbers[6], numbers[7], numbers[8]));
   } else if (!(numbers[3] == std::numeric_limits<double>::max() &&
-                 numbers[6] == std::numeric_limits<double>::lowest())) {
+               numbers[6] == std::numeric_limits<double>::lowest())) {
     // An empty box is stored as Eigen's (max, lowest); anything else reversed or NaN is damage.
     return damaged("bounds not finite");
   }
   tile.texture_width = size[0], tile.texture_height = size[1];
-  if (const std::string problem = Problem(tile, spec_); !problem.empty()) return damaged(problem);
+  if (const std::string problem = Problem(tile, spec); !problem.empty()) return damaged(problem);
   loaded.tile = std::move(tile);
   return loaded;
 }
 
-void TerrainCache::Store(const TerrainTile& tile) {
-  if (!enabled()) return;
+std::string TerrainCache::Encode(const TerrainTile& tile) {
   std::string out(kMagic, sizeof(kMagic));
   Put(&out, std::vector<std::uint64_t>{tile.id.key()});
   const Eigen::AlignedBox3d& b = tile.bounds_W;
@@ -232,6 +244,12 @@ void TerrainCache::Store(const TerrainTile& tile) {
   Put(&out, tile.skirt_indices);
   Put(&out, tile.block_first);
   Put(&out, tile.texture_rgba);
+  return out;
+}
+
+void TerrainCache::Store(const TerrainTile& tile) {
+  if (!enabled()) return;
+  const std::string out = Encode(tile);
   // A name of this process's own: runs sharing the folder never write into one file.
   const fs::path file = FileOf(tile.id),
                  temporary = file.string() + "." + std::to_string(getpid()) + ".part";

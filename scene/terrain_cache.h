@@ -31,12 +31,16 @@ class TerrainCache {
 
   struct Loaded {
     std::optional<TerrainTile> tile;  // the tile when the cache holds it whole and sound
-    std::string damage;  // "FILE: why" when a file is there but cannot be used
+    std::string damage;               // "FILE: why" when a file is there but cannot be used
   };
   Loaded Load(const TileId& id) const;
   // Why `tile` cannot be a tile of `spec` (a count, an index, a value that
   // is not finite, a texture whose size does not match its pixels), or "".
   static std::string Problem(const TerrainTile& tile, const TerrainSpec& spec);
+  // A tile file's bytes, and back: the tile when `bytes` hold tile `id` of
+  // `spec` whole and sound, else why not (Loaded::damage, without the file).
+  static std::string Encode(const TerrainTile& tile);
+  static Loaded Decode(const std::string& bytes, const TileId& id, const TerrainSpec& spec);
   // The most bytes a tile file of `spec` can take.
   static std::uint64_t MaxFileBytes(const TerrainSpec& spec);
   // Keeps `tile`; on failure the cache is switched off and problem() says why.

@@ -1,9 +1,10 @@
 #include "scene/terrain_source.h"
 
 #include <cpl_conv.h>
+#include <cpl_error.h>
 #include <cpl_minixml.h>
 #include <cpl_string.h>
-#include <cpl_error.h>
+#include <cpl_vsi.h>
 #include <gdal.h>
 #include <ogr_srs_api.h>
 
@@ -42,8 +43,18 @@ struct QuietGdal {
 // names other files (SourceFilename, nested VRTs too): GDAL opens them itself,
 // so each is checked here first, with GDAL's own XML reader. A FIFO among
 // them would block the open forever.
+// RegularFileProblem, and GDAL's in-memory files (/vsimem/, tests and fuzzing) as files.
+std::string RasterFileProblem(const std::string& name) {
+  if (name.rfind("/vsimem/", 0) == 0) {
+    VSIStatBufL info;
+    if (VSIStatL(name.c_str(), &info) != 0) return "no such file";
+    return VSI_ISREG(info.st_mode) ? "" : "is not a regular file";
+  }
+  return RegularFileProblem(name);
+}
+
 std::string FileListProblem(const std::filesystem::path& file, int depth = 0) {
-  if (const std::string problem = RegularFileProblem(file); !problem.empty()) {
+  if (const std::string problem = RasterFileProblem(file.string()); !problem.empty()) {
     return (depth ? "it names " + file.string() + ", which " : std::string()) + problem;
   }
   if (LowerExtension(file) != ".vrt") return "";
@@ -62,7 +73,8 @@ std::string FileListProblem(const std::filesystem::path& file, int depth = 0) {
         const bool relative = CPLTestBool(CPLGetXMLValue(node, "relativeToVRT", "0"));
         std::filesystem::path source = name;
         if (relative) source = file.parent_path() / source;
-        if (std::string(name).rfind("/vsi", 0) == 0 || std::string(name).find(':') != std::string::npos) {
+        if (std::string(name).rfind("/vsi", 0) == 0 ||
+            std::string(name).find(':') != std::string::npos) {
           problem = "it names '" + std::string(name) + "', which is not a plain file";
         } else {
           problem = FileListProblem(source, depth + 1);
@@ -89,7 +101,7 @@ struct TerrainSource::Raster {
   OGRSpatialReferenceH crs{nullptr}, wgs84{nullptr};
   OGRCoordinateTransformationH to_lonlat{nullptr}, from_lonlat{nullptr};
   Eigen::Vector2d metres_per_sample{1.0, 1.0};
-  bool geographic{false};  // its x is longitude in degrees
+  bool geographic{false};                // its x is longitude in degrees
   std::vector<double> overview_factors;  // each overview's decimation (band 1)
 
   ~Raster() {
@@ -116,7 +128,7 @@ struct TerrainSource::Raster {
     if (char** files = GDALGetFileList(dataset)) {
       std::string problem;
       for (char** name = files; *name != nullptr && problem.empty(); ++name) {
-        if (const std::string why = RegularFileProblem(*name); !why.empty())
+        if (const std::string why = RasterFileProblem(*name); !why.empty())
           problem = std::string("it reads ") + *name + ", which " + why;
       }
       CSLDestroy(files);
@@ -293,11 +305,15 @@ void TerrainSource::TilesNear(const Eigen::Vector3d& p_W, int lod, double radius
                  ry = radius_m / raster->metres_per_sample.y();
     const int nx = TileCount(raster->cols, span), ny = TileCount(raster->rows, span);
     // In double, clamped to the raster before any int: radii far beyond it stay in range.
-    auto clamp_tile = [](double t, int last) { return int(std::clamp(std::floor(t), 0.0, double(last))); };
+    auto clamp_tile = [](double t, int last) {
+      return int(std::clamp(std::floor(t), 0.0, double(last)));
+    };
     if (s.x() + rx < 0 || s.y() + ry < 0 || (s.x() - rx) / span > nx || (s.y() - ry) / span > ny)
       continue;
-    const int x0 = clamp_tile((s.x() - rx) / span, nx - 1), x1 = clamp_tile((s.x() + rx) / span, nx - 1);
-    const int y0 = clamp_tile((s.y() - ry) / span, ny - 1), y1 = clamp_tile((s.y() + ry) / span, ny - 1);
+    const int x0 = clamp_tile((s.x() - rx) / span, nx - 1),
+              x1 = clamp_tile((s.x() + rx) / span, nx - 1);
+    const int y0 = clamp_tile((s.y() - ry) / span, ny - 1),
+              y1 = clamp_tile((s.y() + ry) / span, ny - 1);
     for (int ty = y0; ty <= y1; ++ty) {
       for (int tx = x0; tx <= x1; ++tx) {
         const TileId id{lod, int(f), tx, ty};
@@ -385,8 +401,8 @@ void TerrainSource::CheckBudgets() const {
       return std::min(across * across, have);
     };
     const double fine = near(spec_.collision_radius_m, side_m, int(s));
-    const double coarse = near(spec_.view_radius_m, side_m * spec_.coarse_factor,
-                               int(s) * spec_.coarse_factor);
+    const double coarse =
+        near(spec_.view_radius_m, side_m * spec_.coarse_factor, int(s) * spec_.coarse_factor);
     tiles += fine + coarse;
     bytes += fine * (drawn + collision) + coarse * drawn;
     for (const auto& image : imagery_) {
@@ -398,8 +414,8 @@ void TerrainSource::CheckBudgets() const {
       const double w = std::min(double(image->cols), side_m / (px - p).norm()),
                    h = std::min(double(image->rows), side_m / (py - p).norm());
       if (std::isfinite(w) && std::isfinite(h))
-        fine_window_px = std::max(fine_window_px, ImageryPixelsRead(image->overview_factors, w,
-                                                                    h, spec_.texture_px));
+        fine_window_px = std::max(
+            fine_window_px, ImageryPixelsRead(image->overview_factors, w, h, spec_.texture_px));
     }
   }
   LoadLimits::Check(file,
@@ -409,17 +425,18 @@ void TerrainSource::CheckBudgets() const {
                     std::uint64_t(std::min(tiles, 1e18)), limits.max_terrain_tiles,
                     "max_terrain_tiles");
   const double mb = bytes / double(1 << 20);
-  LoadLimits::Check(file,
-                    "about " + std::to_string(std::llround(std::min(mb, 1e18))) +
-                        " MB of tiles near a robot at once (tile_samples, texture_px and the radii)",
-                    std::uint64_t(std::min(mb, 1e18)), limits.max_terrain_mb, "max_terrain_mb");
+  LoadLimits::Check(
+      file,
+      "about " + std::to_string(std::llround(std::min(mb, 1e18))) +
+          " MB of tiles near a robot at once (tile_samples, texture_px and the radii)",
+      std::uint64_t(std::min(mb, 1e18)), limits.max_terrain_mb, "max_terrain_mb");
   if (!imagery_.empty()) {
     LoadLimits::Check(spec_.imagery.front(),
                       "a fine tile's texture reads a window of about " +
                           std::to_string(std::llround(std::min(fine_window_px, 1e18))) +
                           " px (add overviews with gdaladdo, or fewer tile_samples)",
-                      std::uint64_t(std::min(fine_window_px, 1e18)),
-                      limits.max_imagery_window_px, "max_imagery_window_px");
+                      std::uint64_t(std::min(fine_window_px, 1e18)), limits.max_imagery_window_px,
+                      "max_imagery_window_px");
   }
 }
 
@@ -545,8 +562,7 @@ TerrainTile TerrainSource::Build(const TileId& id) const {
     const double read_px = ImageryPixelsRead(image->overview_factors, x1 - x0, y1 - y0, size);
     if (read_px > double(spec_.limits.max_imagery_window_px)) {
       tile.imagery_problem = image->path.string() + ": a tile's texture reads a window of " +
-                             std::to_string(std::llround(read_px)) +
-                             " px, over the limit of " +
+                             std::to_string(std::llround(read_px)) + " px, over the limit of " +
                              std::to_string(spec_.limits.max_imagery_window_px) +
                              " ([level] max_imagery_window_px; overviews, gdaladdo, read fewer)";
       break;

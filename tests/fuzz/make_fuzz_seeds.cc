@@ -5,10 +5,14 @@
 //   make_fuzz_seeds DIR SOURCE_DIR
 
 #include <assimp/scene.h>
+#include <cpl_conv.h>
+#include <gdal.h>
+#include <ogr_srs_api.h>
 #include <unistd.h>
 
 #include <assimp/Exporter.hpp>
 #include <assimp/Importer.hpp>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -24,7 +28,10 @@
 #include "sandbox_msgs/bone_values_t.hpp"
 #include "sandbox_msgs/camera_command_t.hpp"
 #include "sandbox_msgs/robot_pose_t.hpp"
+#include "sandbox_msgs/scan_face_compact_t.hpp"
 #include "sandbox_msgs/status_t.hpp"
+#include "scene/terrain_cache.h"
+#include "scene/terrain_source.h"
 
 namespace fs = std::filesystem;
 using Bytes = std::string;
@@ -214,6 +221,94 @@ void ManifestSeeds(const fs::path& dir, const fs::path& source) {
         "quaternion_wxyz = [1, 0, 0, 0]\nscale = [1, 2, 3]\nup = \"y\"\nunit_scale = 0.01\n");
 }
 
+// A small GeoTIFF in WGS84 near (lon 8, lat 46): `bands` of `type`, with
+// GDAL creation `options`.
+Bytes GeoTiff(const fs::path& file, int cols, int rows, int bands, GDALDataType type,
+              std::vector<std::string> options = {}) {
+  GDALAllRegister();
+  std::vector<char*> list;
+  for (std::string& option : options) list.push_back(option.data());
+  list.push_back(nullptr);
+  GDALDatasetH dataset =
+      GDALCreate(GDALGetDriverByName("GTiff"), file.c_str(), cols, rows, bands, type, list.data());
+  double gt[6] = {8.0, 0.0003, 0, 46.01, 0, -0.0003};
+  GDALSetGeoTransform(dataset, gt);
+  OGRSpatialReferenceH wgs84 = OSRNewSpatialReference(nullptr);
+  OSRImportFromEPSG(wgs84, 4326);
+  char* wkt = nullptr;
+  OSRExportToWkt(wgs84, &wkt);
+  GDALSetProjection(dataset, wkt);
+  CPLFree(wkt);
+  OSRDestroySpatialReference(wgs84);
+  std::vector<double> row(static_cast<std::size_t>(cols));
+  for (int b = 1; b <= bands; ++b) {
+    for (int r = 0; r < rows; ++r) {
+      for (int c = 0; c < cols; ++c) row[std::size_t(c)] = 400.0 + 3.0 * c - 2.0 * r + 50.0 * b;
+      if (GDALRasterIO(GDALGetRasterBand(dataset, b), GF_Write, 0, r, cols, 1, row.data(), cols, 1,
+                       GDT_Float64, 0, 0) != CE_None) {
+        std::fprintf(stderr, "make_fuzz_seeds: cannot write %s\n", file.c_str());
+      }
+    }
+  }
+  GDALClose(dataset);
+  const Bytes bytes = Read(file);
+  fs::remove(file);
+  return bytes;
+}
+
+// Rasters as GDAL reads them: elevation and imagery, plain, tiled, compressed.
+void RasterSeeds(const fs::path& dir) {
+  fs::create_directories(dir);
+  Write(dir / "elevation.tif", GeoTiff(dir / "e.tmp.tif", 40, 40, 1, GDT_Float32));
+  Write(dir / "elevation_int16.tif", GeoTiff(dir / "i.tmp.tif", 24, 20, 1, GDT_Int16));
+  Write(dir / "imagery.tif", GeoTiff(dir / "r.tmp.tif", 32, 32, 3, GDT_Byte));
+  Write(dir / "tiled_deflate.tif",
+        GeoTiff(dir / "t.tmp.tif", 48, 48, 1, GDT_Float32,
+                {"TILED=YES", "BLOCKXSIZE=16", "BLOCKYSIZE=16", "COMPRESS=DEFLATE"}));
+}
+
+// Tile-cache files of the fuzz target's settings (16 samples a tile, coarse
+// factor 4, 8 px textures): a fine and a coarse tile, with imagery.
+void TileCacheSeeds(const fs::path& dir) {
+  fs::create_directories(dir);
+  const fs::path elevation = dir / "e.tmp.tif", imagery = dir / "r.tmp.tif";
+  Write(elevation, GeoTiff(dir / "e0.tmp.tif", 70, 70, 1, GDT_Float32));
+  Write(imagery, GeoTiff(dir / "r0.tmp.tif", 64, 64, 3, GDT_Byte));
+  sandbox::scene::TerrainSpec spec;
+  spec.elevation = {elevation};
+  spec.imagery = {imagery};
+  spec.anchor = {46.0, 8.01, 500.0};
+  spec.tile_samples = 16, spec.coarse_factor = 4, spec.texture_px = 8;
+  const sandbox::scene::TerrainSource source(spec);
+  for (const int lod : {0, 1}) {
+    Write(dir / ("tile_lod" + std::to_string(lod)),
+          sandbox::scene::TerrainCache::Encode(source.Build({lod, 0, 0, 0})));
+  }
+  spec.imagery.clear();
+  const sandbox::scene::TerrainSource bare(spec);
+  Write(dir / "tile_bare", sandbox::scene::TerrainCache::Encode(bare.Build({0, 0, 0, 0})));
+  fs::remove(elevation);
+  fs::remove(imagery);
+}
+
+// Compact faces as the sandbox publishes them: millimetres and metres.
+void CompactFaceSeeds(const fs::path& dir) {
+  for (const int encoding : {1, 2}) {
+    sandbox_msgs::scan_face_compact_t face{};
+    face.face = std::int8_t(encoding + 2), face.n = 5, face.resolution_m = 0.5;
+    face.half_extent_m = 1.0, face.encoding = std::int8_t(encoding);
+    face.sensor_position[2] = 60, face.sensor_orientation[0] = 1, face.box_orientation[0] = 1;
+    if (encoding == 1) {
+      face.num_mm = 25;
+      for (int k = 0; k < 25; ++k) face.distance_mm.push_back(std::int16_t(k * 1000 - 3));
+    } else {
+      face.num_m = 25;
+      for (int k = 0; k < 25; ++k) face.distance_m.push_back(k % 3 ? 0.25f * float(k) : INFINITY);
+    }
+    Write(dir / ("face_" + std::to_string(encoding)), Encode(face));
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -227,6 +322,9 @@ int main(int argc, char** argv) {
   UdpSeeds(dir / "udp");
   LogSeeds(dir / "lcm_log");
   LevelFileSeeds(dir / "level_file");
+  RasterSeeds(dir / "raster");
+  TileCacheSeeds(dir / "tile_cache");
+  CompactFaceSeeds(dir / "compact_face");
   std::printf("make_fuzz_seeds: seeds in %s\n", dir.string().c_str());
   return 0;
 }
