@@ -25,8 +25,8 @@
 #include <vector>
 
 #include "app/camera_director.h"
-#include "app/input_clock.h"
 #include "app/frame_pipeline.h"
+#include "app/input_clock.h"
 #include "app/live_view.h"
 #include "app/loaded_level.h"
 #include "app/rate_schedule.h"

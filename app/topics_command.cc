@@ -100,15 +100,14 @@ void PrintTable(const std::map<std::string, bridge::ChannelStats>& stats, double
   double total_Bps = 0.0;
   for (const auto& [channel, s] : stats) {
     total_Bps += bandwidth(s);
-    out << std::left << std::setw(cw) << Escaped(channel) << std::setw(tw) << s.type
-        << std::right << std::setw(10) << s.messages << std::setw(10) << std::fixed
-        << std::setprecision(1) << rate(s) << std::setw(12) << std::setprecision(0)
-        << double(s.bytes) / double(s.messages) << std::setw(12) << std::setprecision(1)
-        << bandwidth(s) * 1e-3 << "\n";
+    out << std::left << std::setw(cw) << Escaped(channel) << std::setw(tw) << s.type << std::right
+        << std::setw(10) << s.messages << std::setw(10) << std::fixed << std::setprecision(1)
+        << rate(s) << std::setw(12) << std::setprecision(0) << double(s.bytes) / double(s.messages)
+        << std::setw(12) << std::setprecision(1) << bandwidth(s) * 1e-3 << "\n";
   }
   if (!stats.empty()) {
-    out << std::left << std::setw(cw + tw + 32) << "total" << std::right << std::setw(12) << std::fixed
-        << std::setprecision(1) << total_Bps * 1e-3 << "\n";
+    out << std::left << std::setw(cw + tw + 32) << "total" << std::right << std::setw(12)
+        << std::fixed << std::setprecision(1) << total_Bps * 1e-3 << "\n";
   }
   out << std::defaultfloat << std::flush;
 }

@@ -77,8 +77,8 @@ void CheckCompactFace(const sandbox_msgs::scan_face_compact_t& message) {
          std::to_string(held));
   const double expected_n = 2.0 * E / res + 1.0;
   if (std::abs(expected_n - message.n) > 0.5)
-    fail("n = " + std::to_string(message.n) + " does not match 2 half_extent_m / resolution_m + 1 = " +
-         std::to_string(expected_n));
+    fail("n = " + std::to_string(message.n) +
+         " does not match 2 half_extent_m / resolution_m + 1 = " + std::to_string(expected_n));
 }
 
 FacePoints DecodeCompactFace(const sandbox_msgs::scan_face_compact_t& message) {

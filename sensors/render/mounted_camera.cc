@@ -52,8 +52,7 @@ void ReadLook(const scene::SensorSpec& spec, scene::SettingsReader* read, Render
     read->Fail("lod_px", "'lod_px' must be 0 (meshes as given) to 8 pixels");
   }
   look->lod_px = float(lod_px);
-  look->cull_hidden_back_faces =
-      read->Flag("cull_hidden_back_faces", look->cull_hidden_back_faces);
+  look->cull_hidden_back_faces = read->Flag("cull_hidden_back_faces", look->cull_hidden_back_faces);
   look->images = kColorImage;
   if (read->Has("images")) {
     look->images = 0;
@@ -136,11 +135,10 @@ std::vector<MountedCamera> MakeRobotCameras(const scene::Level& level) {
       }
       const double pixels = double(camera.view.width) * double(camera.view.height);
       if (pixels > pixel_budget) {
-        throw scene::LevelError(spec.Where() + std::to_string(camera.view.width) + " x " +
-                                std::to_string(camera.view.height) + " = " +
-                                std::to_string(std::int64_t(pixels)) +
-                                " pixels, over pixel_budget " +
-                                std::to_string(std::int64_t(pixel_budget)));
+        throw scene::LevelError(
+            spec.Where() + std::to_string(camera.view.width) + " x " +
+            std::to_string(camera.view.height) + " = " + std::to_string(std::int64_t(pixels)) +
+            " pixels, over pixel_budget " + std::to_string(std::int64_t(pixel_budget)));
       }
       cameras.push_back(std::move(camera));
     }

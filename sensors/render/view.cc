@@ -26,10 +26,9 @@ void CameraView::ValidateOrThrow() const {
                                 std::to_string(width) + " x " + std::to_string(height));
   }
   if (!(fov_y_rad >= kMinFov_rad && fov_y_rad < M_PI)) {
-    throw std::invalid_argument("fov_deg must be at least " +
-                                std::to_string(kMinFov_rad * 180.0 / M_PI).substr(0, 4) +
-                                " and below 180 degrees, got " +
-                                std::to_string(fov_y_rad * 180.0 / M_PI));
+    throw std::invalid_argument(
+        "fov_deg must be at least " + std::to_string(kMinFov_rad * 180.0 / M_PI).substr(0, 4) +
+        " and below 180 degrees, got " + std::to_string(fov_y_rad * 180.0 / M_PI));
   }
   if (!(near_m >= kMinNear_m && far_m > near_m && std::isfinite(far_m))) {
     throw std::invalid_argument("need " + std::to_string(kMinNear_m).substr(0, 6) +

@@ -59,7 +59,7 @@ TEST(ReplayTest, TwoReplaysGiveOneTickPerPoseAndIdenticalFrameIndexesAndScans) {
     EXPECT_EQ(Read(entry.path()), Read(dir.path() / "b" / "scans" / entry.path().filename()))
         << entry.path().filename();
   }
-  EXPECT_EQ(scans, 5);  // at 0, 0.5, 1.0, 1.5 and 2.0 s of input time
+  EXPECT_EQ(scans, 5);   // at 0, 0.5, 1.0, 1.5 and 2.0 s of input time
   EXPECT_EQ(sheets, 5);  // each with its sheet
 }
 
@@ -102,7 +102,7 @@ int MessagesOn(const std::string& log, const std::string& channel) {
 TEST(ReplayTest, InputTimeThatJumpsBackOrIsNegativeKeepsTheSensorsOnTheTickSchedule) {
   sandbox::testing::TempDir dir;
   const std::string log = (dir.path() / "restart.lcmlog").string();
-  WriteFlightLog(log, 60);       // 1.00 .. 2.18 s
+  WriteFlightLog(log, 60);                      // 1.00 .. 2.18 s
   WriteFlightLog(log, 60, 20'000, 100.0, "a");  // 1.00 .. 2.18 s again: back by 1.18 s
   const std::string out = (dir.path() / "out.lcmlog").string();
   auto run = RunSandbox("run --replay " + log + " --record " + out);

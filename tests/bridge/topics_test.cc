@@ -19,7 +19,7 @@ TEST(TopicMonitorTest, ChannelsWithControlCharactersAndLongNamesAreCounted) {
   LcmLink link("memq://");
   TopicMonitor monitor(link);
   const std::string longest(63, 'L');  // LCM's longest channel name
-  const std::vector<std::string> names = {"plain", "with\nnewline", std::string("ctrl\x01x"),
+  const std::vector<std::string> names = {"plain",     "with\nnewline", std::string("ctrl\x01x"),
                                           "tab\there", "utf8-\xc3\xa9", longest};
   const unsigned char data[8] = {1, 2, 3, 4, 5, 6, 7, 8};
   for (int round = 0; round < 2; ++round) {

@@ -4,12 +4,11 @@
 
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
-
-#include <array>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 
@@ -20,7 +19,6 @@ namespace sandbox::bridge {
 namespace {
 
 using Eigen::Vector3d;
-
 
 void Send(int port, const void* data, std::size_t size) {
   const int s = ::socket(AF_INET, SOCK_DGRAM, 0);
@@ -60,7 +58,7 @@ TEST(UdpInputsTest, NetFdmDrivesPoseAndControlSurfaces) {
   fdm.altitude_m = 600.0;         // 100 m up
   fdm.psi_rad = float(M_PI / 2);  // heading east
   fdm.elevator = 0.5f;
-  fdm.cur_time = 1'700'000'000;  // the sender's clock, whole seconds since 1970
+  fdm.cur_time = 1'700'000'000;                  // the sender's clock, whole seconds since 1970
   for (const float lat_offset : {0.0f, 1.0f}) {  // two packets: the newest wins
     NetFdm sent = fdm;
     sent.latitude_rad += lat_offset * 1e-9;
@@ -72,7 +70,7 @@ TEST(UdpInputsTest, NetFdmDrivesPoseAndControlSurfaces) {
   EXPECT_EQ(input.socket().received(), 2);
   EXPECT_EQ(input.socket().superseded(), 1);
   EXPECT_EQ(input.last_tag().utime, 1'700'000'000'000'000);  // the packet's own time
-  EXPECT_EQ(input.last_tag().seq, -1);                        // the format has no counter
+  EXPECT_EQ(input.last_tag().seq, -1);                       // the format has no counter
   // North: the meridian radius of curvature at 47 degrees (plus the altitude)
   // times the latitude step.
   const double e2 = 0.00669437999014, s47 = std::sin(47.0 * M_PI / 180.0);
@@ -193,10 +191,10 @@ TEST(UdpInputsTest, DoublesCarryTheirOwnTimeAndSequenceNumber) {
 TEST(UdpInputsTest, GeodeticDoublesBeyondTheEarthAreRejectedAndCounted) {
   testing::TempDir dir;
   const int port = testing::FreeUdpPort();
-  const scene::Level level = WingLevel(
-      dir, "udp_doubles_port = " + std::to_string(port) +
-               "\nudp_doubles_layout = [\"position\"]\npose_convention = \"geodetic\"\n"
-               "geodetic_origin = [47.0, 8.0, 500.0]\n");
+  const scene::Level level =
+      WingLevel(dir, "udp_doubles_port = " + std::to_string(port) +
+                         "\nudp_doubles_layout = [\"position\"]\npose_convention = \"geodetic\"\n"
+                         "geodetic_origin = [47.0, 8.0, 500.0]\n");
   DoublesInput input(RobotBridgeConfig::FromModel(level.robots[0]), level.robots[0]);
   scene::RobotState state(level.robots[0]);
   const double good[3] = {47.0, 8.0, 600.0};
@@ -204,11 +202,10 @@ TEST(UdpInputsTest, GeodeticDoublesBeyondTheEarthAreRejectedAndCounted) {
   usleep(20000);
   ASSERT_TRUE(input.Apply(&state));
   EXPECT_NEAR(state.pose().translation().z(), 100.0, 0.01);
-  for (const auto& [packet, reason] :
-       {std::pair<std::array<double, 3>, std::string>{{1e300, 8.0, 600.0},
-                                                      "latitude beyond +-90 deg"},
-        {{47.0, 8.0, 1e308}, "altitude outside -12 km to 1e8 m"},
-        {{47.0, 1e5, 600.0}, "longitude beyond +-360 deg"}}) {
+  for (const auto& [packet, reason] : {std::pair<std::array<double, 3>, std::string>{
+                                           {1e300, 8.0, 600.0}, "latitude beyond +-90 deg"},
+                                       {{47.0, 8.0, 1e308}, "altitude outside -12 km to 1e8 m"},
+                                       {{47.0, 1e5, 600.0}, "longitude beyond +-360 deg"}}) {
     Send(port, packet.data(), sizeof(double) * 3);
     usleep(20000);
     EXPECT_FALSE(input.Apply(&state));

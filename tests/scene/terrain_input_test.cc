@@ -71,9 +71,8 @@ void WriteRaster(const fs::path& file, int cols, int rows, double lon0, double l
 // north-south) with its north-west corner at (lon0, lat0).
 void WriteFlat(const fs::path& file, double lon0 = 8.0, double lat0 = 46.02,
                const std::function<double(int, int)>& height = nullptr) {
-  WriteRaster(file, 129, 129, lon0, lat0, 0.0003, 1, GDT_Float32, [&](int c, int r, int) {
-    return height ? height(c, r) : kGround_m;
-  });
+  WriteRaster(file, 129, 129, lon0, lat0, 0.0003, 1, GDT_Float32,
+              [&](int c, int r, int) { return height ? height(c, r) : kGround_m; });
 }
 
 // A [[terrain]] over the flat rasters with `keys`; the tile settings below
@@ -117,9 +116,7 @@ struct Probe {
 
 // The ground of a flat raster at height kGround_m lies below the tangent plane
 // at the anchor by the Earth's curvature: d^2 / (2 R) at d from the anchor.
-double ExpectedDown(double x, double y) {
-  return 100.0 + (x * x + y * y) / (2.0 * 6371000.0);
-}
+double ExpectedDown(double x, double y) { return 100.0 + (x * x + y * y) / (2.0 * 6371000.0); }
 
 TEST(TerrainInputTest, AFifoAsARasterOrNamedByAVrtIsLeftOutAtOnce) {
   testing::TempDir dir;
@@ -134,8 +131,8 @@ TEST(TerrainInputTest, AFifoAsARasterOrNamedByAVrtIsLeftOutAtOnce) {
             "  </VRTRasterBand>\n</VRTDataset>\n");
   // As elevation: left out, said; the good raster still serves.
   for (const std::string name : {"pipe.tif", "names_pipe.vrt"}) {
-    const Level level = LoadLevel(dir.Write(
-        "level.toml", TerrainToml("elevation = [\"" + name + "\", \"flat.tif\"]\n")));
+    const Level level = LoadLevel(
+        dir.Write("level.toml", TerrainToml("elevation = [\"" + name + "\", \"flat.tif\"]\n")));
     ASSERT_EQ(level.warnings.size(), 1u) << name;
     EXPECT_NE(level.warnings[0].find("is a FIFO, not a regular file"), std::string::npos)
         << level.warnings[0];
@@ -145,8 +142,8 @@ TEST(TerrainInputTest, AFifoAsARasterOrNamedByAVrtIsLeftOutAtOnce) {
     EXPECT_NEAR(*down, ExpectedDown(100, 100), 0.05);
   }
   // As imagery: drawn without it.
-  const Level imagery = LoadLevel(dir.Write(
-      "level.toml", TerrainToml("elevation = \"flat.tif\"\nimagery = \"pipe.tif\"\n")));
+  const Level imagery = LoadLevel(
+      dir.Write("level.toml", TerrainToml("elevation = \"flat.tif\"\nimagery = \"pipe.tif\"\n")));
   ASSERT_EQ(imagery.warnings.size(), 1u);
   EXPECT_NE(imagery.warnings[0].find("pipe.tif: is a FIFO"), std::string::npos)
       << imagery.warnings[0];
@@ -158,18 +155,18 @@ TEST(TerrainInputTest, BudgetsRefuseTerrainWorkBeyondThemAtLoadNamingTheFigureAn
   // A sparse imagery raster of 1,000,000 x 1,000,000 px over the same ground
   // (11 MB on disk): a fine tile's texture would resample a window of
   // about 2e10 px.
-  WriteRaster(dir.path() / "giant.tif", 1000000, 1000000, 8.0, 46.02, 0.0384 / 1e6, 3, GDT_Byte,
-              nullptr, {"TILED=YES", "BLOCKXSIZE=4096", "BLOCKYSIZE=4096", "SPARSE_OK=TRUE", "BIGTIFF=YES"},
-              false);
-  std::string error = LoadError(
-      dir, TerrainToml("elevation = \"flat.tif\"\nimagery = \"giant.tif\"\n"));
+  WriteRaster(
+      dir.path() / "giant.tif", 1000000, 1000000, 8.0, 46.02, 0.0384 / 1e6, 3, GDT_Byte, nullptr,
+      {"TILED=YES", "BLOCKXSIZE=4096", "BLOCKYSIZE=4096", "SPARSE_OK=TRUE", "BIGTIFF=YES"}, false);
+  std::string error =
+      LoadError(dir, TerrainToml("elevation = \"flat.tif\"\nimagery = \"giant.tif\"\n"));
   EXPECT_NE(error.find("giant.tif: a fine tile's texture reads a window of about"),
             std::string::npos)
       << error;
   EXPECT_NE(error.find("([level] max_imagery_window_px"), std::string::npos) << error;
   // Samples per tile, tiles near a robot, their memory.
-  error = LoadError(dir, "[level]\nmax_tile_samples = 1000\n" +
-                             TerrainToml("elevation = \"flat.tif\"\n"));
+  error = LoadError(
+      dir, "[level]\nmax_tile_samples = 1000\n" + TerrainToml("elevation = \"flat.tif\"\n"));
   EXPECT_NE(error.find("tile_samples 32 makes tiles of 1089 samples, over the limit of 1000 "
                        "([level] max_tile_samples"),
             std::string::npos)
@@ -201,8 +198,9 @@ TEST(TerrainInputTest, SettingsBeyondPhysicalSenseAreRefusedNamingTheKey) {
   EXPECT_NE(LoadError(dir, TerrainToml(flat + "view_radius_m = 5e12\n"))
                 .find("'view_radius_m' must be at most"),
             std::string::npos);
-  EXPECT_NE(LoadError(dir, "[[terrain]]\nname = \"g\"\nelevation = \"flat.tif\"\n"
-                           "anchor = [46.0, 8.02, 1e308]\n")
+  EXPECT_NE(LoadError(dir,
+                      "[[terrain]]\nname = \"g\"\nelevation = \"flat.tif\"\n"
+                      "anchor = [46.0, 8.02, 1e308]\n")
                 .find("'anchor' height must be from -12000 to 100000 m"),
             std::string::npos);
   EXPECT_NE(LoadError(dir, TerrainToml(flat) + "[horizon]\nvisibility_m = 1e-300\n")
@@ -221,8 +219,8 @@ TEST(TerrainInputTest, OneAbsurdHeightIsNoDataAndTheRestOfItsTileStands) {
   const Level level =
       LoadLevel(dir.Write("level.toml", TerrainToml("elevation = \"spikes.tif\"\n")));
   Probe probe(level);
-  for (const auto& [x, y] : std::vector<std::pair<double, double>>{
-           {0, 0}, {150, -120}, {-300, 200}, {40, 30}}) {
+  for (const auto& [x, y] :
+       std::vector<std::pair<double, double>>{{0, 0}, {150, -120}, {-300, 200}, {40, 30}}) {
     const auto down = probe.Down(x, y);
     ASSERT_TRUE(down.has_value()) << x << ", " << y;
     EXPECT_NEAR(*down, ExpectedDown(x, y), 0.05) << x << ", " << y;
@@ -261,10 +259,11 @@ TEST(TerrainInputTest, ARasterAcrossTheAntimeridianServesBothSides) {
   // Longitude 179.9 to about 180.1 (past 180), latitude 0.1 to -0.1.
   WriteRaster(dir.path() / "dateline.tif", 201, 201, 179.9, 0.1, 0.001, 1, GDT_Float32,
               [](int, int, int) { return kGround_m; });
-  const Level level = LoadLevel(dir.Write(
-      "level.toml", "[[terrain]]\nname = \"ground\"\nelevation = \"dateline.tif\"\n"
-                    "anchor = [0.0, 180.0, 500.0]\ntile_samples = 32\ncoarse_factor = 4\n"
-                    "collision_radius_m = 500\nview_radius_m = 2000\n"));
+  const Level level =
+      LoadLevel(dir.Write("level.toml",
+                          "[[terrain]]\nname = \"ground\"\nelevation = \"dateline.tif\"\n"
+                          "anchor = [0.0, 180.0, 500.0]\ntile_samples = 32\ncoarse_factor = 4\n"
+                          "collision_radius_m = 500\nview_radius_m = 2000\n"));
   ASSERT_TRUE(level.warnings.empty()) << level.warnings.front();
   Probe probe(level);
   for (const double x : {-3000.0, 0.0, 3000.0}) {  // west (+179.97), on, east (-179.97)
@@ -280,8 +279,8 @@ TEST(TerrainInputTest, ARasterPastAPoleOrWithANonFiniteGeotransformIsLeftOutSaid
   WriteFlat(dir.path() / "flat.tif");
   WriteRaster(dir.path() / "pole.tif", 64, 64, 8.0, 90.5, 0.01, 1, GDT_Float32,
               [](int, int, int) { return kGround_m; });
-  const Level level = LoadLevel(
-      dir.Write("level.toml", TerrainToml("elevation = [\"pole.tif\", \"flat.tif\"]\n")));
+  const Level level =
+      LoadLevel(dir.Write("level.toml", TerrainToml("elevation = [\"pole.tif\", \"flat.tif\"]\n")));
   ASSERT_EQ(level.warnings.size(), 1u);
   EXPECT_NE(level.warnings[0].find("pole.tif: it reaches latitude 90.5"), std::string::npos)
       << level.warnings[0];
@@ -295,8 +294,8 @@ TEST(TerrainInputTest, ARasterPastAPoleOrWithANonFiniteGeotransformIsLeftOutSaid
   double gt[6] = {8.0, std::nan(""), 0, 46.0, 0, -0.001};
   GDALSetGeoTransform(nan, gt);
   GDALClose(nan);
-  const Level level2 = LoadLevel(
-      dir.Write("level.toml", TerrainToml("elevation = [\"nan.tif\", \"flat.tif\"]\n")));
+  const Level level2 =
+      LoadLevel(dir.Write("level.toml", TerrainToml("elevation = [\"nan.tif\", \"flat.tif\"]\n")));
   ASSERT_EQ(level2.warnings.size(), 1u);
   EXPECT_NE(level2.warnings[0].find("nan.tif: "), std::string::npos) << level2.warnings[0];
   EXPECT_NE(level2.warnings[0].find("left out"), std::string::npos) << level2.warnings[0];
@@ -309,9 +308,9 @@ TEST(TerrainInputTest, DamagedTileCacheFilesAreReportedAndBuiltAgain) {
   WriteFlat(dir.path() / "flat.tif");
   WriteRaster(dir.path() / "image.tif", 512, 512, 8.0, 46.02, 0.0384 / 512, 3, GDT_Byte,
               [](int c, int r, int b) { return (c + r + b * 40) % 256; });
-  const Level level = LoadLevel(dir.Write(
-      "level.toml", TerrainToml("elevation = \"flat.tif\"\nimagery = \"image.tif\"\n"
-                                "cache = \"tiles\"\ntexture_px = 64\n")));
+  const Level level = LoadLevel(
+      dir.Write("level.toml", TerrainToml("elevation = \"flat.tif\"\nimagery = \"image.tif\"\n"
+                                          "cache = \"tiles\"\ntexture_px = 64\n")));
   const TerrainSource source(*level.terrain);
   std::vector<TileId> near;
   source.TilesNear(Vector3d(0, 0, 0), 0, 1.0, &near);

@@ -166,9 +166,9 @@ TEST(FaceScannerTest, PointsAreTheRaysEnds) {
     for (int f = 0; f < 6; ++f) {
       for (std::size_t k = 0; k < scan.faces[std::size_t(f)].distance_m.size(); ++k) {
         const std::size_t i = grids[std::size_t(f)].first + k;
-        const Vector3d end = rays.origin_W + (rays.start[i].cast<double>() +
-                                              double(hits.distance_m[i]) *
-                                                  rays.direction[i].cast<double>());
+        const Vector3d end =
+            rays.origin_W + (rays.start[i].cast<double>() +
+                             double(hits.distance_m[i]) * rays.direction[i].cast<double>());
         worst_m = std::max(worst_m, (scan.PointW(f, k) - end).norm());
         occupied += scan.faces[std::size_t(f)].occupancy[k] == kOccupied;
       }
