@@ -32,6 +32,7 @@
 #include "sandbox_msgs/status_t.hpp"
 #include "scene/terrain_cache.h"
 #include "scene/terrain_source.h"
+#include "tests/test_rasters.h"
 
 namespace fs = std::filesystem;
 using Bytes = std::string;
@@ -221,36 +222,13 @@ void ManifestSeeds(const fs::path& dir, const fs::path& source) {
         "quaternion_wxyz = [1, 0, 0, 0]\nscale = [1, 2, 3]\nup = \"y\"\nunit_scale = 0.01\n");
 }
 
-// A small GeoTIFF in WGS84 near (lon 8, lat 46): `bands` of `type`, with
-// GDAL creation `options`.
+// A small GeoTIFF in WGS84 near (lon 8, lat 46), as bytes: `bands` of
+// `type`, with GDAL creation `options`.
 Bytes GeoTiff(const fs::path& file, int cols, int rows, int bands, GDALDataType type,
               std::vector<std::string> options = {}) {
-  GDALAllRegister();
-  std::vector<char*> list;
-  for (std::string& option : options) list.push_back(option.data());
-  list.push_back(nullptr);
-  GDALDatasetH dataset =
-      GDALCreate(GDALGetDriverByName("GTiff"), file.c_str(), cols, rows, bands, type, list.data());
-  double gt[6] = {8.0, 0.0003, 0, 46.01, 0, -0.0003};
-  GDALSetGeoTransform(dataset, gt);
-  OGRSpatialReferenceH wgs84 = OSRNewSpatialReference(nullptr);
-  OSRImportFromEPSG(wgs84, 4326);
-  char* wkt = nullptr;
-  OSRExportToWkt(wgs84, &wkt);
-  GDALSetProjection(dataset, wkt);
-  CPLFree(wkt);
-  OSRDestroySpatialReference(wgs84);
-  std::vector<double> row(static_cast<std::size_t>(cols));
-  for (int b = 1; b <= bands; ++b) {
-    for (int r = 0; r < rows; ++r) {
-      for (int c = 0; c < cols; ++c) row[std::size_t(c)] = 400.0 + 3.0 * c - 2.0 * r + 50.0 * b;
-      if (GDALRasterIO(GDALGetRasterBand(dataset, b), GF_Write, 0, r, cols, 1, row.data(), cols, 1,
-                       GDT_Float64, 0, 0) != CE_None) {
-        std::fprintf(stderr, "make_fuzz_seeds: cannot write %s\n", file.c_str());
-      }
-    }
-  }
-  GDALClose(dataset);
+  sandbox::testing::WriteRaster(
+      file, cols, rows, 8.0, 46.01, 0.0003, bands, type,
+      [](int c, int r, int b) { return 400.0 + 3.0 * c - 2.0 * r + 50.0 * b; }, options);
   const Bytes bytes = Read(file);
   fs::remove(file);
   return bytes;

@@ -4,10 +4,8 @@
 // settings beyond any physical sense. Every raster is written here with GDAL;
 // expected heights come from the values written, not from the terrain code.
 
-#include <cpl_conv.h>
 #include <gdal.h>
 #include <gtest/gtest.h>
-#include <ogr_srs_api.h>
 #include <sys/stat.h>
 
 #include <cmath>
@@ -20,6 +18,7 @@
 #include "scene/terrain_cache.h"
 #include "scene/terrain_source.h"
 #include "scene/terrain_streamer.h"
+#include "tests/test_rasters.h"
 #include "tests/test_util.h"
 
 namespace sandbox::scene {
@@ -27,45 +26,9 @@ namespace {
 
 using Eigen::Vector3d;
 namespace fs = std::filesystem;
+using testing::WriteRaster;
 
 constexpr double kGround_m = 500.0;  // the flat rasters' height
-
-// A raster in WGS84 (EPSG:4326): `cols` x `rows` samples of `spacing_deg`
-// from the north-west corner (lon0, lat0); band values from `value(col, row,
-// band)`. Extra GDAL creation options (SPARSE_OK=TRUE, ...) as given.
-void WriteRaster(const fs::path& file, int cols, int rows, double lon0, double lat0,
-                 double spacing_deg, int bands, GDALDataType type,
-                 const std::function<double(int, int, int)>& value,
-                 std::vector<std::string> options = {}, bool fill = true) {
-  GDALAllRegister();
-  GDALDriverH driver = GDALGetDriverByName("GTiff");
-  std::vector<char*> list;
-  for (std::string& option : options) list.push_back(option.data());
-  list.push_back(nullptr);
-  GDALDatasetH dataset = GDALCreate(driver, file.c_str(), cols, rows, bands, type, list.data());
-  ASSERT_NE(dataset, nullptr) << file;
-  double gt[6] = {lon0, spacing_deg, 0.0, lat0, 0.0, -spacing_deg};
-  GDALSetGeoTransform(dataset, gt);
-  OGRSpatialReferenceH wgs84 = OSRNewSpatialReference(nullptr);
-  OSRImportFromEPSG(wgs84, 4326);
-  char* wkt = nullptr;
-  OSRExportToWkt(wgs84, &wkt);
-  GDALSetProjection(dataset, wkt);
-  CPLFree(wkt);
-  OSRDestroySpatialReference(wgs84);
-  if (fill) {
-    std::vector<double> row(static_cast<std::size_t>(cols));
-    for (int b = 1; b <= bands; ++b) {
-      for (int r = 0; r < rows; ++r) {
-        for (int c = 0; c < cols; ++c) row[std::size_t(c)] = value(c, r, b);
-        ASSERT_EQ(GDALRasterIO(GDALGetRasterBand(dataset, b), GF_Write, 0, r, cols, 1, row.data(),
-                               cols, 1, GDT_Float64, 0, 0),
-                  CE_None);
-      }
-    }
-  }
-  GDALClose(dataset);
-}
 
 // A flat elevation raster of 129 x 129 samples 0.0003 deg apart (about 33 m
 // north-south) with its north-west corner at (lon0, lat0).
@@ -155,9 +118,9 @@ TEST(TerrainInputTest, BudgetsRefuseTerrainWorkBeyondThemAtLoadNamingTheFigureAn
   // A sparse imagery raster of 1,000,000 x 1,000,000 px over the same ground
   // (11 MB on disk): a fine tile's texture would resample a window of
   // about 2e10 px.
-  WriteRaster(
-      dir.path() / "giant.tif", 1000000, 1000000, 8.0, 46.02, 0.0384 / 1e6, 3, GDT_Byte, nullptr,
-      {"TILED=YES", "BLOCKXSIZE=4096", "BLOCKYSIZE=4096", "SPARSE_OK=TRUE", "BIGTIFF=YES"}, false);
+  WriteRaster(dir.path() / "giant.tif", 1000000, 1000000, 8.0, 46.02, 0.0384 / 1e6, 3, GDT_Byte,
+              nullptr,
+              {"TILED=YES", "BLOCKXSIZE=4096", "BLOCKYSIZE=4096", "SPARSE_OK=TRUE", "BIGTIFF=YES"});
   std::string error =
       LoadError(dir, TerrainToml("elevation = \"flat.tif\"\nimagery = \"giant.tif\"\n"));
   EXPECT_NE(error.find("giant.tif: a fine tile's texture reads a window of about"),
