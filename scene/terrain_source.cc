@@ -88,6 +88,9 @@ std::string FileListProblem(const std::filesystem::path& file, int depth = 0) {
   return problem;
 }
 
+// The most one block of a raster (all bands) may take: GDAL reads whole blocks.
+constexpr double kMaxBlockBytes = 256.0 * (1 << 20);
+
 }  // namespace
 
 struct TerrainSource::Raster {
@@ -176,6 +179,17 @@ struct TerrainSource::Raster {
       }
     }
     const GDALRasterBandH band = GDALGetRasterBand(dataset, 1);
+    // GDAL reads whole blocks: a header may claim blocks of gigabytes.
+    int block_x = 0, block_y = 0;
+    GDALGetBlockSize(band, &block_x, &block_y);
+    const double block_bytes = double(block_x) * double(block_y) * double(bands) *
+                               double(GDALGetDataTypeSizeBytes(GDALGetRasterDataType(band)));
+    if (!(block_bytes <= kMaxBlockBytes)) {
+      return "its blocks of " + std::to_string(block_x) + " x " + std::to_string(block_y) +
+             " samples take " + std::to_string(std::llround(block_bytes / (1 << 20))) +
+             " MB each, over " + std::to_string(int(kMaxBlockBytes / (1 << 20))) +
+             " MB (write it tiled: gdal_translate -co TILED=YES)";
+    }
     for (int o = 0; o < GDALGetOverviewCount(band); ++o) {
       const GDALRasterBandH overview = GDALGetOverview(band, o);
       if (overview != nullptr && GDALGetRasterBandXSize(overview) > 0)

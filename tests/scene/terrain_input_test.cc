@@ -264,6 +264,22 @@ TEST(TerrainInputTest, ARasterPastAPoleOrWithANonFiniteGeotransformIsLeftOutSaid
   EXPECT_NE(level2.warnings[0].find("left out"), std::string::npos) << level2.warnings[0];
 }
 
+// GDAL reads whole blocks: a raster whose blocks claim more than 256 MB (a
+// fuzzed header asked for 5 GB to read 17 x 17 samples) is left out, said.
+TEST(TerrainInputTest, ARasterWhoseBlocksAreHugeIsLeftOutSaid) {
+  testing::TempDir dir;
+  WriteFlat(dir.path() / "flat.tif");
+  WriteRaster(dir.path() / "strips.tif", 70000, 1000, 8.0, 46.02, 0.0384 / 70000, 1, GDT_Float32,
+              nullptr, {"BLOCKYSIZE=1000", "COMPRESS=DEFLATE", "SPARSE_OK=TRUE"});
+  const Level level = LoadLevel(
+      dir.Write("level.toml", TerrainToml("elevation = [\"strips.tif\", \"flat.tif\"]\n")));
+  ASSERT_EQ(level.warnings.size(), 1u);
+  EXPECT_NE(level.warnings[0].find("strips.tif: its blocks of 70000 x 1000 samples take 267 MB "
+                                   "each, over 256 MB"),
+            std::string::npos)
+      << level.warnings[0];
+}
+
 // Cache files written through the cache itself from a built tile with one
 // thing wrong: each is reported, built again, and the rebuilt tile is sound.
 TEST(TerrainInputTest, DamagedTileCacheFilesAreReportedAndBuiltAgain) {
