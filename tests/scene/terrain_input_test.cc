@@ -134,6 +134,11 @@ TEST(TerrainInputTest, BudgetsRefuseTerrainWorkBeyondThemAtLoadNamingTheFigureAn
                        "([level] max_tile_samples"),
             std::string::npos)
       << error;
+  error = LoadError(dir, TerrainToml("elevation = \"flat.tif\"\ntile_samples = 4096\n"));
+  EXPECT_NE(error.find("tile_samples 4096 makes tiles of 16785409 samples, over the limit of "
+                       "1050625"),
+            std::string::npos)
+      << error;  // the documented maximum of tile_samples, refused by the default budget
   error = LoadError(dir, TerrainToml("elevation = \"flat.tif\"\ntile_samples = 2\n"
                                      "coarse_factor = 1\n"));
   EXPECT_NE(error.find("tiles near a robot at once"), std::string::npos) << error;
