@@ -1,3 +1,5 @@
+// Over 600 lines: the GDAL side of a terrain (opening checks, coordinate
+// systems, tiles and their imagery) is one unit; its header says what it offers.
 #include "scene/terrain_source.h"
 
 #include <cpl_conv.h>
@@ -12,6 +14,8 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <memory>
 #include <mutex>
 #include <stdexcept>
 
@@ -88,6 +92,51 @@ std::string FileListProblem(const std::filesystem::path& file, int depth = 0) {
   return problem;
 }
 
+// A coordinate system and the transformations between it and WGS84 (x =
+// longitude or easting), or why they cannot be made.
+struct CrsLink {
+  OGRSpatialReferenceH crs{nullptr}, wgs84{nullptr};
+  OGRCoordinateTransformationH to_lonlat{nullptr}, from_lonlat{nullptr};
+  std::string problem;
+  CrsLink() = default;
+  CrsLink(const CrsLink&) = delete;
+  CrsLink& operator=(const CrsLink&) = delete;
+  ~CrsLink() {
+    if (to_lonlat) OCTDestroyCoordinateTransformation(to_lonlat);
+    if (from_lonlat) OCTDestroyCoordinateTransformation(from_lonlat);
+    if (crs) OSRDestroySpatialReference(crs);
+    if (wgs84) OSRDestroySpatialReference(wgs84);
+  }
+};
+
+// PROJ looks a transformation up in its database each time one is made, most
+// of the time of opening a small raster: made once per coordinate system and
+// thread (transformations are not shared between threads), up to 64 of them.
+std::shared_ptr<const CrsLink> LinkFor(OGRSpatialReferenceH own) {
+  char* wkt = nullptr;
+  OSRExportToWkt(own, &wkt);
+  const std::string key = wkt != nullptr ? wkt : "";
+  CPLFree(wkt);
+  thread_local std::map<std::string, std::shared_ptr<const CrsLink>> links;
+  if (const auto found = links.find(key); found != links.end() && !key.empty()) {
+    return found->second;
+  }
+  auto link = std::make_shared<CrsLink>();
+  link->crs = OSRClone(own);
+  link->wgs84 = OSRNewSpatialReference(nullptr);
+  OSRSetWellKnownGeogCS(link->wgs84, "WGS84");
+  OSRSetAxisMappingStrategy(link->crs, OAMS_TRADITIONAL_GIS_ORDER);
+  OSRSetAxisMappingStrategy(link->wgs84, OAMS_TRADITIONAL_GIS_ORDER);
+  link->to_lonlat = OCTNewCoordinateTransformation(link->crs, link->wgs84);
+  link->from_lonlat = OCTNewCoordinateTransformation(link->wgs84, link->crs);
+  if (!link->to_lonlat || !link->from_lonlat) {
+    link->problem = "its coordinate system cannot be transformed to WGS84 (" +
+                    QuietGdal::Last("no transformation") + ")";
+  }
+  if (links.size() < 64 && !key.empty()) links.emplace(key, link);
+  return link;
+}
+
 // The most one block of a raster (all bands) may take: GDAL reads whole blocks.
 constexpr double kMaxBlockBytes = 256.0 * (1 << 20);
 
@@ -101,17 +150,13 @@ struct TerrainSource::Raster {
   int cols{0}, rows{0}, bands{0};
   bool has_nodata{false};
   double nodata{0.0};
-  OGRSpatialReferenceH crs{nullptr}, wgs84{nullptr};
-  OGRCoordinateTransformationH to_lonlat{nullptr}, from_lonlat{nullptr};
+  std::shared_ptr<const CrsLink> link;                                    // to and from WGS84
+  OGRCoordinateTransformationH to_lonlat{nullptr}, from_lonlat{nullptr};  // link's
   Eigen::Vector2d metres_per_sample{1.0, 1.0};
   bool geographic{false};                // its x is longitude in degrees
   std::vector<double> overview_factors;  // each overview's decimation (band 1)
 
   ~Raster() {
-    if (to_lonlat) OCTDestroyCoordinateTransformation(to_lonlat);
-    if (from_lonlat) OCTDestroyCoordinateTransformation(from_lonlat);
-    if (crs) OSRDestroySpatialReference(crs);
-    if (wgs84) OSRDestroySpatialReference(wgs84);
     if (dataset) GDALClose(dataset);
   }
 
@@ -153,20 +198,12 @@ struct TerrainSource::Raster {
       return "it has no georeferencing (no coordinate system): a GeoTIFF with its CRS, or a .prj, "
              "is needed";
     }
-    crs = OSRClone(own);
-    wgs84 = OSRNewSpatialReference(nullptr);
-    OSRSetWellKnownGeogCS(wgs84, "WGS84");
-    OSRSetAxisMappingStrategy(crs, OAMS_TRADITIONAL_GIS_ORDER);  // x = longitude / easting
-    OSRSetAxisMappingStrategy(wgs84, OAMS_TRADITIONAL_GIS_ORDER);
-    to_lonlat = OCTNewCoordinateTransformation(crs, wgs84);
-    from_lonlat = OCTNewCoordinateTransformation(wgs84, crs);
-    if (!to_lonlat || !from_lonlat) {
-      return "its coordinate system cannot be transformed to WGS84 (" +
-             QuietGdal::Last("no transformation") + ")";
-    }
+    link = LinkFor(own);
+    if (!link->problem.empty()) return link->problem;
+    to_lonlat = link->to_lonlat, from_lonlat = link->from_lonlat;
     // Geographic rasters: longitudes may run past +-180 (read around the
     // antimeridian), latitudes may not pass a pole.
-    geographic = OSRIsGeographic(crs) != 0;
+    geographic = OSRIsGeographic(link->crs) != 0;
     if (geographic) {
       for (const double row : {0.0, double(rows)}) {
         for (const double col : {0.0, double(cols)}) {
