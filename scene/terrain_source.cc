@@ -268,6 +268,16 @@ TerrainSource::TerrainSource(const TerrainSpec& spec) : spec_(spec), plane_(spec
                           px = SampleToWorldOf(*raster, c + 1, r),
                           py = SampleToWorldOf(*raster, c, r + 1);
     raster->metres_per_sample = {(px - p).norm(), (py - p).norm()};
+    // Samples a millimetre to 1000 km apart, or the tiles cannot be measured.
+    if (!(raster->metres_per_sample.minCoeff() >= 1e-3 &&
+          raster->metres_per_sample.maxCoeff() <= 1e6)) {
+      problems_.push_back(file.string() + ": its samples are " +
+                          std::to_string(raster->metres_per_sample.x()) + " x " +
+                          std::to_string(raster->metres_per_sample.y()) +
+                          " m apart at its middle, not 1 mm to 1000 km; this raster is left out");
+      elevation_.push_back(nullptr);
+      continue;
+    }
     elevation_.push_back(std::move(raster));
   }
   for (const std::filesystem::path& file : spec.imagery) {
@@ -469,6 +479,9 @@ void TerrainSource::CheckBudgets() const {
             fine_window_px, ImageryPixelsRead(image->overview_factors, w, h, spec_.texture_px));
     }
   }
+  // Estimates that are not finite (a raster's extreme geometry) count as over any limit.
+  const auto bounded = [](double x) { return std::isfinite(x) ? std::min(x, 1e18) : 1e18; };
+  tiles = bounded(tiles), bytes = bounded(bytes), fine_window_px = bounded(fine_window_px);
   LoadLimits::Check(file,
                     "about " + std::to_string(std::llround(tiles)) +
                         " tiles near a robot at once (collision_radius_m and view_radius_m over "

@@ -269,6 +269,22 @@ TEST(TerrainInputTest, ARasterPastAPoleOrWithANonFiniteGeotransformIsLeftOutSaid
   EXPECT_NE(level2.warnings[0].find("left out"), std::string::npos) << level2.warnings[0];
 }
 
+// A raster whose samples are a nanometre apart (found by the fuzz target: its
+// tile estimates were NaN) is left out, said.
+TEST(TerrainInputTest, ARasterWithoutMeasurableSpacingIsLeftOutSaid) {
+  testing::TempDir dir;
+  WriteFlat(dir.path() / "flat.tif");
+  WriteRaster(dir.path() / "tiny.tif", 64, 64, 8.0, 46.0, 1e-14, 1, GDT_Float32,
+              [](int, int, int) { return kGround_m; });
+  const Level level =
+      LoadLevel(dir.Write("level.toml", TerrainToml("elevation = [\"tiny.tif\", \"flat.tif\"]\n")));
+  ASSERT_EQ(level.warnings.size(), 1u);
+  EXPECT_NE(level.warnings[0].find("m apart at its middle, not 1 mm to 1000 km; this raster is "
+                                   "left out"),
+            std::string::npos)
+      << level.warnings[0];
+}
+
 // GDAL reads whole blocks: a raster whose blocks claim more than 256 MB (a
 // fuzzed header asked for 5 GB to read 17 x 17 samples) is left out, said.
 TEST(TerrainInputTest, ARasterWhoseBlocksAreHugeIsLeftOutSaid) {
