@@ -1,3 +1,5 @@
+// Over 600 lines: one renderer class (context, shaders, scene, passes) until issue 38
+// splits it into parts with one job each.
 #include "sensors/render/renderer.h"
 
 #define GL_GLEXT_PROTOTYPES
