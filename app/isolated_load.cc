@@ -90,7 +90,7 @@ void CheckLoadsInIsolation(const std::string& file, const scene::AssetConversion
 
   // What the child says, line by line, until it ends (or takes twice its CPU
   // time in wall time: then it is waiting on something and is killed).
-  std::string said, reading, error;
+  std::string said, reading, reader = "assimp", error;
   bool started = false;
   const auto deadline =
       std::chrono::steady_clock::now() + std::chrono::seconds(2 * limits.max_import_s + 10);
@@ -115,7 +115,11 @@ void CheckLoadsInIsolation(const std::string& file, const scene::AssetConversion
     for (std::size_t end; (end = said.find('\n')) != std::string::npos; said.erase(0, end + 1)) {
       const std::string line = said.substr(0, end);
       if (line == "started") started = true;
-      if (line.rfind("reading ", 0) == 0) reading = line.substr(8);
+      if (const std::size_t tab = line.find('\t');
+          line.rfind("reading ", 0) == 0 && tab != std::string::npos) {
+        reader = line.substr(8, tab - 8);
+        reading = line.substr(tab + 1);
+      }
       if (line.rfind("error ", 0) == 0) error = line.substr(6);
     }
   }
@@ -144,10 +148,10 @@ void CheckLoadsInIsolation(const std::string& file, const scene::AssetConversion
                             " s of CPU ([level] max_import_s in a level manifest)");
   }
   if (WIFSIGNALED(status)) {
-    throw scene::LevelError(where + ": the importer crashed on it (" +
-                            SignalName(WTERMSIG(status)) +
-                            "); the file is corrupt or shows a bug of assimp 5.2.5 "
-                            "(docs/reliability.md), or needed more than its [level] "
+    throw scene::LevelError(where + ": " + reader + " crashed reading it (" +
+                            SignalName(WTERMSIG(status)) + "); the file is corrupt or shows a bug of " +
+                            reader +
+                            " (docs/reliability.md), or reading it needed more than its [level] "
                             "max_import_mb = " +
                             std::to_string(limits.max_import_mb));
   }
@@ -164,9 +168,9 @@ int RunLoadLevelChild(const std::vector<std::string>& args, std::ostream& out) {
   if (args.empty()) return 2;
   out << "started" << std::endl;
   std::string reading = args[0];
-  options.on_file = [&out, &reading](const std::filesystem::path& file) {
+  options.on_file = [&out, &reading](const std::filesystem::path& file, std::string_view reader) {
     reading = file.string();
-    out << "reading " << reading << std::endl;
+    out << "reading " << reader << '\t' << reading << std::endl;
   };
   // One line each: the parent reads lines.
   auto error_line = [&out](std::string message) {
@@ -181,13 +185,13 @@ int RunLoadLevelChild(const std::vector<std::string>& args, std::ostream& out) {
     for (const scene::Material& material : level.materials) {
       render::RgbaImage image;
       if (!material.base_color_texture_path.empty()) {
-        options.on_file(material.base_color_texture_path);
+        options.on_file(material.base_color_texture_path, "the texture decoder (OpenCV)");
         decode(nullptr, material.base_color_texture_path, &image);
       }
       for (const int t :
            {material.base_color_texture_embedded, material.lightmap_texture_embedded}) {
         if (t < 0 || t >= int(level.textures.size())) continue;
-        options.on_file(level.name + " (a texture embedded in it)");
+        options.on_file(level.name + " (a texture embedded in it)", "the texture decoder (OpenCV)");
         decode(&level.textures[std::size_t(t)], "", &image);
       }
     }

@@ -45,8 +45,8 @@ void CheckTriangles(const fs::path& file, const Level& level) {
                     level.limits.max_triangles, "max_triangles");
 }
 
-void Reading(const LoadOptions& options, const fs::path& file) {
-  if (options.on_file) options.on_file(file);
+void Reading(const LoadOptions& options, const fs::path& file, std::string_view reader) {
+  if (options.on_file) options.on_file(file, reader);
 }
 
 // What makes two [[actor]] tables read the same: the file and how it is read.
@@ -66,7 +66,7 @@ std::string AssetKey(const ActorSpec& spec) {
 // A scene file as a level: one actor per node with meshes, posed at the
 // node's rigid transform.
 Level LoadSceneFile(const fs::path& file, const LoadOptions& options) {
-  Reading(options, file);
+  Reading(options, file, "assimp");
   ImportedAsset asset = ImportAsset(file, options.conversion, options.limits);
   Level level;
   level.file = file;
@@ -91,7 +91,7 @@ Level LoadSceneFile(const fs::path& file, const LoadOptions& options) {
 // A manifest as a level: one actor per [[actor]], all of its asset's nodes
 // merged into it, scaled in the asset root frame and then placed.
 Level LoadManifest(const fs::path& file, const LoadOptions& options) {
-  Reading(options, file);
+  Reading(options, file, "the manifest reader");
   const LevelManifest manifest = ParseManifest(file);
   Level level;
   level.file = file;
@@ -103,7 +103,7 @@ Level LoadManifest(const fs::path& file, const LoadOptions& options) {
     auto read = read_once.find(AssetKey(spec));
     if (read == read_once.end()) {
       ImportedAsset asset;
-      Reading(options, spec.file);
+      Reading(options, spec.file, spec.is_heightmap ? "the heightmap reader (libpng)" : "assimp");
       try {
         asset = spec.is_heightmap
                     ? ImportHeightmapImage(spec.file, spec.heightmap_size_m, level.limits)
@@ -136,12 +136,12 @@ Level LoadManifest(const fs::path& file, const LoadOptions& options) {
   if (manifest.terrain) {
     // The rasters are opened and checked here; their tiles are read while running.
     const TerrainSpec& spec = *manifest.terrain;
-    for (const fs::path& raster : spec.elevation) Reading(options, raster);
     if (level.FindActor(spec.name) >= 0) {
       throw LevelError(file.string() + ":" + std::to_string(spec.line) + ": terrain '" + spec.name +
                        "': an [[actor]] has that name too");
     }
-    const TerrainSource source(spec);
+    const TerrainSource source(
+        spec, [&options](const fs::path& raster) { Reading(options, raster, "GDAL and PROJ"); });
     for (const std::string& problem : source.problems()) level.warnings.push_back(problem);
     source.CheckBudgets();
     Actor actor;
@@ -162,7 +162,7 @@ Level LoadManifest(const fs::path& file, const LoadOptions& options) {
     level.horizon->visibility_m = manifest.horizon->visibility_m;
   }
   for (const RobotSpec& spec : manifest.robots) {
-    Reading(options, spec.file);
+    Reading(options, spec.file, "assimp");
     level.robots.push_back(LoadRobotModel(spec, file, &level));
     CheckTriangles(spec.file, level);
   }

@@ -69,8 +69,9 @@ struct Level {
 struct LoadOptions {
   AssetConversion conversion;  // a scene file's axes and unit, when it does not say them
   LoadLimits limits;           // a manifest's [level] table sets its own
-  // Called before each file of the level is read.
-  std::function<void(const std::filesystem::path& file)> on_file;
+  // Called before each file of the level is read, with the library that
+  // reads it ("assimp", "GDAL and PROJ", "the manifest reader", ...).
+  std::function<void(const std::filesystem::path& file, std::string_view reader)> on_file;
 };
 
 // Appends materials and textures to the level, renumbering the materials'

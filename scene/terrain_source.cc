@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <map>
 #include <memory>
@@ -109,6 +110,39 @@ struct CrsLink {
   }
 };
 
+// Why `crs` claims an EPSG code that PROJ's database gives to another kind of
+// coordinate system (a GeoTIFF's geographic key holding a geocentric code), or
+// "". PROJ 9.1 dereferences null making a transformation from some of them
+// (docs/reliability.md): such a raster is refused before one is made.
+std::string IdentityProblem(OGRSpatialReferenceH crs) {
+  const auto kind = [](OGRSpatialReferenceH s) {
+    return OSRIsCompound(s)     ? "compound"
+           : OSRIsProjected(s)  ? "projected"
+           : OSRIsGeocentric(s) ? "geocentric"
+           : OSRIsGeographic(s) ? "geographic"
+           : OSRIsVertical(s)   ? "vertical"
+                                : "other";
+  };
+  const char* authority = OSRGetAuthorityName(crs, nullptr);
+  const char* code = OSRGetAuthorityCode(crs, nullptr);
+  if (authority == nullptr || code == nullptr || !EQUAL(authority, "EPSG")) return "";
+  char* end = nullptr;
+  const long number = std::strtol(code, &end, 10);
+  if (end == code || *end != '\0' || number <= 0 || number > std::numeric_limits<int>::max()) {
+    return std::string("its coordinate system names EPSG code '") + code + "', not a number";
+  }
+  OGRSpatialReferenceH known = OSRNewSpatialReference(nullptr);
+  std::string problem;
+  if (OSRImportFromEPSG(known, int(number)) == OGRERR_NONE &&
+      std::string(kind(known)) != kind(crs)) {
+    problem = std::string("its coordinate system is ") + kind(crs) + " but calls itself EPSG:" +
+              code + ", which is " + kind(known) + " (" + OSRGetName(known) +
+              "): a GeoTIFF key with the wrong kind of code";
+  }
+  OSRDestroySpatialReference(known);
+  return problem;
+}
+
 // PROJ looks a transformation up in its database each time one is made, most
 // of the time of opening a small raster: made once per coordinate system and
 // thread (transformations are not shared between threads), up to 64 of them.
@@ -127,6 +161,11 @@ std::shared_ptr<const CrsLink> LinkFor(OGRSpatialReferenceH own) {
   OSRSetWellKnownGeogCS(link->wgs84, "WGS84");
   OSRSetAxisMappingStrategy(link->crs, OAMS_TRADITIONAL_GIS_ORDER);
   OSRSetAxisMappingStrategy(link->wgs84, OAMS_TRADITIONAL_GIS_ORDER);
+  link->problem = IdentityProblem(link->crs);
+  if (!link->problem.empty()) {
+    if (links.size() < 64 && !key.empty()) links.emplace(key, link);
+    return link;
+  }
   link->to_lonlat = OCTNewCoordinateTransformation(link->crs, link->wgs84);
   link->from_lonlat = OCTNewCoordinateTransformation(link->wgs84, link->crs);
   if (!link->to_lonlat || !link->from_lonlat) {
@@ -246,7 +285,9 @@ struct TerrainSource::Raster {
   }
 };
 
-TerrainSource::TerrainSource(const TerrainSpec& spec) : spec_(spec), plane_(spec.anchor) {
+TerrainSource::TerrainSource(const TerrainSpec& spec,
+                             const std::function<void(const std::filesystem::path&)>& on_open)
+    : spec_(spec), plane_(spec.anchor) {
   if (spec.tile_samples < 2 || spec.coarse_factor < 1 || spec.tile_samples % spec.coarse_factor) {
     throw LevelError("[[terrain]] '" + spec.name + "': tile_samples (" +
                      std::to_string(spec.tile_samples) +
@@ -256,6 +297,7 @@ TerrainSource::TerrainSource(const TerrainSpec& spec) : spec_(spec), plane_(spec
   const QuietGdal quiet;
   for (const std::filesystem::path& file : spec.elevation) {
     auto raster = std::make_unique<Raster>();
+    if (on_open) on_open(file);
     const std::string problem = raster->Open(file);
     if (!problem.empty()) {
       problems_.push_back(file.string() + ": " + problem + "; this raster is left out");
@@ -282,6 +324,7 @@ TerrainSource::TerrainSource(const TerrainSpec& spec) : spec_(spec), plane_(spec
   }
   for (const std::filesystem::path& file : spec.imagery) {
     auto raster = std::make_unique<Raster>();
+    if (on_open) on_open(file);
     const std::string problem = raster->Open(file);
     if (!problem.empty()) {
       problems_.push_back(file.string() + ": " + problem + "; the terrain is drawn without it");

@@ -9,6 +9,7 @@
 // are not shared between threads); the streamer's worker has its own.
 
 #include <Eigen/Geometry>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -23,7 +24,9 @@ class TerrainSource {
   // georeferencing, is left out and said in problems() ("FILE: why"); the
   // others still serve. Throws LevelError for settings that cannot work
   // (tile_samples not a multiple of coarse_factor, radii not positive).
-  explicit TerrainSource(const TerrainSpec& spec);
+  // `on_open` is called with each raster's path before GDAL opens it.
+  explicit TerrainSource(const TerrainSpec& spec,
+                         const std::function<void(const std::filesystem::path&)>& on_open = {});
   ~TerrainSource();
   TerrainSource(const TerrainSource&) = delete;
   TerrainSource& operator=(const TerrainSource&) = delete;

@@ -17,11 +17,13 @@ namespace sandbox::testing {
 // `cols` x `rows` samples of `spacing_deg` from the north-west corner (lon0,
 // lat0), `bands` of `type`, band values from `value(col, row, band)` (none
 // written when `value` is empty: a sparse file with SPARSE_OK=TRUE), with
-// GDAL creation `options`. Throws std::runtime_error naming the file.
+// GDAL creation `options`, in the coordinate system `crs_wkt` (WGS84 when
+// empty). Throws std::runtime_error naming the file.
 inline void WriteRaster(const std::filesystem::path& file, int cols, int rows, double lon0,
                         double lat0, double spacing_deg, int bands, GDALDataType type,
                         const std::function<double(int, int, int)>& value,
-                        std::vector<std::string> options = {}) {
+                        std::vector<std::string> options = {},
+                        const std::string& crs_wkt = "") {
   GDALAllRegister();
   std::vector<char*> list;
   for (std::string& option : options) list.push_back(option.data());
@@ -31,13 +33,18 @@ inline void WriteRaster(const std::filesystem::path& file, int cols, int rows, d
   if (dataset == nullptr) throw std::runtime_error(file.string() + ": GDAL cannot create it");
   double gt[6] = {lon0, spacing_deg, 0.0, lat0, 0.0, -spacing_deg};
   GDALSetGeoTransform(dataset, gt);
-  OGRSpatialReferenceH wgs84 = OSRNewSpatialReference(nullptr);
-  OSRImportFromEPSG(wgs84, 4326);
-  char* wkt = nullptr;
-  OSRExportToWkt(wgs84, &wkt);
-  GDALSetProjection(dataset, wkt);
-  CPLFree(wkt);
-  OSRDestroySpatialReference(wgs84);
+  if (crs_wkt.empty()) {
+    OGRSpatialReferenceH wgs84 = OSRNewSpatialReference(nullptr);
+    OSRImportFromEPSG(wgs84, 4326);
+    char* wkt = nullptr;
+    OSRExportToWkt(wgs84, &wkt);
+    GDALSetProjection(dataset, wkt);
+    CPLFree(wkt);
+    OSRDestroySpatialReference(wgs84);
+  } else if (GDALSetProjection(dataset, crs_wkt.c_str()) != CE_None) {
+    GDALClose(dataset);
+    throw std::runtime_error(file.string() + ": GDAL refuses the coordinate system " + crs_wkt);
+  }
   bool written = true;
   if (value) {
     std::vector<double> row(static_cast<std::size_t>(cols));

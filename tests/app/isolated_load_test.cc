@@ -45,7 +45,7 @@ bool HasLine(const std::string& out, const std::string& start) {
 TEST(IsolatedLoadTest, AFileThatCrashesTheImporterIsAnErrorNamingIt) {
   sandbox::testing::TempDir dir;
   const std::string off = dir.Write("crash.off", kCrashingOff).string();
-  const std::string crashed = off + ": the importer crashed on it " + kCrashSignal;
+  const std::string crashed = off + ": assimp crashed reading it " + kCrashSignal;
   // A scene file given as the level is always read apart first.
   const auto info = RunSandbox("info " + off);
   EXPECT_EQ(info.exit_code, 1) << info.out;

@@ -1,7 +1,7 @@
 // The terrain's inputs as an outside tester tries them: rasters that are
 // FIFOs or name FIFOs, sparse giants, absurd heights, damaged imagery and
-// tile-cache files, rasters across the antimeridian and past a pole, and
-// settings beyond any physical sense. Every raster is written here with GDAL;
+// tile-cache files, rasters across the antimeridian and past a pole, lying
+// coordinate systems, and settings beyond any physical sense. Every raster is written here with GDAL;
 // expected heights come from the values written, not from the terrain code.
 
 #include <gdal.h>
@@ -296,6 +296,35 @@ TEST(TerrainInputTest, ARasterWithoutMeasurableSpacingOrWithHugeBlocksIsLeftOutS
                          "256 MB"),
             std::string::npos)
       << warning;
+}
+
+// Found by the fuzz target: a GeoTIFF whose geographic key holds EPSG:4342, a
+// geocentric system; PROJ 9.1 crashes making a transformation from it. Left
+// out, said, before PROJ is asked; a geographic key holding 4326 still serves.
+TEST(TerrainInputTest, ARasterWhoseCoordinateSystemClaimsAnotherKindOfCodeIsLeftOutSaid) {
+  testing::TempDir dir;
+  const auto geographic = [](const std::string& code) {
+    return "GEOGCS[\"X\",DATUM[\"D\",SPHEROID[\"GRS 1980\",6378137,298.257223563]],"
+           "PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433],"
+           "AUTHORITY[\"EPSG\",\"" +
+           code + "\"]]";
+  };
+  WriteRaster(dir.path() / "geocentric.tif", 64, 64, 8.0, 46.0, 0.001, 1, GDT_Float32,
+              [](int, int, int) { return kGround_m; }, {}, geographic("4342"));
+  const std::string warning = LeftOutWarning(dir, "geocentric.tif");
+  EXPECT_NE(warning.find("geocentric.tif: its coordinate system is geographic but calls itself "
+                         "EPSG:4342, which is geocentric"),
+            std::string::npos)
+      << warning;
+  WriteRaster(dir.path() / "honest.tif", 129, 129, 8.0, 46.02, 0.0003, 1, GDT_Float32,
+              [](int, int, int) { return kGround_m; }, {}, geographic("4326"));
+  const Level level =
+      LoadLevel(dir.Write("level.toml", TerrainToml("elevation = [\"honest.tif\"]\n")));
+  EXPECT_TRUE(level.warnings.empty()) << level.warnings[0];
+  Probe probe(level);
+  const auto down = probe.Down(0.0, 0.0);
+  ASSERT_TRUE(down.has_value());
+  EXPECT_NEAR(*down, ExpectedDown(0.0, 0.0), 0.05);
 }
 
 // Cache files written through the cache itself from a built tile with one
