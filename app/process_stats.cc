@@ -18,6 +18,5 @@ double StatusFieldMiB(const std::string& field) {
 }  // namespace
 
 double PeakResidentMiB() { return StatusFieldMiB("VmHWM"); }
-double ResidentMiB() { return StatusFieldMiB("VmRSS"); }
 
 }  // namespace sandbox::app

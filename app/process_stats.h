@@ -5,7 +5,5 @@ namespace sandbox::app {
 
 // Peak resident set size (VmHWM) in MiB; 0 when unknown.
 double PeakResidentMiB();
-// Current resident set size (VmRSS) in MiB; 0 when unknown.
-double ResidentMiB();
 
 }  // namespace sandbox::app

@@ -5,7 +5,7 @@
 // 1M-triangle level and, where ../shared/assets is, its Quake 3 map. Ray
 // sets: a full face scan (15,606 rays) cast as a bag of rays and by the
 // structured kernel ("face, grid": RayCaster::CastGrids), lidar sweeps of
-// 16 x 1024 and 64 x 2048 likewise ("sweep": RayCaster::CastSweep); and on the sample level the
+// 16 x 1024 and 64 x 2048; and on the sample level the
 // high-resolution face scan (6 x 501 x 501 at 0.1 m) with the face scanner's whole scans a second.
 //
 //   bench_rays [--seconds S]   (time per measurement, default 0.3)
@@ -324,12 +324,10 @@ Agreement Agree(const scene::CollisionWorld& world, const EmbreeScene& watertigh
   return agreement;
 }
 
-// With `grids` or `sweep`, ours is the structured kernel (RayCaster::CastGrids
-// or CastSweep) on them.
+// With `grids`, ours is the structured kernel (RayCaster::CastGrids) on them.
 void Compare(const char* level, const char* name, const scene::CollisionWorld& world,
              const Reference& embree, const sensors::RayBatch& rays, double seconds, int show,
-             const std::vector<sensors::RayGrid>* grids = nullptr,
-             const sensors::RaySweep* sweep = nullptr) {
+             const std::vector<sensors::RayGrid>* grids = nullptr) {
   const std::size_t n = rays.size();
   const Eigen::Vector3f origin_B = (rays.origin_W - world.origin()).cast<float>();
   for (const int threads : {1, 2}) {
@@ -349,8 +347,6 @@ void Compare(const char* level, const char* name, const scene::CollisionWorld& w
       ours_rate = std::max(ours_rate, n * CallsPerSecond(share, [&] {
                                         if (grids != nullptr) {
                                           caster.CastGrids(world, rays, *grids, {}, &ours);
-                                        } else if (sweep != nullptr) {
-                                          caster.CastSweep(world, rays, *sweep, {}, &ours);
                                         } else {
                                           caster.Cast(world, rays, {}, &ours);
                                         }
@@ -416,15 +412,12 @@ void RunLevel(const char* name, const fs::path& file, const Eigen::Isometry3d& X
   face.GridRays(0, X_WS, &face_rays, &face_grids);
   Compare(name, "face scan", world, embree, face_rays, seconds, show);
   Compare(name, "face, grid", world, embree, face_rays, seconds, show, &face_grids);
-  sensors::RaySweep sweep;
   const sensors::Lidar lidar16(sensors::LidarConfig::Uniform(16, -15, 15, 1024, 100.0));
-  const sensors::RayBatch rays16 = lidar16.Rays(X_WLidar, X_WLidar, &sweep);
+  const sensors::RayBatch rays16 = lidar16.Rays(X_WLidar, X_WLidar);
   Compare(name, "lidar 16x1024", world, embree, rays16, seconds, show);
-  Compare(name, "16x1024, sweep", world, embree, rays16, seconds, show, nullptr, &sweep);
   const sensors::Lidar lidar64(sensors::LidarConfig::Uniform(64, -25, 15, 2048, 100.0));
-  const sensors::RayBatch rays64 = lidar64.Rays(X_WLidar, X_WLidar, &sweep);
+  const sensors::RayBatch rays64 = lidar64.Rays(X_WLidar, X_WLidar);
   Compare(name, "lidar 64x2048", world, embree, rays64, seconds, show);
-  Compare(name, "64x2048, sweep", world, embree, rays64, seconds, show, nullptr, &sweep);
 }
 
 // The high-resolution face scan (six faces of 501 x 501 at 0.1 m, 1.5 million

@@ -113,12 +113,6 @@ void TopicMonitor::StartWindow() {
   for (auto& [channel, s] : stats_) s.window_messages = s.window_bytes = 0;
 }
 
-std::map<std::string, ChannelStats> ListenToAll(LcmLink& link, double seconds) {
-  TopicMonitor monitor(link);
-  monitor.Listen(seconds);
-  return monitor.stats();
-}
-
 std::map<std::string, ChannelStats> ReadLogTopics(const std::string& path,
                                                   std::string* stopped_early) {
   std::map<std::string, ChannelStats> stats;

@@ -47,9 +47,6 @@ class TopicMonitor {
   std::map<std::string, ChannelStats> stats_;
 };
 
-// Every channel on `link` for `seconds`.
-std::map<std::string, ChannelStats> ListenToAll(LcmLink& link, double seconds);
-
 // The same for every event of an LCM log file (times are the events' own).
 // Throws std::runtime_error naming the file (see LogReader); a log cut short
 // is read up to the break, which *stopped_early then tells.

@@ -41,14 +41,9 @@ void LidarConfig::ValidateOrThrow() const {
 
 Lidar::Lidar(const LidarConfig& config) : config_(config) { config_.ValidateOrThrow(); }
 
-RayBatch Lidar::Rays(const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3d& X_WS_end,
-                     RaySweep* sweep) const {
+RayBatch Lidar::Rays(const Eigen::Isometry3d& X_WS_start,
+                     const Eigen::Isometry3d& X_WS_end) const {
   const int channels = config_.channels(), steps = config_.azimuth_steps;
-  if (sweep != nullptr) {
-    sweep->elevations_rad = config_.elevations_rad;
-    sweep->forward_W.resize(std::size_t(steps));
-    sweep->up_W.resize(std::size_t(steps));
-  }
   RayBatch rays;
   rays.origin_W = X_WS_start.translation();
   rays.Resize(std::size_t(channels) * std::size_t(steps));
@@ -60,11 +55,6 @@ RayBatch Lidar::Rays(const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3
     const Eigen::Matrix3d R = q0.slerp(s, q1).toRotationMatrix();
     const Eigen::Vector3f start = (s * travel).cast<float>();
     const double azimuth = 2.0 * M_PI * k / steps;
-    if (sweep != nullptr) {
-      sweep->forward_W[std::size_t(k)] =
-          R * Eigen::Vector3d(std::cos(azimuth), std::sin(azimuth), 0.0);
-      sweep->up_W[std::size_t(k)] = R.col(2);
-    }
     for (int c = 0; c < channels; ++c) {
       const double e = config_.elevations_rad[std::size_t(c)];
       const Eigen::Vector3d d(std::cos(e) * std::cos(azimuth), std::cos(e) * std::sin(azimuth),
@@ -84,15 +74,10 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
   if (!X_WS_start.matrix().allFinite() || !X_WS_end.matrix().allFinite()) {
     throw std::invalid_argument("Lidar::Sweep(): non-finite pose");
   }
-  RaySweep sweep;
-  const RayBatch rays = Rays(X_WS_start, X_WS_end, &sweep);
+  const RayBatch rays = Rays(X_WS_start, X_WS_end);
   RayHits hits;
   hits.with_normals = false;
-  if (config_.structured) {
-    caster.CastSweep(world, rays, sweep, filter, &hits);
-  } else {
-    caster.Cast(world, rays, filter, &hits);
-  }
+  caster.Cast(world, rays, filter, &hits);
   const std::size_t n = rays.size();
   scan->channels = config_.channels();
   scan->origin_W = rays.origin_W;
@@ -129,18 +114,18 @@ LidarConfig LidarConfig::Read(scene::SettingsReader& read) {
   lidar.azimuth_steps = read.Whole("azimuth_steps", 1024);
   lidar.range_m = read.Number("range_m", 100.0);
   lidar.rotation_hz = read.Number("rotation_hz", 10.0);
-  const std::string kernel = read.Text("kernel", "general");
-  if (kernel != "general" && kernel != "sweep") {
-    read.Fail("kernel", "'kernel' must be general or sweep, got '" + kernel + "'");
+  if (read.Has("kernel")) {
+    read.Fail("kernel",
+              "'kernel' is no longer a key: every lidar is cast by the general caster, faster "
+              "than the structured sweep kernel on every level measured "
+              "(docs/decisions/001-no-structured-lidar-kernel.md); delete the key");
   }
-  lidar.structured = kernel == "sweep";
   return lidar;
 }
 
 std::string LidarConfig::Summary() const {
   std::ostringstream out;
   out << channels() << "x" << azimuth_steps << ", " << range_m << " m";
-  if (structured) out << ", sweep kernel";
   return out.str();
 }
 

@@ -25,10 +25,6 @@ struct LidarConfig {
   int azimuth_steps{1024};
   double range_m{100.0};
   double rotation_hz{10.0};  // one sweep lasts 1 / rotation_hz
-  // Cast by RayCaster::CastSweep (the structured kernel) instead of the
-  // general caster: the same hits; faster with many channels or walls near
-  // the sensor, slower over open dense terrain (docs/sensors.md, figures).
-  bool structured{false};
 
   // `channels` elevations evenly from min to max (degrees).
   static LidarConfig Uniform(int channels, double min_deg, double max_deg, int azimuth_steps,
@@ -41,7 +37,7 @@ struct LidarConfig {
   // The [[robot.sensor]] table's own keys (docs/levels.md); throws scene::LevelError
   // naming the key.
   static LidarConfig Read(scene::SettingsReader& read);
-  std::string Summary() const;  // "16x1024, 100 m" (", sweep kernel" when structured)
+  std::string Summary() const;  // "16x1024, 100 m"
 };
 
 struct LidarScan {
@@ -78,10 +74,8 @@ class Lidar {
              const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3d& X_WS_end,
              LidarScan* scan) const;
 
-  // The rays of that sweep (origin_W is the start pose's position) and, when
-  // asked for, their structure (each step's half-plane) for RayCaster::CastSweep.
-  RayBatch Rays(const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3d& X_WS_end,
-                RaySweep* sweep = nullptr) const;
+  // The rays of that sweep (origin_W is the start pose's position).
+  RayBatch Rays(const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3d& X_WS_end) const;
 
  private:
   LidarConfig config_;

@@ -22,9 +22,6 @@ namespace sandbox::sensors {
 namespace {
 
 constexpr int kRaysPerChunk = 256;
-// A sweep's chunk of work: up to this many steps of up to this many channels.
-constexpr int kStepsPerTile = 16;
-constexpr int kChannelsPerTile = 16;
 constexpr int kStackInPlace = RayCaster::kStackInPlace;
 
 // One Bullet object as a ray sees it: where it is, its BVH nodes and triangles.
@@ -345,21 +342,6 @@ inline __m128 Mul(__m128 a, __m128 b) { return _mm_mul_ps(a, b); }
 inline __m128 Add(__m128 a, __m128 b) { return _mm_add_ps(a, b); }
 inline __m128 Sub(__m128 a, __m128 b) { return _mm_sub_ps(a, b); }
 
-// Lanes whose rays enter the box [lo, hi] (quantized space) before their t_max.
-inline __m128 EnterBox4(const btQuantizedBvhNode& node, const __m128 qo[3], const __m128 inverse[3],
-                        __m128 t_max) {
-  __m128 t_enter = _mm_setzero_ps(), t_exit = t_max;
-  for (int k = 0; k < 3; ++k) {
-    const __m128 t1 =
-        Mul(Sub(_mm_set1_ps(float(node.m_quantizedAabbMin[k]) - 1.0f), qo[k]), inverse[k]);
-    const __m128 t2 =
-        Mul(Sub(_mm_set1_ps(float(node.m_quantizedAabbMax[k]) + 1.0f), qo[k]), inverse[k]);
-    t_enter = _mm_max_ps(t_enter, _mm_min_ps(t1, t2));
-    t_exit = _mm_min_ps(t_exit, _mm_max_ps(t1, t2));
-  }
-  return _mm_cmple_ps(t_enter, t_exit);
-}
-
 struct Vec4 {  // a vector per lane
   __m128 x, y, z;
 };
@@ -400,13 +382,11 @@ inline __m128 MeetsCornerBox4(const Vec4& low, const Vec4& high, const Vec4& o, 
                       Mul(t_exit, _mm_set1_ps(1.0f + slack)));
 }
 
-// The rays of a band of rows of one grid block (RayGrid), or of a tile of a
-// sweep (RaySweep), as the structured kernels read them: origins in the Bullet
-// frame and results, indexed by cell (a band's ray from its first, a tile's
-// ray of the batch).
+// The rays of a band of rows of one grid block (RayGrid), as the structured
+// kernel reads them: origins in the Bullet frame and results, indexed by cell
+// (a band's ray from its first).
 struct GridBand {
   __m128 dx, dy, dz;                          // the block's direction
-  const Eigen::Vector3f* direction{nullptr};  // or each cell's own (a sweep)
   __m128 ox, oy, oz;                      // the batch origin (a ray starts at it plus its start)
   const Eigen::Vector3f* start{nullptr};  // the cells' rays' starts
   float* t_max{nullptr};                  // their entries of RayHits::distance_m
@@ -495,19 +475,9 @@ const bool kHasAvx512 = [] {
          !(kernel != nullptr && std::string(kernel) == "fma");
 }();
 
-inline void WalkTarget4(const Target& target, Packet* packet) {
-  if (kHasFma) {  // the same branch every time: predicted
-    fma_kernel::WalkTarget4(target, packet);
-  } else {
-    sse2_kernel::WalkTarget4(target, packet);
-  }
-}
-// The object's own hierarchy where it has one (every object the scene made),
-// else Bullet's.
+// The object's own hierarchy (every object has one: CollectTargets).
 inline void WalkWide4(const Target& target, Packet* packet) {
-  if (target.bvh == nullptr) {
-    WalkTarget4(target, packet);
-  } else if (kHasFma) {
+  if (kHasFma) {
     fma_kernel::WalkWide4(target, packet);
   } else {
     sse2_kernel::WalkWide4(target, packet);
@@ -581,11 +551,11 @@ struct BandFrame {
   float margin, margin_columns, margin_rows;
 };
 
-// Up to four linear coordinates of points (a band's columns, rows and depths;
-// a sweep tile's slabs) as seen from one object's quantized BVH: over a node
-// box [lo, hi] (quantized), coordinate w spans w0 + sum_k (q_k * a_k) over its
-// corners; `margin` widens that, and it must meet [0, limit] (in a whole
-// number, in `integral` lanes).
+// Up to four linear coordinates of points (a band's columns, rows and depths)
+// as seen from one object's own hierarchy: over a node box [lo, hi] (the
+// object's frame), coordinate w spans w0 + sum_k (p_k * a_k) over its corners;
+// `margin` widens that, and it must meet [0, limit] (in a whole number, in
+// `integral` lanes).
 struct GridCull {
   __m128 positive[3], negative[3];  // per axis k: the weights a_k, split by sign
   __m128 w0, margin, limit, integral;
@@ -616,66 +586,9 @@ void ObjectFrame(const Target& target, Eigen::Matrix3d* R_BL, Eigen::Vector3d* p
   *p_BL = Eigen::Vector3d(X_BL.getOrigin().x(), X_BL.getOrigin().y(), X_BL.getOrigin().z());
 }
 
-// The cull for coordinates w = (p - origin) . axes[w] (p in the Bullet frame)
-// that must lie in [0, limit[w]] to within margin[w]; lanes beyond `count`
-// always pass.
-GridCull CullFor(const Target& target, const Eigen::Vector3d& origin,
-                 const Eigen::Vector3d* const axes[], int count, const double limit[],
-                 const double margin[], bool integral_first_two) {
-  // w = (X_BL (q / quantization + bvh_min) - origin) . axis: linear in q.
-  Eigen::Matrix3d R_BL;
-  Eigen::Vector3d p_BL;
-  ObjectFrame(target, &R_BL, &p_BL);
-  const Eigen::Vector3d offset = R_BL * target.bvh_min.cast<double>() + p_BL - origin;
-  alignas(16) float positive[3][4] = {}, negative[3][4] = {}, w0[4] = {}, slack[4] = {};
-  alignas(16) float top[4] = {};
-  for (int w = 0; w < count; ++w) {
-    const Eigen::Vector3d a =
-        (R_BL.transpose() * *axes[w]).cwiseQuotient(target.quantization.cast<double>());
-    w0[w] = float(offset.dot(*axes[w]));
-    top[w] = float(limit[w]);
-    double reach = std::abs(w0[w]);
-    for (int k = 0; k < 3; ++k) {
-      positive[k][w] = float(std::max(a[k], 0.0));
-      negative[k][w] = float(std::min(a[k], 0.0));
-      reach += 65535.0 * std::abs(a[k]);
-    }
-    // The margin, a quantum each way, and the float rounding of the sums.
-    const double quantum = std::abs(a[0]) + std::abs(a[1]) + std::abs(a[2]);
-    slack[w] = float(margin[w] + quantum + 1e-6 * reach);
-  }
-  return GridCull::Of(positive, negative, w0, slack, top, integral_first_two);
-}
-
-// The spans [low, high] of a cull's coordinates over a node's box (widened
-// by the cull's margins), a coordinate a lane.
-inline void NodeSpans(const btQuantizedBvhNode& node, const GridCull& cull, __m128* low,
-                      __m128* high) {
-  __m128 from = cull.w0, to = cull.w0;
-  for (int k = 0; k < 3; ++k) {
-    const __m128 q_min = _mm_set1_ps(float(node.m_quantizedAabbMin[k]));
-    const __m128 q_max = _mm_set1_ps(float(node.m_quantizedAabbMax[k]));
-    from = Add(from, Add(Mul(q_min, cull.positive[k]), Mul(q_max, cull.negative[k])));
-    to = Add(to, Add(Mul(q_max, cull.positive[k]), Mul(q_min, cull.negative[k])));
-  }
-  *low = Sub(from, cull.margin), *high = Add(to, cull.margin);
-}
-
-// Whether a node's box reaches a grid point in columns and rows and the rays'
-// span in depth (a sweep tile's slabs: all four spans).
-inline bool NodeMeetsGrid(const btQuantizedBvhNode& node, const GridCull& cull) {
-  __m128 low, high;
-  NodeSpans(node, cull, &low, &high);
-  const __m128 from = _mm_max_ps(low, _mm_setzero_ps());
-  const __m128 to = _mm_min_ps(high, cull.limit);
-  // Columns and rows need a whole number in [from, to]; depth an overlap.
-  const __m128 whole = _mm_cvtepi32_ps(_mm_cvttps_epi32(to));
-  const __m128 top = Select(cull.integral, whole, to);
-  return _mm_movemask_ps(_mm_cmpge_ps(top, from)) == 0xF;
-}
-
-// CullFor over the object's own hierarchy (float boxes in its frame):
-// w = (X_BL p - origin) . axis is linear in p, and the slack covers the
+// The cull for coordinates w = (X_BL p - origin) . axes[w] (p in the
+// object's frame) that must lie in [0, limit[w]] to within margin[w]; lanes
+// beyond `count` always pass. w is linear in p, and the slack covers the
 // boxes' growth for the change of frame and the rounding of the sums.
 GridCull CullForWide(const Target& target, const Eigen::Vector3d& origin,
                      const Eigen::Vector3d* const axes[], int count, const double limit[],
@@ -702,7 +615,8 @@ GridCull CullForWide(const Target& target, const Eigen::Vector3d& origin,
   return GridCull::Of(positive, negative, w0, slack, top, integral_first_two);
 }
 
-// NodeMeetsGrid for child c of one of the object's own nodes.
+// Whether child c of one of the object's own nodes reaches a grid point in
+// columns and rows and the rays' span in depth.
 inline bool ChildMeetsGrid(const scene::TriangleBvh::Node& node, int c, const GridCull& cull) {
   __m128 from = cull.w0, to = cull.w0;
   for (int k = 0; k < 3; ++k) {
@@ -748,102 +662,6 @@ void ForEachTriangleOverGridWide(const Target& target, const GridCull& cull, Vis
   }
 }
 
-// A sweep tile's channels as elevation bands about its anchor: a region
-// whose elevations (seen from the anchor, in the middle step's frame) meet
-// none of them holds no point its rays can reach. The bands are each
-// channel's elevation widened by the tile's tilt (the steps' up directions
-// against the middle one's) and the rays' rounding; a region's elevations
-// are widened by the origins' drift from the anchor (and the margin) over
-// its forward distance.
-struct ChannelBands {
-  alignas(16) float low[kChannelsPerTile], high[kChannelsPerTile];  // tangents; padding never meets
-  float drift{0.0f};  // the origins' drift from the anchor plus the margin, metres
-
-  // Whether points with forward distances [f_low, f_high], up [u_low,
-  // u_high] and |sideways| <= side (the middle step's frame, from the anchor)
-  // may lie on a channel's band.
-  bool MayMeet(float f_low, float f_high, float u_low, float u_high, float side) const {
-    if (!(f_low > 20.0f * drift)) return true;  // near or behind the anchor: keep
-    const float h_high = std::sqrt(f_high * f_high + side * side);
-    float from = u_low > 0.0f ? u_low / h_high : u_low / f_low;
-    float to = u_high > 0.0f ? u_high / f_low : u_high / h_high;
-    // The origins' drift: at most drift / f_low radians (< 0.05, its tangent
-    // at most 1.001 times that), added as tan(x - a) = (t - tan a) / (1 + t tan a).
-    const float turn = 1.001f * 1.001f * drift / f_low;
-    const float below = 1.0f + from * turn, above = 1.0f - to * turn;
-    from = below > 0.0f ? (from - turn) / below : -kHuge;
-    to = above > 0.0f ? (to + turn) / above : kHuge;
-    const __m128 lo = _mm_set1_ps(from), hi = _mm_set1_ps(to);
-    for (int q = 0; q < kChannelsPerTile; q += 4) {
-      const __m128 meets = _mm_and_ps(_mm_cmpge_ps(_mm_load_ps(&high[q]), lo),
-                                      _mm_cmple_ps(_mm_load_ps(&low[q]), hi));
-      if (_mm_movemask_ps(meets) != 0) return true;
-    }
-    return false;
-  }
-};
-
-// The squared distance in metres from a point to a node's box (grown by a
-// quantum), both in one object's quantized coordinates.
-struct NodeDistance {
-  NodeDistance(const Eigen::Vector3f& q_point, const Eigen::Vector3f& quantization)
-      : point(_mm_setr_ps(q_point.x(), q_point.y(), q_point.z(), 0.0f)),
-        metres(_mm_setr_ps(1.0f / quantization.x(), 1.0f / quantization.y(),
-                           1.0f / quantization.z(), 0.0f)) {}
-  float operator()(const btQuantizedBvhNode& node) const {
-    const __m128 q_min = _mm_setr_ps(float(node.m_quantizedAabbMin[0]) - 1.0f,
-                                     float(node.m_quantizedAabbMin[1]) - 1.0f,
-                                     float(node.m_quantizedAabbMin[2]) - 1.0f, 0.0f);
-    const __m128 q_max = _mm_setr_ps(float(node.m_quantizedAabbMax[0]) + 1.0f,
-                                     float(node.m_quantizedAabbMax[1]) + 1.0f,
-                                     float(node.m_quantizedAabbMax[2]) + 1.0f, 0.0f);
-    const __m128 gap =
-        _mm_max_ps(_mm_max_ps(Sub(q_min, point), Sub(point, q_max)), _mm_setzero_ps());
-    const __m128 g = Mul(gap, metres);
-    alignas(16) float squared[4];
-    _mm_store_ps(squared, Mul(g, g));
-    return squared[0] + squared[1] + squared[2];
-  }
-  __m128 point, metres;
-};
-
-// Calls visit(part, triangle) for each triangle of `target` whose BVH leaf
-// box meets(node) (and every box above it), nearest node first: a node whose
-// distance (squared, NodeDistance) is beyond(...) when its turn comes is
-// skipped with its subtree (visits shorten the reach).
-template <typename Meets, typename Beyond, typename Visit>
-void ForEachTriangleNearFirst(const Target& target, Meets&& meets, const NodeDistance& distance,
-                              Beyond&& beyond, Visit&& visit) {
-  const btQuantizedBvhNode* nodes = target.nodes;
-  struct Entry {
-    int node;
-    float distance2;
-  };
-  WalkStack<Entry, kStackInPlace> stack;
-  if (meets(nodes[0])) stack.Push({0, distance(nodes[0])});
-  while (!stack.empty()) {
-    const Entry entry = stack.Pop();
-    if (beyond(entry.distance2)) continue;
-    const btQuantizedBvhNode& node = nodes[entry.node];
-    if (node.isLeafNode()) {
-      const int packed = node.m_escapeIndexOrTriangleIndex;
-      visit(packed >> 21, packed & ((1 << 21) - 1));
-      continue;
-    }
-    const int left = entry.node + 1;
-    const int right = left + (nodes[left].isLeafNode() ? 1 : nodes[left].getEscapeIndex());
-    Entry child[2];
-    int children = 0;
-    for (const int index : {left, right}) {
-      if (!meets(nodes[index])) continue;
-      const float d2 = distance(nodes[index]);
-      if (!beyond(d2)) child[children++] = {index, d2};
-    }
-    if (children == 2 && child[0].distance2 < child[1].distance2) std::swap(child[0], child[1]);
-    for (int c = 0; c < children; ++c) stack.Push(child[c]);  // the nearer last: popped first
-  }
-}
-
 // Lanes whose rays enter an axis-aligned box (Bullet frame) before their t_max.
 inline int PacketMeetsBox(const Packet& packet, const __m128 inverse[3],
                           const Eigen::Vector3f& box_min, const Eigen::Vector3f& box_max) {
@@ -858,55 +676,6 @@ inline int PacketMeetsBox(const Packet& packet, const __m128 inverse[3],
   return _mm_movemask_ps(_mm_and_ps(packet.active, _mm_cmple_ps(t_enter, t_exit)));
 }
 #endif
-
-// The cut of a triangle (Bullet-frame corners) by a sweep step's slab
-// |w| <= m (its corners in the slab and its edges' crossings of the slab's
-// faces, as forward f and up u): narrows the channels [*j0, *j1) (of the
-// tile's, from j_begin, their tangents in `tangents`) to those whose elevation's
-// tangent lies within the cut's (widened by m_tangent / f), and raises *near
-// to the cut's nearest forward distance. False when no ray can meet it.
-// Bits set in a four-lane mask (a table: without -mpopcnt, __builtin_popcount
-// is a library call).
-constexpr int kBitsSet[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
-
-struct SweepStep {
-  Eigen::Vector3f o, f, u, n;  // the rays' origin, forward, up, normal
-};
-inline bool Cut(const Eigen::Vector3f corners[3], const SweepStep& s, float m, float m_tangent,
-                int j_begin, const float* tangents, int* j0, int* j1, float* near) {
-  float w[3], f[3], u[3];
-  for (int i = 0; i < 3; ++i) {
-    const Eigen::Vector3f p = corners[i] - s.o;
-    w[i] = p.dot(s.n), f[i] = p.dot(s.f), u[i] = p.dot(s.u);
-  }
-  float f_min = kHuge, f_max = -kHuge, lo = kHuge, hi = -kHuge;
-  auto point = [&](float pf, float pu) {
-    f_min = std::min(f_min, pf), f_max = std::max(f_max, pf);
-    if (pf > 0.0f) {
-      const float inverse = 1.0f / pf;
-      lo = std::min(lo, (pu - m_tangent) * inverse);
-      hi = std::max(hi, (pu + m_tangent) * inverse);
-    }
-  };
-  for (int i = 0; i < 3; ++i) {
-    if (std::abs(w[i]) <= m) point(f[i], u[i]);
-    const int j = i == 2 ? 0 : i + 1;
-    if (w[i] == w[j]) continue;
-    for (const float face : {-m, m}) {
-      if ((face - w[i]) * (face - w[j]) > 0.0f) continue;
-      const float t = std::clamp((face - w[i]) / (w[j] - w[i]), 0.0f, 1.0f);
-      point(f[i] + t * (f[j] - f[i]), u[i] + t * (u[j] - u[i]));
-    }
-  }
-  if (f_max < -m || f_min == kHuge) return false;  // behind the rays, or no cut
-  *near = std::max(*near, f_min - m);
-  if (f_min <= m) return true;  // within the margin of the origin: keep all
-  const float* first = tangents + (*j0 - j_begin);
-  const float* last = tangents + (*j1 - j_begin);
-  *j0 = j_begin + int(std::lower_bound(first, last, lo) - tangents);
-  *j1 = j_begin + int(std::upper_bound(first, last, hi) - tangents);
-  return *j0 < *j1;
-}
 
 }  // namespace
 
@@ -1196,7 +965,6 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
     band.body = hits->body.data() + first;
     std::fill(band.t_max, band.t_max + count, length);
     std::fill(band.body, band.body + count, RayHits::kNoHit);
-    band.direction = nullptr;
     band.normal = nullptr;
     if (hits->with_normals) {
       band.normals.resize(count);
@@ -1312,383 +1080,6 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
   for (std::size_t b = 0; b < grids.size(); ++b) grid_costs_[b].rows = grids[b].rows;
   for (std::size_t i = 0; i < bands.size(); ++i) {
     grid_costs_[std::size_t(bands[i].block)].seconds += band_seconds[i];
-  }
-#endif
-}
-
-void RayCaster::CastSweep(const scene::CollisionWorld& world, const RayBatch& rays,
-                          const RaySweep& sweep, const RayFilter& filter, RayHits* hits) {
-  const int channels = sweep.channels(), steps = sweep.steps();
-  const std::size_t n = rays.size();
-  if (sweep.up_W.size() != sweep.forward_W.size() || std::size_t(channels) * steps != n) {
-    throw std::invalid_argument("RayCaster::CastSweep(): " + std::to_string(channels) +
-                                " channels x " + std::to_string(steps) + " steps for a batch of " +
-                                std::to_string(n) + " rays");
-  }
-  double lowest_cosine = 1.0;
-  for (const double e : sweep.elevations_rad) {
-    if (!std::isfinite(e))
-      throw std::invalid_argument("RayCaster::CastSweep(): elevation not finite");
-    lowest_cosine = std::min(lowest_cosine, std::cos(e));
-  }
-  for (int k = 0; k < steps; ++k) {
-    const Eigen::Vector3d& f = sweep.forward_W[std::size_t(k)];
-    const Eigen::Vector3d& u = sweep.up_W[std::size_t(k)];
-    if (!(std::abs(f.norm() - 1.0) < 1e-9 && std::abs(u.norm() - 1.0) < 1e-9 &&
-          std::abs(f.dot(u)) < 1e-9)) {
-      throw std::invalid_argument("RayCaster::CastSweep(): step " + std::to_string(k) +
-                                  "'s forward and up are not unit and perpendicular");
-    }
-  }
-  // Near the poles a step's half-plane no longer orders its rays: cast them
-  // as a bag of rays.
-  if (n == 0 || lowest_cosine < std::cos(85.0 * M_PI / 180.0)) {
-    // Cast() checks nothing of the sweep: check the batch the same way.
-    for (int c = 0; c < channels; ++c) {
-      for (int k = 0; k < steps; ++k) {
-        const std::size_t i = std::size_t(c) * std::size_t(steps) + std::size_t(k);
-        if (rays.start[i] != rays.start[std::size_t(k)] || rays.length_m[i] != rays.length_m[0]) {
-          throw std::invalid_argument("RayCaster::CastSweep(): ray " + std::to_string(i) +
-                                      " differs in start or length from its step's");
-        }
-      }
-    }
-    Cast(world, rays, filter, hits);
-    return;
-  }
-#if !defined(__SSE2__)
-  Cast(world, rays, filter, hits);
-#else
-  rays_cast_ += std::int64_t(n);
-  SizeHits(n, hits);
-  const Eigen::Vector3f origin_B = (rays.origin_W - world.origin()).cast<float>();
-  const std::vector<Target>& all_targets = TargetsOf(world).all;
-  const Visible wanted{filter, world.internals().num_actors};
-  const float length = rays.length_m[0];
-  // Channels in order of elevation, by the tangent (monotonic within +-90 degrees).
-  std::vector<int> order(static_cast<std::size_t>(channels), 0);
-  for (int c = 0; c < channels; ++c) order[std::size_t(c)] = c;
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
-    return sweep.elevations_rad[std::size_t(a)] < sweep.elevations_rad[std::size_t(b)];
-  });
-  const std::size_t num_channels = std::size_t(channels);
-  std::vector<float> tangent(num_channels), cosine(num_channels), sine(num_channels);
-  for (int j = 0; j < channels; ++j) {
-    const double e = sweep.elevations_rad[std::size_t(order[std::size_t(j)])];
-    tangent[std::size_t(j)] = float(std::tan(e));
-  }
-  for (int c = 0; c < channels; ++c) {
-    cosine[std::size_t(c)] = float(std::cos(sweep.elevations_rad[std::size_t(c)]));
-    sine[std::size_t(c)] = float(std::sin(sweep.elevations_rad[std::size_t(c)]));
-  }
-  std::vector<Eigen::Vector3f> normals(hits->with_normals ? n : 0);
-  // Tiles of neighbouring steps and neighbouring channels (by elevation),
-  // each a chunk of work: about four a thread at least.
-  const int per_sector = std::clamp(steps / (4 * threads()), 1, kStepsPerTile);
-  const int sectors = (steps + per_sector - 1) / per_sector;
-  const int per_group = std::min(channels, kChannelsPerTile);
-  const int groups = (channels + per_group - 1) / per_group;
-  std::atomic<std::int64_t> bad_ray{-1};
-
-  const std::function<void(int)> job = [&](int tile) {
-    const int first_step = (tile / groups) * per_sector;
-    const int end_step = std::min(steps, first_step + per_sector);
-    const int j_begin = (tile % groups) * per_group;
-    const int j_end = std::min(channels, j_begin + per_group);
-    auto ray_of = [&](int j, int k) {
-      return std::size_t(order[std::size_t(j)]) * std::size_t(steps) + std::size_t(k);
-    };
-    thread_local GridBand band;
-    band.ox = _mm_set1_ps(origin_B.x()), band.oy = _mm_set1_ps(origin_B.y());
-    band.oz = _mm_set1_ps(origin_B.z());
-    band.direction = rays.direction.data();
-    band.start = rays.start.data();
-    band.t_max = hits->distance_m.data();
-    band.body = hits->body.data();
-    band.normal = normals.empty() ? nullptr : normals.data();
-    band.pairs.count = 0;
-    // Each step's half-plane in the Bullet frame: its rays' origin (as Cast()
-    // forms it), forward, up and normal.
-    SweepStep step[kStepsPerTile];
-    // The tile's pyramid: between the first and the last step's half-planes,
-    // above the lowest channel's cone and below the highest's (as planes at
-    // the middle step), each bounded by the tile's rays' ends.
-    const std::size_t mid = std::size_t((first_step + end_step) / 2);
-    const Eigen::Vector3d& mid_f = sweep.forward_W[mid];
-    const Eigen::Vector3d& mid_u = sweep.up_W[mid];
-    const double e_low = sweep.elevations_rad[std::size_t(order[std::size_t(j_begin)])];
-    const double e_high = sweep.elevations_rad[std::size_t(order[std::size_t(j_end - 1)])];
-    const Eigen::Vector3d first_n =
-        sweep.forward_W[std::size_t(first_step)].cross(sweep.up_W[std::size_t(first_step)]);
-    const Eigen::Vector3d last_n =
-        sweep.forward_W[std::size_t(end_step - 1)].cross(sweep.up_W[std::size_t(end_step - 1)]);
-    const Eigen::Vector3d above = -std::sin(e_low) * mid_f + std::cos(e_low) * mid_u;
-    const Eigen::Vector3d below = std::sin(e_high) * mid_f - std::cos(e_high) * mid_u;
-    const Eigen::Vector3d* axes[4] = {&first_n, &last_n, &above, &below};
-    const Eigen::Vector3d anchor = (origin_B + rays.start[std::size_t(first_step)]).cast<double>();
-    double low[4], high[4];
-    for (int w = 0; w < 4; ++w) low[w] = std::numeric_limits<double>::max(), high[w] = -low[w];
-    Eigen::AlignedBox3d box;
-    double reach = 0.0, drift = 0.0;
-    for (int k = first_step; k < end_step; ++k) {
-      SweepStep& s = step[k - first_step];
-      s.o = origin_B + rays.start[std::size_t(k)];
-      s.f = sweep.forward_W[std::size_t(k)].cast<float>();
-      s.u = sweep.up_W[std::size_t(k)].cast<float>();
-      s.n = s.f.cross(s.u);
-      const Eigen::Vector3d o = s.o.cast<double>();
-      reach = std::max(reach, o.norm());
-      drift = std::max(drift, (o - anchor).norm());
-      for (int j = j_begin; j < j_end; ++j) {
-        const std::size_t i = ray_of(j, k);
-        const std::size_t c = std::size_t(order[std::size_t(j)]);
-        const Eigen::Vector3f expected = cosine[c] * s.f + sine[c] * s.u;
-        if (rays.start[i] != rays.start[std::size_t(k)] || rays.length_m[i] != length ||
-            (rays.direction[i] - expected).cwiseAbs().maxCoeff() > 1e-6f) {
-          bad_ray = std::int64_t(i);
-          return;
-        }
-        hits->distance_m[i] = length;
-        hits->body[i] = RayHits::kNoHit;
-        // The tile's rays lie between the bounds of their ends on each axis.
-        const Eigen::Vector3d end = o + double(length) * rays.direction[i].cast<double>();
-        for (const Eigen::Vector3d& p : {o, end}) {
-          box.extend(p);
-          for (int w = 0; w < 4; ++w) {
-            const double along = (p - anchor).dot(*axes[w]);
-            low[w] = std::min(low[w], along), high[w] = std::max(high[w], along);
-          }
-        }
-      }
-    }
-    // Margin: float rounding of origins, directions (1e-6 checked above) and
-    // of the cuts below.
-    const double margin = 1e-5 * (reach + 2.0 * double(length)) + 1e-5;
-    const Eigen::Vector3f box_min = (box.min().array() - margin).cast<float>();
-    const Eigen::Vector3f box_max = (box.max().array() + margin).cast<float>();
-    double limit[4], margins[4] = {margin, margin, margin, margin};
-    for (int w = 0; w < 4; ++w) limit[w] = high[w] - low[w];
-    const int count = end_step - first_step;
-    // Each step's normal, forward and up as linear functions of a point
-    // (a . p - a . o), four steps a vector; padding steps see nothing.
-    alignas(16) float frame[3][4][kStepsPerTile];
-    for (int k = 0; k < kStepsPerTile; ++k) {
-      const bool real = k < count;
-      const SweepStep& s = step[std::min(k, count - 1)];
-      const Eigen::Vector3f* along[3] = {&s.n, &s.f, &s.u};
-      for (int a = 0; a < 3; ++a) {
-        for (int c = 0; c < 3; ++c) frame[a][c][k] = real ? (*along[a])[c] : 0.0f;
-        frame[a][3][k] = real ? along[a]->dot(s.o) : kHuge;
-      }
-    }
-    // The tile's channels' tangents, padded with +inf to 16.
-    alignas(16) float tile_tangent[kChannelsPerTile];
-    for (int j = 0; j < kChannelsPerTile; ++j) {
-      tile_tangent[j] = j_begin + j < j_end ? tangent[std::size_t(j_begin + j)] : kHuge;
-    }
-    const float tangent_slack = float(2e-6 / (lowest_cosine * lowest_cosine));
-    // The channels as elevation bands seen from the anchor in the middle
-    // step's frame (ChannelBands).
-    const Eigen::Vector3d mid_n = mid_f.cross(mid_u);
-    double tilt = 0.0;
-    for (int k = first_step; k < end_step; ++k) {
-      tilt =
-          std::max(tilt, std::acos(std::clamp(sweep.up_W[std::size_t(k)].dot(mid_u), -1.0, 1.0)));
-    }
-    tilt += 1e-5;  // the directions' rounding
-    ChannelBands bands;
-    bands.drift = float(drift + margin);
-    for (int j = 0; j < kChannelsPerTile; ++j) {
-      bands.low[j] = kHuge, bands.high[j] = -kHuge;
-      if (j_begin + j >= j_end) continue;
-      const double e = sweep.elevations_rad[std::size_t(order[std::size_t(j_begin + j)])];
-      constexpr double kSteep = 89.0 * M_PI / 180.0;
-      bands.low[j] = e - tilt > -kSteep ? float(std::tan(e - tilt)) : -kHuge;
-      bands.high[j] = e + tilt < kSteep ? float(std::tan(e + tilt)) : kHuge;
-    }
-    const Eigen::Vector3d* frame_axes[3] = {&mid_f, &mid_u, &mid_n};
-    const double frame_limit[3] = {0.0, 0.0, 0.0}, frame_margin[3] = {margin, margin, margin};
-    // The pyramid's bounds for single triangles: axis, low bound, extent.
-    __m128 pyramid[4][4], pyramid_limit[4];
-    for (int a = 0; a < 4; ++a) {
-      for (int k = 0; k < 3; ++k) pyramid[a][k] = _mm_set1_ps(float((*axes[a])[k]));
-      pyramid[a][3] = _mm_set1_ps(float(low[a]));
-      pyramid_limit[a] = _mm_set1_ps(float(limit[a] + margin));
-    }
-    // The farthest any of the tile's rays still reaches: nodes beyond it are
-    // skipped (after each test of the queued pairs).
-    float tile_reach = length;
-    auto test = [&](GridBand* b) {
-      HitPairs(b);
-      float farthest = 0.0f;
-      for (int j = j_begin; j < j_end; ++j) {
-        for (int k = first_step; k < end_step; ++k) {
-          farthest = std::max(farthest, hits->distance_m[ray_of(j, k)]);
-        }
-      }
-      tile_reach = farthest;
-    };
-    for (const Target& target : all_targets) {
-      if (!wanted(target) || (target.aabb_min.array() > box_max.array()).any() ||
-          (target.aabb_max.array() < box_min.array()).any()) {
-        continue;
-      }
-      // Coordinates shifted so that each bound starts at 0: w - low[w].
-      GridCull cull = CullFor(target, anchor, axes, 4, limit, margins, false);
-      alignas(16) float shift[4] = {float(low[0]), float(low[1]), float(low[2]), float(low[3])};
-      cull.w0 = Sub(cull.w0, _mm_load_ps(shift));
-      // The anchor in the object's quantized coordinates, for node distances.
-      const Eigen::Vector3f anchor_L = target.R_LB * anchor.cast<float>() + target.p_LB;
-      const Eigen::Vector3f q_anchor =
-          (anchor_L - target.bvh_min).cwiseProduct(target.quantization);
-      const NodeDistance distance(q_anchor, target.quantization);
-      const float reach_slack = float(drift + margin) + 1e-6f * float(reach + length);
-      auto beyond = [&](float distance2) {
-        const float reach_now = tile_reach + reach_slack;
-        return distance2 > reach_now * reach_now;
-      };
-      // A node is entered if it meets the tile's pyramid and a channel's band.
-      const GridCull frame_cull =
-          CullFor(target, anchor, frame_axes, 3, frame_limit, frame_margin, false);
-      auto meets = [&](const btQuantizedBvhNode& node) {
-        if (!NodeMeetsGrid(node, cull)) return false;
-        __m128 from, to;
-        NodeSpans(node, frame_cull, &from, &to);
-        alignas(16) float lo[4], hi[4];
-        _mm_store_ps(lo, from), _mm_store_ps(hi, to);
-        return bands.MayMeet(lo[0], hi[0], lo[1], hi[1], std::max(-lo[2], hi[2]));
-      };
-      ForEachTriangleNearFirst(target, meets, distance, beyond, [&](int part, int triangle) {
-        Eigen::Vector3f corners[3];
-        Corners(target, part, triangle, corners);
-        const __m128 cx = _mm_setr_ps(corners[0].x(), corners[1].x(), corners[2].x(), 0.0f);
-        const __m128 cy = _mm_setr_ps(corners[0].y(), corners[1].y(), corners[2].y(), 0.0f);
-        const __m128 cz = _mm_setr_ps(corners[0].z(), corners[1].z(), corners[2].z(), 0.0f);
-        const float size =
-            ((corners[0] - step[0].o).cwiseAbs().sum() + (corners[1] - step[0].o).cwiseAbs().sum() +
-             (corners[2] - step[0].o).cwiseAbs().sum());
-        // The margin: the rays' rounding (margin) and the rounding of the
-        // coordinates below, in the corners' and origins' size.
-        const float m = float(margin) + 1e-6f * (size + 3.0f * float(reach));
-        const __m128 slack = _mm_set1_ps(m), negative_slack = _mm_set1_ps(-m);
-        const float m_cut_tangent = m / float(lowest_cosine);
-        const __m128 m_tangent = _mm_set1_ps(m_cut_tangent);
-        // Outside the tile's pyramid (all corners beyond one of its bounds): no ray meets it.
-        {
-          const __m128 x = Sub(cx, _mm_set1_ps(float(anchor.x())));
-          const __m128 y = Sub(cy, _mm_set1_ps(float(anchor.y())));
-          const __m128 z = Sub(cz, _mm_set1_ps(float(anchor.z())));
-          for (int a = 0; a < 4; ++a) {
-            const __m128 w =
-                Sub(Add(Add(Mul(x, pyramid[a][0]), Mul(y, pyramid[a][1])), Mul(z, pyramid[a][2])),
-                    pyramid[a][3]);
-            const int under = _mm_movemask_ps(_mm_cmplt_ps(w, negative_slack));
-            const int over = _mm_movemask_ps(_mm_cmpgt_ps(w, Add(pyramid_limit[a], slack)));
-            if ((under & 7) == 7 || (over & 7) == 7) return;
-          }
-          // Between the channels' bands: no ray meets it.
-          auto span = [&](const Eigen::Vector3d& axis, float* lo, float* hi) {
-            alignas(16) float v[4];
-            _mm_store_ps(v, Add(Add(Mul(x, _mm_set1_ps(float(axis.x()))),
-                                    Mul(y, _mm_set1_ps(float(axis.y())))),
-                                Mul(z, _mm_set1_ps(float(axis.z())))));
-            *lo = std::min({v[0], v[1], v[2]}) - m, *hi = std::max({v[0], v[1], v[2]}) + m;
-          };
-          float f_lo, f_hi, u_lo, u_hi, w_lo, w_hi;
-          span(mid_f, &f_lo, &f_hi), span(mid_u, &u_lo, &u_hi), span(mid_n, &w_lo, &w_hi);
-          if (!bands.MayMeet(f_lo, f_hi, u_lo, u_hi, std::max(-w_lo, w_hi))) return;
-        }
-        // Four steps at a time, a step a lane: the corners' distances w from
-        // the step's plane, forward f and up u. The triangle may meet the
-        // step's rays if it reaches the slab |w| <= m in front; the rays'
-        // elevations there have tangents u / f within those of the corners
-        // (a ratio of linear functions has its extremes at the corners when
-        // f > 0 throughout).
-        __m128 corner_x[3], corner_y[3], corner_z[3];
-        for (int i = 0; i < 3; ++i) {
-          corner_x[i] = _mm_set1_ps(corners[i].x()), corner_y[i] = _mm_set1_ps(corners[i].y());
-          corner_z[i] = _mm_set1_ps(corners[i].z());
-        }
-        auto along = [&](int a, int k, int i) {
-          return Sub(Add(Add(Mul(_mm_load_ps(&frame[a][0][k]), corner_x[i]),
-                             Mul(_mm_load_ps(&frame[a][1][k]), corner_y[i])),
-                         Mul(_mm_load_ps(&frame[a][2][k]), corner_z[i])),
-                     _mm_load_ps(&frame[a][3][k]));
-        };
-        for (int k = 0; k < count; k += 4) {
-          // First the slab: most groups of steps miss the triangle.
-          __m128 w_low = _mm_set1_ps(kHuge), w_high = _mm_set1_ps(-kHuge);
-          for (int i = 0; i < 3; ++i) {
-            const __m128 w = along(0, k, i);
-            w_low = _mm_min_ps(w_low, w), w_high = _mm_max_ps(w_high, w);
-          }
-          int step_meets = _mm_movemask_ps(
-              _mm_and_ps(_mm_cmple_ps(w_low, slack), _mm_cmpge_ps(w_high, negative_slack)));
-          if (step_meets == 0) continue;
-          __m128 f_low = _mm_set1_ps(kHuge), f_high = _mm_set1_ps(-kHuge);
-          __m128 t_low = f_low, t_high = f_high;
-          for (int i = 0; i < 3; ++i) {
-            const __m128 f = along(1, k, i), u = along(2, k, i);
-            f_low = _mm_min_ps(f_low, f), f_high = _mm_max_ps(f_high, f);
-            const __m128 inverse = _mm_div_ps(_mm_set1_ps(1.0f), f);
-            t_low = _mm_min_ps(t_low, Mul(Sub(u, m_tangent), inverse));
-            t_high = _mm_max_ps(t_high, Mul(Add(u, m_tangent), inverse));
-          }
-          step_meets &= _mm_movemask_ps(_mm_cmpge_ps(f_high, negative_slack));
-          if (step_meets == 0) continue;
-          const int in_front = _mm_movemask_ps(_mm_cmpgt_ps(f_low, slack));
-          // The direction's own rounding, in tangents.
-          const __m128 spread = Mul(_mm_set1_ps(tangent_slack),
-                                    Add(_mm_set1_ps(1.0f), _mm_max_ps(Abs(t_low), Abs(t_high))));
-          t_low = Sub(t_low, spread), t_high = Add(t_high, spread);
-          alignas(16) float lows[4], highs[4], nears[4];
-          _mm_store_ps(lows, t_low), _mm_store_ps(highs, t_high);
-          _mm_store_ps(nears, Sub(f_low, slack));
-          for (int lane = 0; lane < 4; ++lane) {
-            if (!(step_meets & (1 << lane))) continue;
-            // The tile's channels whose tangent lies in [low, high]; all of
-            // them when the triangle comes within the margin of the origin.
-            int j0 = j_begin, j1 = j_end;
-            if (in_front & (1 << lane)) {
-              const __m128 from = _mm_set1_ps(lows[lane]), to = _mm_set1_ps(highs[lane]);
-              int under = 0, up_to = 0;
-              for (int q = 0; q < kChannelsPerTile; q += 4) {
-                const __m128 t = _mm_load_ps(&tile_tangent[q]);
-                under += kBitsSet[_mm_movemask_ps(_mm_cmplt_ps(t, from))];
-                up_to += kBitsSet[_mm_movemask_ps(_mm_cmple_ps(t, to))];
-              }
-              j0 = j_begin + under, j1 = j_begin + up_to;
-            }
-            float near = nears[lane];
-            // Several channels: the cut by the step's slab, often narrower
-            // than the whole triangle, tells which.
-            if (j1 - j0 > 1 && !Cut(corners, step[k + lane], m, m_cut_tangent, j_begin,
-                                    tile_tangent, &j0, &j1, &near)) {
-              continue;
-            }
-            const int ray_step = first_step + k + lane;
-            for (int j = j0; j < j1; ++j) {
-              band.Add(corners, target.body, int(ray_of(j, ray_step)), near, test);
-            }
-          }
-        }
-      });
-    }
-    test(&band);
-    if (band.normal != nullptr) {
-      for (int j = j_begin; j < j_end; ++j) {
-        for (int k = first_step; k < end_step; ++k) {
-          const std::size_t i = ray_of(j, k);
-          WriteHit(i, hits->distance_m[i], hits->body[i], normals[i], rays.direction[i], hits);
-        }
-      }
-    }
-  };
-  RunParallel(sectors * groups, job);
-  if (bad_ray >= 0) {
-    throw std::invalid_argument("RayCaster::CastSweep(): ray " + std::to_string(bad_ray.load()) +
-                                " is not its channel's ray of its step (start, direction or "
-                                "length)");
   }
 #endif
 }

@@ -57,18 +57,6 @@ struct RayGrid {
   float length_m{1.0f};
 };
 
-// A lidar sweep as a batch of channels x steps rays: ray (c, k) is the
-// batch's ray c * steps + k. The rays of step k share one start and lie in one
-// half-plane: ray (c, k) runs along cos(e_c) forward_W[k] + sin(e_c) up_W[k]
-// (to float rounding), e_c = elevations_rad[c]; forward and up are unit and
-// perpendicular. All rays have one length.
-struct RaySweep {
-  std::vector<double> elevations_rad;            // one per channel
-  std::vector<Eigen::Vector3d> forward_W, up_W;  // one per step
-  int channels() const { return static_cast<int>(elevations_rad.size()); }
-  int steps() const { return static_cast<int>(forward_W.size()); }
-};
-
 // What rays may see.
 struct RayFilter {
   std::uint32_t group_mask{scene::kAllGroups};
@@ -117,23 +105,12 @@ class RayCaster {
   void CastGrids(const scene::CollisionWorld& world, const RayBatch& rays,
                  const std::vector<RayGrid>& grids, const RayFilter& filter, RayHits* hits);
 
-  // Cast() for a lidar sweep, by the structured kernel: per tile of
-  // neighbouring steps and channels, the triangles inside the tile's rays'
-  // bounds are found once, nearest first, until the rays are stopped; each is
-  // cut by each step's half-plane and tested against exactly the channels
-  // whose elevations meet the cut, with Cast()'s own per-ray test. Same hits
-  // as Cast() (docs/sensors.md). Sweeps with an elevation beyond 85
-  // degrees are cast by Cast(). Throws std::invalid_argument when the batch
-  // is not the sweep's rays (count, starts, directions, lengths).
-  void CastSweep(const scene::CollisionWorld& world, const RayBatch& rays, const RaySweep& sweep,
-                 const RayFilter& filter, RayHits* hits);
-
   int threads() const { return pool_.threads(); }
   // Entries a BVH walk keeps on its own stack before it grows on the heap
   // (a deeper tree costs an allocation per walk, never a dropped node).
   static constexpr int kStackInPlace = 32;
   // The packet kernel in use: "avx512" (sixteen rays a packet in Cast(),
-  // sixteen triangle-ray pairs a test in CastGrids() and CastSweep(); the
+  // sixteen triangle-ray pairs a test in CastGrids(); the
   // FMA kernel's arithmetic), "fma" (the CPU's fused multiply-add unit, four
   // rays; SANDBOX_RAY_KERNEL=fma forces it), "sse2" (fused operations emulated
   // where they decide; SANDBOX_RAY_KERNEL=sse2) or "scalar" (no SSE2). All

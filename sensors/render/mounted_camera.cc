@@ -69,13 +69,6 @@ void ReadLook(const scene::SensorSpec& spec, scene::SettingsReader* read, Render
 
 }  // namespace
 
-std::string_view CameraTypeName(CameraKind kind) {
-  for (const auto& [k, name] : kCameraTypes) {
-    if (k == kind) return name;
-  }
-  return "?";
-}
-
 Eigen::Isometry3d MountedCamera::Pose(const scene::RobotState& state, ChaseCamera* chase_state,
                                       const TrailingCommand& command, double dt_s) const {
   switch (kind) {

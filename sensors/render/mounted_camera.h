@@ -23,9 +23,6 @@ enum class CameraKind {
   kFixed,     // a world pose
 };
 
-// The manifest's name of a kind ("chase", ...).
-std::string_view CameraTypeName(CameraKind kind);
-
 // A camera declared by a [[robot.camera]] table.
 struct MountedCamera {
   scene::SensorSpec spec;  // name, type, mount, X_MS, rate

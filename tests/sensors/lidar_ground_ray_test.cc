@@ -32,20 +32,10 @@ class PlaneTest : public ::testing::Test {
   scene::Level level_;
   scene::CollisionWorld world_;
   RayCaster caster_{2};
-  void LidarBeamsHitAtHeightOverSine(bool structured);
 };
 
 TEST_F(PlaneTest, LidarBeamsBelowTheHorizonHitAtHeightOverSine) {
-  for (const bool structured : {false, true}) {  // the general caster, the sweep kernel
-    SCOPED_TRACE(structured ? "sweep kernel" : "general caster");
-    LidarBeamsHitAtHeightOverSine(structured);
-  }
-}
-
-void PlaneTest::LidarBeamsHitAtHeightOverSine(bool structured) {
-  LidarConfig config = LidarConfig::Uniform(16, -30, 15, 360, 100.0, 10.0);
-  config.structured = structured;
-  const Lidar lidar(config);
+  const Lidar lidar(LidarConfig::Uniform(16, -30, 15, 360, 100.0, 10.0));
   LidarScan scan;
   const Isometry3d X(Eigen::Translation3d(1, 2, 10));
   lidar.Sweep(world_, caster_, {}, X, X, &scan);

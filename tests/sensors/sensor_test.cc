@@ -78,7 +78,7 @@ scene::Level EveryKindLevel(testing::TempDir& dir) {
                     "resolution_m = 2\nhalf_extent_m = 40\n"
                     "[[robot.sensor]]\nname = \"below\"\ntype = \"ground\"\nposition = [1, 0, 0]\n"
                     "[[robot.sensor]]\nname = \"spin\"\ntype = \"lidar\"\nchannels = 4\n"
-                    "azimuth_steps = 64\nrpy_deg = [0, 20, 0]\nkernel = \"sweep\"\n"
+                    "azimuth_steps = 64\nrpy_deg = [0, 20, 0]\n"
                     "[[robot.sensor]]\nname = \"alt\"\ntype = \"ray\"\nrange_m = 200\n"));
 }
 
@@ -131,12 +131,6 @@ TEST(SensorTest, EveryKindRunsThroughTheFamilyAsItsOwnClassWould) {
       LidarScan expected;  // no pose history: the sweep is cast from the pose now
       Lidar(std::get<LidarConfig>(m.config)).Sweep(world, caster, filter, X_WS, X_WS, &expected);
       EXPECT_EQ(sweep->range_m, expected.range_m);
-      // Its kernel = "sweep" is read and used: the same ranges as the general caster's.
-      LidarConfig general = std::get<LidarConfig>(m.config);
-      EXPECT_TRUE(general.structured);
-      general.structured = false;
-      Lidar(general).Sweep(world, caster, filter, X_WS, X_WS, &expected);
-      EXPECT_EQ(sweep->range_m, expected.range_m);
       for (const std::uint8_t h : sweep->hit) hits += h;
     } else if (const auto* reading = std::get_if<RangeReading>(&output)) {
       const RangeReading expected =
@@ -150,7 +144,7 @@ TEST(SensorTest, EveryKindRunsThroughTheFamilyAsItsOwnClassWould) {
   // What `sandbox info` prints, from each config.
   EXPECT_EQ(mounted[0].Describe(), "face 41x41x6 at 2 m on body");
   EXPECT_EQ(mounted[1].Describe(), "ground +-25 m at 1 m on body");
-  EXPECT_EQ(mounted[2].Describe(), "lidar 4x64, 100 m, sweep kernel on body");
+  EXPECT_EQ(mounted[2].Describe(), "lidar 4x64, 100 m on body");
   EXPECT_EQ(mounted[3].Describe(), "ray 200 m on body");
 }
 
@@ -224,8 +218,11 @@ TEST(SensorTest, MistakesNameTheSensorAndField) {
             "level.toml:8: sensor 's': 'type' must be face, ground, lidar or ray, got 'sonar'");
   EXPECT_EQ(Error("type = \"lidar\"\nchannels = 0\n"),
             "level.toml:9: sensor 's': 'channels' must be at least 1");
-  EXPECT_EQ(Error("type = \"lidar\"\nkernel = \"embree\"\n"),
-            "level.toml:9: sensor 's': 'kernel' must be general or sweep, got 'embree'");
+  // A removed key names what replaced it.
+  EXPECT_EQ(Error("type = \"lidar\"\nkernel = \"sweep\"\n"),
+            "level.toml:9: sensor 's': 'kernel' is no longer a key: every lidar is cast by the "
+            "general caster, faster than the structured sweep kernel on every level measured "
+            "(docs/decisions/001-no-structured-lidar-kernel.md); delete the key");
   EXPECT_EQ(Error("type = \"ray\"\nrange_m = nan\n"),
             "level.toml:9: sensor 's': 'range_m' must be finite, got nan");
   EXPECT_EQ(Error("type = \"ray\"\nrate_hz = -1\n"),

@@ -1,7 +1,6 @@
-// The structured kernels (RayCaster::CastGrids for face scans, CastSweep for
-// lidar sweeps) against the general caster (RayCaster::Cast) on the same rays:
-// every ray hits or misses in both, at the same distance, on the same body.
-// Random poses and orientations (and, for sweeps, motion during the sweep), a
+// The structured face-scan kernel (RayCaster::CastGrids) against the general
+// caster (RayCaster::Cast) on the same rays: every ray hits or misses in both,
+// at the same distance, on the same body. Random poses and orientations, a
 // bent robot, and meshes whose vertices lie exactly on the rays.
 
 #include <gtest/gtest.h>
@@ -68,26 +67,6 @@ Difference CompareKernels(const scene::CollisionWorld& world, const FaceScannerC
   difference.body_differs += second.body_differs;
   difference.normal_differs += second.normal_differs;
   difference.worst_m = std::max(difference.worst_m, second.worst_m);
-  return difference;
-}
-
-// A lidar sweep from X_WS_start to X_WS_end cast both ways (with normals:
-// they come from the hit triangle, so they must agree too).
-Difference CompareSweeps(const scene::CollisionWorld& world, const LidarConfig& config,
-                         const Isometry3d& X_WS_start, const Isometry3d& X_WS_end,
-                         const RayFilter& filter = {}) {
-  RaySweep sweep;
-  const RayBatch rays = Lidar(config).Rays(X_WS_start, X_WS_end, &sweep);
-  RayCaster caster(2);
-  RayHits general, structured;
-  caster.Cast(world, rays, filter, &general);
-  caster.CastSweep(world, rays, sweep, filter, &structured);
-  Difference difference = Differences(general, structured);
-  for (std::size_t i = 0; i < rays.size(); ++i) {
-    if (general.body[i] != RayHits::kNoHit && general.body[i] == structured.body[i]) {
-      difference.normal_differs += general.normal_W[i].dot(structured.normal_W[i]) < 0.99999f;
-    }
-  }
   return difference;
 }
 
@@ -242,9 +221,8 @@ TEST(StructuredScanTest, ATieBetweenActorsGoesToTheFirstInEveryKernel) {
   FaceScanner(face).GridRays(0, Isometry3d(Eigen::Translation3d(0.1, 0.2, 3.0)), &face_rays,
                              &grids);
   const LidarConfig lidar = LidarConfig::Uniform(16, -60, -10, 256, 40.0);
-  RaySweep sweep;
   const Isometry3d X_WS(Eigen::Translation3d(0.3, -0.2, 4.0));
-  const RayBatch lidar_rays = Lidar(lidar).Rays(X_WS, X_WS, &sweep);
+  const RayBatch lidar_rays = Lidar(lidar).Rays(X_WS, X_WS);
   RayHits hits;
   auto expect_first = [&](const char* kernel) {
     int on_floor = 0, second = 0;
@@ -258,8 +236,6 @@ TEST(StructuredScanTest, ATieBetweenActorsGoesToTheFirstInEveryKernel) {
   expect_first("CastGrids");
   caster.Cast(world, lidar_rays, {}, &hits);
   expect_first("Cast, sweep");
-  caster.CastSweep(world, lidar_rays, sweep, {}, &hits);
-  expect_first("CastSweep");
 }
 
 TEST(StructuredScanTest, BadBlocksAreRefused) {
@@ -283,148 +259,6 @@ TEST(StructuredScanTest, BadBlocksAreRefused) {
   grid.length_m = rays.length_m[0];
   caster.CastGrids(world, rays, {grid}, {}, &hits);  // restored: cast
   EXPECT_EQ(hits.size(), rays.size());
-}
-
-// A sweep's end pose: the start moved up to `move_m` and turned up to `turn_rad`.
-Isometry3d Moved(std::mt19937& random, const Isometry3d& X_WS_start, double move_m,
-                 double turn_rad) {
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  double draw[6];
-  for (double& value : draw) value = unit(random);
-  const Vector3d axis = Vector3d(draw[3], draw[4], draw[5]).normalized();
-  return Eigen::Translation3d(X_WS_start.translation() +
-                              move_m * Vector3d(draw[0], draw[1], draw[2])) *
-         Eigen::AngleAxisd(turn_rad, axis) * Eigen::Quaterniond(X_WS_start.linear());
-}
-
-TEST(StructuredSweepTest, SameHitsAsTheGeneralCasterOnTheSampleLevelFromRandomMovingPoses) {
-  const scene::Level level = scene::LoadLevel(testing::SampleLevel());
-  const scene::CollisionWorld world(level);
-  std::mt19937 random(20261125);
-  const Eigen::AlignedBox3d valley(Vector3d(-150, -150, 5), Vector3d(150, 150, 60));
-  // Evenly spread, the bench's 64 channels, and an unsorted list; few steps
-  // (each sector wide) and many.
-  LidarConfig unsorted = LidarConfig::Uniform(1, 0, 0, 300);
-  unsorted.elevations_rad.clear();
-  for (const double deg : {5.0, -10.0, 0.0, 12.0, -3.0, -40.0, 70.0}) {
-    unsorted.elevations_rad.push_back(deg * M_PI / 180.0);
-  }
-  const LidarConfig configs[] = {LidarConfig::Uniform(16, -15, 15, 1024),
-                                 LidarConfig::Uniform(64, -25, 15, 2048, 120.0), unsorted,
-                                 LidarConfig::Uniform(8, -30, 30, 7, 200.0)};
-  int hits = 0, k = 0;
-  for (const LidarConfig& config : configs) {
-    for (int pose = 0; pose < 3; ++pose, ++k) {
-      const Isometry3d X_WS_start = RandomPose(random, valley);
-      // Still, moving 2 m and turning 10 degrees, moving fast and tumbling.
-      const Isometry3d X_WS_end = pose == 0   ? X_WS_start
-                                  : pose == 1 ? Moved(random, X_WS_start, 2.0, 0.17)
-                                              : Moved(random, X_WS_start, 20.0, 2.0);
-      const Difference difference = CompareSweeps(world, config, X_WS_start, X_WS_end);
-      ExpectSame(difference, config.Summary() + ", pose " + std::to_string(pose));
-      hits += difference.hits;
-    }
-  }
-  EXPECT_GT(hits, 50000);  // the sweeps see the valley, not only the sky
-}
-
-TEST(StructuredSweepTest, SameHitsOnABentRobotSweptFromBesideIt) {
-  const scene::Level level = scene::LoadLevel(testing::SampleLevel());
-  scene::CollisionWorld world(level);
-  ASSERT_TRUE(BendTheWing(level, &world));
-  const LidarConfig config = LidarConfig::Uniform(32, -40, 40, 1024, 50.0);
-  std::mt19937 random(8);
-  const Eigen::AlignedBox3d near_wing(Vector3d(0, 14, 36), Vector3d(20, 26, 44));
-  int robot_hits = 0;
-  RayFilter only_robots;
-  only_robots.group_mask = scene::kRobot;
-  for (int k = 0; k < 4; ++k) {
-    const Isometry3d X_WS = RandomPose(random, near_wing);
-    const Isometry3d X_WS_end = Moved(random, X_WS, 0.5, 0.1);
-    ExpectSame(CompareSweeps(world, config, X_WS, X_WS_end), "pose " + std::to_string(k));
-    const Difference robot = CompareSweeps(world, config, X_WS, X_WS_end, only_robots);
-    ExpectSame(robot, "robot only, pose " + std::to_string(k));
-    robot_hits += robot.hits;
-  }
-  EXPECT_GT(robot_hits, 500);
-  RayFilter own;
-  own.ignore_robot = 0;
-  const Isometry3d inside(Eigen::Translation3d(10, 20, 40));
-  ExpectSame(CompareSweeps(world, config, inside, inside, own), "own robot ignored");
-}
-
-// A closed mesh around a still lidar whose vertices are the points of its
-// own rays at varying distances: every ray runs through a vertex shared by
-// six triangles, where the watertight rules decide.
-TEST(StructuredSweepTest, SameHitsWhereRaysRunThroughVertices) {
-  const LidarConfig config = LidarConfig::Uniform(24, -30, 30, 360, 50.0);
-  const Vector3d where(3.25, -1.5, 2.0);
-  const Isometry3d X_WS(Eigen::Translation3d(where) * Eigen::AngleAxisd(0.3, Vector3d::UnitZ()));
-  const RayBatch rays = Lidar(config).Rays(X_WS, X_WS);
-  const int channels = config.channels(), steps = config.azimuth_steps;
-  testing::TempDir dir;
-  {
-    std::ofstream obj(dir.path() / "shell.obj");
-    obj.precision(9);
-    for (int c = 0; c < channels; ++c) {
-      for (int k = 0; k < steps; ++k) {
-        const std::size_t i = std::size_t(c) * std::size_t(steps) + std::size_t(k);
-        const double r = 10.0 + 0.5 * ((c * 7 + k * 3) % 5);
-        const Vector3d p = where + r * rays.direction[i].cast<double>();
-        obj << "v " << float(p.x()) << " " << float(p.y()) << " " << float(p.z()) << "\n";
-      }
-    }
-    for (int c = 0; c + 1 < channels; ++c) {
-      for (int k = 0; k < steps; ++k) {
-        const int a = c * steps + k + 1, b = c * steps + (k + 1) % steps + 1;
-        const int d = a + steps, e = b + steps;
-        obj << "f " << a << " " << b << " " << e << "\nf " << a << " " << e << " " << d << "\n";
-      }
-    }
-    std::ofstream(dir.path() / "level.toml")
-        << "[[actor]]\nname = \"shell\"\nfile = \"shell.obj\"\n";
-  }
-  const scene::Level level = scene::LoadLevel(dir.path() / "level.toml");
-  const scene::CollisionWorld world(level);
-  const Difference difference = CompareSweeps(world, config, X_WS, X_WS);
-  ExpectSame(difference, "shell", true);
-  EXPECT_GT(difference.hits, difference.rays * 9 / 10);  // every ray meets the shell
-}
-
-TEST(StructuredSweepTest, ABatchThatIsNotTheSweepsRaysIsRefused) {
-  const scene::Level level = scene::LoadLevel(testing::SampleLevel());
-  const scene::CollisionWorld world(level);
-  const Lidar lidar(LidarConfig::Uniform(4, -10, 10, 64));
-  RaySweep sweep;
-  RayBatch rays = lidar.Rays(Isometry3d::Identity(), Isometry3d::Identity(), &sweep);
-  RayCaster caster(2);
-  RayHits hits;
-  RaySweep fewer = sweep;
-  fewer.forward_W.pop_back(), fewer.up_W.pop_back();
-  EXPECT_THROW(caster.CastSweep(world, rays, fewer, {}, &hits), std::invalid_argument);
-  RaySweep slanted = sweep;
-  slanted.up_W[3] = Vector3d(1, 0, 1).normalized();
-  EXPECT_THROW(caster.CastSweep(world, rays, slanted, {}, &hits), std::invalid_argument);
-  rays.direction[70] = -rays.direction[70];
-  EXPECT_THROW(caster.CastSweep(world, rays, sweep, {}, &hits), std::invalid_argument);
-  rays.direction[70] = -rays.direction[70];
-  rays.start[130].x() += 0.5f;
-  EXPECT_THROW(caster.CastSweep(world, rays, sweep, {}, &hits), std::invalid_argument);
-  rays.start[130].x() -= 0.5f;
-  caster.CastSweep(world, rays, sweep, {}, &hits);  // the batch restored: cast
-  EXPECT_EQ(hits.size(), rays.size());
-}
-
-// Beams near the poles (beyond 85 degrees) go to the general caster: still
-// the same hits.
-TEST(StructuredSweepTest, SteepBeamsGiveTheSameHits) {
-  const scene::Level level = scene::LoadLevel(testing::SampleLevel());
-  const scene::CollisionWorld world(level);
-  LidarConfig config = LidarConfig::Uniform(5, -89, 89, 256);
-  const Isometry3d X_WS(Eigen::Translation3d(20, -25, 22));
-  const Difference difference = CompareSweeps(world, config, X_WS, X_WS);
-  ExpectSame(difference, "steep");
-  EXPECT_GT(difference.hits, 256);
 }
 
 }  // namespace
