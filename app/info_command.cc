@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 #include <variant>
 
@@ -32,6 +33,36 @@ struct LoadFigures {
   int collision_objects{0};
   std::size_t merged_static_triangles{0};  // CollisionWorld::merged_static_triangles
 };
+
+// A level's [[terrain]] as its rasters give it (the terrain actor has no
+// meshes: its tiles are built while running).
+struct TerrainFigures {
+  int usable{0};                    // elevation rasters that serve
+  double fine_tile_m{0.0};          // a fine tile's side
+  Eigen::AlignedBox3d bounds_W;     // TerrainSource::Bounds_W
+  Eigen::AlignedBox2d ground_W;     // TerrainSource::InnerFootprint_W
+};
+
+std::optional<TerrainFigures> TerrainOf(const Level& level) {
+  if (!level.terrain) return std::nullopt;
+  const scene::TerrainSource source(*level.terrain);
+  return TerrainFigures{source.num_usable(), source.fine_tile_m(), source.Bounds_W(),
+                        source.InnerFootprint_W()};
+}
+
+// The level's bounds with its terrain's.
+Eigen::AlignedBox3d BoundsOf(const Level& level, const std::optional<TerrainFigures>& terrain) {
+  Eigen::AlignedBox3d bounds = level.bounds_W();
+  if (terrain && !terrain->bounds_W.isEmpty()) bounds.extend(terrain->bounds_W);
+  return bounds;
+}
+
+// An actor's bounds; the terrain actor's are its rasters'.
+Eigen::AlignedBox3d ActorBounds(const Level& level, std::size_t actor,
+                                const std::optional<TerrainFigures>& terrain) {
+  if (terrain && int(actor) == level.terrain_actor) return terrain->bounds_W;
+  return level.actors[actor].bounds_W;
+}
 
 std::string JsonString(const std::string& text) {
   std::string out = "\"";
@@ -64,7 +95,8 @@ Eigen::Vector3d Hi(const Eigen::AlignedBox3d& b) {
 }
 
 void PrintJson(const Level& level, const std::vector<sensors::MountedSensor>& sensors,
-               const LoadFigures& figures, std::ostream& out) {
+               const LoadFigures& figures, const std::optional<TerrainFigures>& terrain,
+               std::ostream& out) {
   std::size_t vertices = 0, collision_actors = 0, movable_actors = 0;
   out << "{\n  \"level\": {\"name\": " << JsonString(level.name)
       << ", \"file\": " << JsonString(level.file.string()) << "},\n  \"actors\": [";
@@ -77,8 +109,8 @@ void PrintJson(const Level& level, const std::vector<sensors::MountedSensor>& se
         << ", \"triangles\": " << a.num_triangles() << ", \"vertices\": " << a.num_vertices()
         << ", \"collision\": " << (a.collision ? "true" : "false")
         << ", \"movable\": " << (a.movable ? "true" : "false")
-        << ", \"bounds_min\": " << JsonVector(Lo(a.bounds_W))
-        << ", \"bounds_max\": " << JsonVector(Hi(a.bounds_W)) << "}";
+        << ", \"bounds_min\": " << JsonVector(Lo(ActorBounds(level, i, terrain)))
+        << ", \"bounds_max\": " << JsonVector(Hi(ActorBounds(level, i, terrain))) << "}";
   }
   out << "\n  ],\n  \"robots\": [";
   for (std::size_t i = 0; i < level.robots.size(); ++i) {
@@ -100,15 +132,34 @@ void PrintJson(const Level& level, const std::vector<sensors::MountedSensor>& se
     }
     out << "]}";
   }
-  out << "\n  ],\n  \"totals\": {\"actors\": " << level.actors.size()
+  out << "\n  ],\n";
+  if (terrain) {
+    const scene::TerrainSpec& t = *level.terrain;
+    const Eigen::AlignedBox2d& g = terrain->ground_W;
+    auto xy = [](const Eigen::Vector2d& v) { return JsonVector({v.x(), v.y(), 0.0}); };
+    out << "  \"terrain\": {\"name\": " << JsonString(t.name)
+        << ", \"elevation_rasters\": " << t.elevation.size()
+        << ", \"usable_rasters\": " << terrain->usable
+        << ", \"imagery_rasters\": " << t.imagery.size() << ", \"anchor\": "
+        << JsonVector({t.anchor.latitude_deg, t.anchor.longitude_deg, t.anchor.height_m})
+        << ", \"fine_tile_m\": " << terrain->fine_tile_m
+        << ", \"collision_radius_m\": " << t.collision_radius_m
+        << ", \"view_radius_m\": " << t.view_radius_m
+        << ", \"bounds_min\": " << JsonVector(Lo(terrain->bounds_W))
+        << ", \"bounds_max\": " << JsonVector(Hi(terrain->bounds_W)) << ", \"ground_min\": "
+        << xy(g.isEmpty() ? Eigen::Vector2d::Zero() : g.min()) << ", \"ground_max\": "
+        << xy(g.isEmpty() ? Eigen::Vector2d::Zero() : g.max()) << "},\n";
+  }
+  const Eigen::AlignedBox3d bounds = BoundsOf(level, terrain);
+  out << "  \"totals\": {\"actors\": " << level.actors.size()
       << ", \"collision_actors\": " << collision_actors
       << ", \"movable_actors\": " << movable_actors << ", \"triangles\": " << level.num_triangles()
       << ", \"vertices\": " << vertices << ", \"materials\": " << level.materials.size()
       << ", \"textures\": " << level.textures.size()
       << ", \"collision_objects\": " << figures.collision_objects
       << ", \"merged_static_triangles\": " << figures.merged_static_triangles
-      << ", \"bounds_min\": " << JsonVector(Lo(level.bounds_W()))
-      << ", \"bounds_max\": " << JsonVector(Hi(level.bounds_W())) << "},\n";
+      << ", \"bounds_min\": " << JsonVector(Lo(bounds))
+      << ", \"bounds_max\": " << JsonVector(Hi(bounds)) << "},\n";
   out << std::fixed << std::setprecision(4) << "  \"load\": {\"level_s\": " << figures.level_s
       << ", \"collision_world_s\": " << figures.collision_world_s
       << ", \"total_s\": " << figures.level_s + figures.collision_world_s << std::setprecision(1)
@@ -120,7 +171,8 @@ void PrintJson(const Level& level, const std::vector<sensors::MountedSensor>& se
 }
 
 void PrintText(const Level& level, const std::vector<sensors::MountedSensor>& sensors,
-               const LoadFigures& figures, std::ostream& out) {
+               const LoadFigures& figures, const std::optional<TerrainFigures>& terrain,
+               std::ostream& out) {
   std::size_t name_width = 5;
   for (const scene::Actor& a : level.actors) name_width = std::max(name_width, a.name.size());
   name_width = std::min<std::size_t>(name_width, 48);
@@ -129,8 +181,10 @@ void PrintText(const Level& level, const std::vector<sensors::MountedSensor>& se
       << std::setw(11) << "triangles"
       << "  collision  movable  bounds min .. max (m)\n";
   out << std::fixed << std::setprecision(2);
-  for (const scene::Actor& a : level.actors) {
-    const Eigen::Vector3d lo = Lo(a.bounds_W), hi = Hi(a.bounds_W);
+  for (std::size_t i = 0; i < level.actors.size(); ++i) {
+    const scene::Actor& a = level.actors[i];
+    const Eigen::AlignedBox3d box = ActorBounds(level, i, terrain);
+    const Eigen::Vector3d lo = Lo(box), hi = Hi(box);
     out << std::left << std::setw(static_cast<int>(name_width)) << a.name << std::right
         << std::setw(11) << a.num_triangles() << "  " << std::left << std::setw(9)
         << (a.collision ? "yes" : "no") << "  " << std::setw(7) << (a.movable ? "yes" : "no")
@@ -149,14 +203,13 @@ void PrintText(const Level& level, const std::vector<sensors::MountedSensor>& se
       out << "  sensor " << sensor.spec.name << ": " << sensor.Describe() << "\n";
     }
   }
-  if (level.terrain) {
+  if (terrain) {
     const scene::TerrainSpec& t = *level.terrain;
-    const scene::TerrainSource source(t);
-    const Eigen::AlignedBox2d ground = source.InnerFootprint_W();
-    out << "terrain " << t.name << ": " << source.num_usable() << " of " << t.elevation.size()
+    const Eigen::AlignedBox2d& ground = terrain->ground_W;
+    out << "terrain " << t.name << ": " << terrain->usable << " of " << t.elevation.size()
         << " elevation rasters, " << t.imagery.size() << " imagery; anchor " << std::setprecision(6)
         << t.anchor.latitude_deg << ", " << t.anchor.longitude_deg << ", " << std::setprecision(2)
-        << t.anchor.height_m << " m; fine tiles of " << source.fine_tile_m() << " m within "
+        << t.anchor.height_m << " m; fine tiles of " << terrain->fine_tile_m << " m within "
         << t.collision_radius_m << " m, coarse within " << t.view_radius_m
         << " m (streamed while running)\n";
     if (!ground.isEmpty()) {
@@ -164,7 +217,7 @@ void PrintText(const Level& level, const std::vector<sensors::MountedSensor>& se
           << ground.max().x() << ", " << ground.max().y() << ") m, inside the outermost tiles\n";
     }
   }
-  const Eigen::AlignedBox3d bounds = level.bounds_W();
+  const Eigen::AlignedBox3d bounds = BoundsOf(level, terrain);
   const Eigen::Vector3d size = Hi(bounds) - Lo(bounds);
   out << "\ntotal " << level.actors.size() << " actors, " << level.num_triangles() << " triangles, "
       << level.materials.size() << " materials, " << level.textures.size() << " embedded textures, "
@@ -253,10 +306,11 @@ int RunInfo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     figures.peak_memory_mib = PeakResidentMiB();
     figures.collision_objects = world.num_collision_objects();
     figures.merged_static_triangles = world.merged_static_triangles();
+    const std::optional<TerrainFigures> terrain = TerrainOf(level);
     if (json) {
-      PrintJson(level, sensors, figures, out);
+      PrintJson(level, sensors, figures, terrain, out);
     } else {
-      PrintText(level, sensors, figures, out);
+      PrintText(level, sensors, figures, terrain, out);
     }
     return 0;
   } catch (const scene::LevelError& error) {

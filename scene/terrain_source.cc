@@ -470,6 +470,35 @@ Eigen::AlignedBox2d TerrainSource::InnerFootprint_W() const {
   return box;
 }
 
+Eigen::AlignedBox3d TerrainSource::Bounds_W() const {
+  const QuietGdal quiet;
+  Eigen::AlignedBox3d box;
+  for (const auto& raster : elevation_) {
+    if (raster == nullptr) continue;
+    double range[2] = {0.0, 0.0};
+    if (GDALComputeRasterMinMax(GDALGetRasterBand(raster->dataset, 1), TRUE, range) != CE_None ||
+        !std::isfinite(range[0]) || !std::isfinite(range[1])) {
+      continue;  // no valid sample: nothing of it stands
+    }
+    range[0] = std::max(range[0], -kMaxHeightAboveEllipsoid_m);
+    range[1] = std::min(range[1], kMaxHeightAboveEllipsoid_m);
+    // A grid of points over the raster at both heights: the curvature's
+    // lowest point is at a corner, its highest inside.
+    constexpr int kSteps = 16;
+    for (int i = 0; i <= kSteps; ++i) {
+      for (int j = 0; j <= kSteps; ++j) {
+        const double col = -0.5 + raster->cols * double(i) / kSteps;
+        const double row = -0.5 + raster->rows * double(j) / kSteps;
+        for (const double height : range) {
+          const Eigen::Vector3d p = SampleToWorldOf(*raster, col, row, height);
+          if (p.allFinite()) box.extend(p);
+        }
+      }
+    }
+  }
+  return box;
+}
+
 double TerrainSource::fine_tile_m() const {
   for (const auto& raster : elevation_) {
     if (raster != nullptr) return raster->metres_per_sample.maxCoeff() * spec_.tile_samples;

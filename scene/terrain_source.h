@@ -46,6 +46,10 @@ class TerrainSource {
   // The rasters' footprint in the world (x, y), without the outermost tile
   // of samples: the ground beyond it is the horizon's (renderer).
   Eigen::AlignedBox2d InnerFootprint_W() const;
+  // The usable rasters' extent in the world: their whole footprint, from
+  // each one's least to greatest height (GDAL's approximate statistics) with
+  // the Earth's curvature; empty when no raster serves. Reads the rasters.
+  Eigen::AlignedBox3d Bounds_W() const;
   // A fine tile's side in metres (about: the raster's sample spacing times tile_samples).
   double fine_tile_m() const;
 

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "tests/app/run_sandbox.h"
+#include "tests/test_rasters.h"
 #include "tests/test_util.h"
 
 namespace {
@@ -81,6 +82,50 @@ TEST(InfoCommandTest, SaysWhetherTheStaticActorsShareOneHierarchy) {
   const CommandRun single = Sandbox("info " + one.string());
   ASSERT_EQ(single.exit_code, 0) << single.out;
   EXPECT_NE(single.out.find("rays  a hierarchy per object"), std::string::npos) << single.out;
+}
+
+// The three numbers after `key` in `text` ("key": [x, y, z]).
+std::array<double, 3> Triple(const std::string& text, const std::string& key) {
+  std::smatch m;
+  const std::regex pattern("\"" + key + "\": \\[([-0-9.e+]+), ([-0-9.e+]+), ([-0-9.e+]+)\\]");
+  if (!std::regex_search(text, m, pattern)) return {0, 0, 0};
+  return {std::stod(m[1]), std::stod(m[2]), std::stod(m[3])};
+}
+
+// A terrain's extent comes from its rasters: a flat raster of 129 x 129
+// samples 0.0003 deg apart at 46 deg north spans 0.0387 deg each way, about
+// 4,301 m north-south (111.14 km a degree of latitude there) and 2,993 m
+// east-west (cos 46 deg of 111.32 km), and a metre of height at most (the
+// curvature within 3 km of the anchor).
+TEST(InfoCommandTest, ATerrainsExtentComesFromItsRasters) {
+  sandbox::testing::TempDir dir;
+  sandbox::testing::WriteRaster(dir.path() / "flat.tif", 129, 129, 8.0, 46.02, 0.0003, 1,
+                                GDT_Float32, [](int, int, int) { return 500.0; });
+  const std::string level = dir.Write("level.toml",
+                                      "[[terrain]]\nname = \"ground\"\nanchor = [46.0, 8.02, 500]\n"
+                                      "elevation = [\"flat.tif\"]\n")
+                                .string();
+  const CommandRun json = Sandbox("info " + level + " --json");
+  ASSERT_EQ(json.exit_code, 0) << json.out;
+  const std::size_t terrain = json.out.find("\"terrain\": {\"name\": \"ground\"");
+  ASSERT_NE(terrain, std::string::npos) << json.out;
+  EXPECT_NE(json.out.find("\"usable_rasters\": 1", terrain), std::string::npos) << json.out;
+  const std::string block = json.out.substr(terrain);
+  const auto lo = Triple(block, "bounds_min"), hi = Triple(block, "bounds_max");
+  EXPECT_NEAR(hi[0] - lo[0], 2993.0, 15.0) << json.out;
+  EXPECT_NEAR(hi[1] - lo[1], 4301.0, 15.0) << json.out;
+  EXPECT_GE(hi[2] - lo[2], 0.0);
+  EXPECT_LE(hi[2] - lo[2], 1.0) << json.out;
+  // The totals and the text's size line include it.
+  const auto total_lo = Triple(json.out.substr(json.out.find("\"totals\"")), "bounds_min");
+  EXPECT_DOUBLE_EQ(total_lo[0], lo[0]);
+  const CommandRun text = Sandbox("info " + level);
+  ASSERT_EQ(text.exit_code, 0) << text.out;
+  std::smatch size;
+  ASSERT_TRUE(std::regex_search(text.out, size, std::regex("size  ([0-9.]+) x ([0-9.]+) x")))
+      << text.out;
+  EXPECT_NEAR(std::stod(size[1]), 2993.0, 15.0) << text.out;
+  EXPECT_NEAR(std::stod(size[2]), 4301.0, 15.0) << text.out;
 }
 
 TEST(InfoCommandTest, BadLevelsExitOneWithOneMessage) {
