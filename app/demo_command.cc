@@ -231,8 +231,8 @@ int RunDemo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     WriteOverview(dir, "overview.jpg");
     out << "\nsandbox demo: done. Everything is in " << dir.string() << ":\n"
         << "  chase.mp4, trailing.mp4, belly.mp4   the cameras as video\n"
-        << "  chase_<tick>.jpg, ...                the frames, indexed by chase.csv, ...\n"
-        << "  belly_<tick>_depth.png               the payload camera's depth (16-bit mm)\n"
+        << "  chase/chase_<tick>.jpg, ...          the frames, indexed by chase.csv, ...\n"
+        << "  belly/belly_<tick>_depth.png         the payload camera's depth (16-bit mm)\n"
         << "  scans/scanner_<tick>.ply, .png       the face scan every second (red occupied) and\n"
         << "                                       its sheet (the six faces as distance images)\n"
         << "  ticks.csv, ticks.png                 every tick's duration, and its plot\n"

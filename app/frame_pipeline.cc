@@ -182,10 +182,21 @@ void FramePipeline::Write(const Encoded& item) {
     return;
   }
   const std::filesystem::path dir = config_.out_dir;
+  // A camera's images in a folder of its own: DIR/chase/chase_000017.jpg.
   std::ostringstream name;
-  name << item.camera << "_" << std::setw(6) << std::setfill('0') << item.tick;
+  name << item.camera << "/" << item.camera << "_" << std::setw(6) << std::setfill('0')
+       << item.tick;
   std::string file;
   try {
+    if (camera_dirs_.insert(item.camera).second) {
+      std::error_code error;
+      std::filesystem::create_directories(dir / item.camera, error);
+      if (error) {
+        camera_dirs_.erase(item.camera);
+        throw std::runtime_error("cannot make the folder " + (dir / item.camera).string() + ": " +
+                                 error.message());
+      }
+    }
     if (!config_.video_format.empty()) {
       std::unique_ptr<Video>& video = videos_[item.camera];
       if (!video) {

@@ -6,12 +6,13 @@
 // is not starved by two 30 Hz ones on a busy machine), and the oldest job is
 // dropped when the queue is full; drops are counted, and the loop never waits.
 //
-// Files: DIR/<camera>_<tick>.jpg (or .png) and/or one DIR/<camera>.mp4 (or
-// .avi) per camera; DIR/<camera>_<tick>_depth.png (16-bit millimetres),
-// _depth.npy or _depth.exr (float32 metres); _seg.png (16-bit segment ids,
-// named in DIR/segmentation.csv); _normals.png (8-bit, camera frame) or
-// _normals.npy with a float depth format; DIR/<camera>.csv indexing every
-// frame: tick, time_s, file (the image, else the video), the robot pose, the
+// Files: DIR/<camera>/<camera>_<tick>.jpg (or .png) and/or one
+// DIR/<camera>.mp4 (or .avi) per camera; DIR/<camera>/<camera>_<tick>_depth.png
+// (16-bit millimetres), _depth.npy or _depth.exr (float32 metres); _seg.png
+// (16-bit segment ids, named in DIR/segmentation.csv); _normals.png (8-bit,
+// camera frame) or _normals.npy with a float depth format; DIR/<camera>.csv
+// indexing every frame: tick, time_s, file (the image, else the video; paths
+// relative to DIR), the robot pose, the
 // camera pose X_WC (x forward, y left, z up), the pinhole intrinsics in
 // pixels (fx = fy, cx, cy; image x to the right, y down, pixel centres at
 // whole coordinates as in OpenCV's camera matrix) and the files of the other
@@ -27,6 +28,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -120,6 +122,7 @@ class FramePipeline {
   std::map<std::string, std::unique_ptr<RowFile>> indexes_;  // write thread only
   std::chrono::steady_clock::time_point retry_after_{};      // write thread only
   bool legend_written_{false};                               // write thread only
+  std::set<std::string> camera_dirs_;                        // made; write thread only
   std::thread render_thread_, write_thread_;
 };
 

@@ -156,7 +156,34 @@ LogReader::LogReader(const std::string& path, std::uint32_t max_event_bytes)
                              "' is not an LCM log (it does not start with the sync word "
                              "0xEDA1DA01)");
   }
+  unsigned char header[28];
+  if (std::fseek(file_, 0, SEEK_SET) == 0 && std::fread(header, 1, 28, file_) == 28) {
+    first_utime_ = utime_ = std::int64_t(BigEndian(header + 12, 8));
+    end_utime_ = LastEventUtime().value_or(first_utime_);
+  }
   std::fseek(file_, 0, SEEK_SET);
+}
+
+std::optional<std::int64_t> LogReader::LastEventUtime() {
+  // The last megabyte, searched from its end for an event header whose event
+  // ends exactly at the end of the file.
+  const std::int64_t tail = std::min<std::int64_t>(size_, 1 << 20);
+  std::vector<unsigned char> bytes(std::size_t(tail), 0);
+  if (std::fseek(file_, long(size_ - tail), SEEK_SET) != 0 ||
+      std::fread(bytes.data(), 1, bytes.size(), file_) != bytes.size()) {
+    return std::nullopt;
+  }
+  for (std::int64_t at = tail - 28; at >= 0; --at) {
+    const unsigned char* header = bytes.data() + at;
+    if (BigEndian(header, 4) != kLogSync) continue;
+    const std::int64_t channel_length = std::int64_t(BigEndian(header + 20, 4)),
+                       data_length = std::int64_t(BigEndian(header + 24, 4));
+    if (channel_length >= 1 && channel_length <= 256 &&
+        size_ - tail + at + 28 + channel_length + data_length == size_) {
+      return std::int64_t(BigEndian(header + 12, 8));
+    }
+  }
+  return std::nullopt;
 }
 
 LogReader::~LogReader() {
@@ -177,6 +204,7 @@ bool LogReader::Next(std::string* channel, std::vector<std::uint8_t>* data, std:
     if (got < sizeof(header)) return stop("truncated inside an event header");
     if (BigEndian(header, 4) != kLogSync) return stop("corrupt (no sync word)");
     const std::int64_t event_utime = std::int64_t(BigEndian(header + 12, 8));
+    utime_ = event_utime;
     const std::uint64_t channel_length = BigEndian(header + 20, 4),
                         data_length = BigEndian(header + 24, 4);
     if (channel_length == 0 || channel_length > 256) return stop("corrupt (channel name length)");
@@ -206,7 +234,12 @@ bool LogReader::Next(std::string* channel, std::vector<std::uint8_t>* data, std:
   }
 }
 
-double LogReader::fraction_read() const { return double(offset_) / double(size_); }
+double LogReader::fraction_read() const {
+  if (end_utime_ > first_utime_) {
+    return std::clamp(double(utime_ - first_utime_) / double(end_utime_ - first_utime_), 0.0, 1.0);
+  }
+  return double(offset_) / double(size_);
+}
 
 namespace {
 

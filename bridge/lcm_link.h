@@ -14,6 +14,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -123,7 +124,10 @@ class LogReader {
 
   // The next event, or false at the end of the file or of its valid part.
   bool Next(std::string* channel, std::vector<std::uint8_t>* data, std::int64_t* utime);
-  double fraction_read() const;                    // 0 .. 1
+  // How far the replay is, 0 .. 1: by the events' times (the time of the
+  // last event read between the first event's and the last's), else, when
+  // the last event cannot be found (a log cut short), by bytes.
+  double fraction_read() const;
   std::int64_t events() const { return events_; }  // read so far
   std::int64_t skipped() const { return skipped_; }
   // Empty after a clean end; otherwise where and why reading stopped, e.g.
@@ -131,10 +135,14 @@ class LogReader {
   const std::string& stopped_early() const { return stopped_early_; }
 
  private:
+  // The time of the event that ends the file, when one does within its last megabyte.
+  std::optional<std::int64_t> LastEventUtime();
+
   std::string path_;
   std::uint32_t max_event_bytes_;
   std::FILE* file_{nullptr};
   std::int64_t size_{1}, offset_{0}, events_{0}, skipped_{0};
+  std::int64_t first_utime_{0}, end_utime_{0}, utime_{0};  // end_utime_ <= first_utime_: unknown
   std::string stopped_early_;
 };
 

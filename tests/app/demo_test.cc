@@ -62,7 +62,7 @@ void CheckDemoOutput(const std::string& out, const fs::path& dir, double seconds
     EXPECT_GE(indexed, 1) << camera << "\n" << out;
     EXPECT_LE(indexed, long(seconds * rate_hz) + 2) << camera;
     long jpegs = 0;
-    for (const auto& entry : fs::directory_iterator(dir)) {
+    for (const auto& entry : fs::directory_iterator(dir / camera)) {  // a folder a camera
       const std::string name = entry.path().filename().string();
       jpegs += name.rfind(std::string(camera) + "_", 0) == 0 && entry.path().extension() == ".jpg";
     }

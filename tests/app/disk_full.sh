@@ -66,6 +66,6 @@ faces=$("$sandbox" topics --log "$record" | awk '$1 == "ELAHA/SCAN_FACE" { print
 awk -F, 'NR > 1 && NF != 24 { bad = 1 } END { exit bad }' "$dir/chase.csv" ||
   { echo "chase.csv has a cut row"; status=1; }
 for png in $(find "$dir" -name 'chase_*.png'); do
-  grep -q ",$(basename "$png")," "$dir/chase.csv" || { echo "$png is not indexed"; status=1; }
+  grep -q ",chase/$(basename "$png")," "$dir/chase.csv" || { echo "$png is not indexed"; status=1; }
 done
 exit "$status"

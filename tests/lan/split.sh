@@ -45,9 +45,9 @@ for camera in chase trailing belly; do
   fi
 done
 differ=0 frames=0
-for image in "$out/both"/chase_*.jpg; do
+for image in "$out/both"/chase/chase_*.jpg; do
   frames=$((frames + 1))
-  cmp -s "$image" "$out/frames/$(basename "$image")" || differ=$((differ + 1))
+  cmp -s "$image" "$out/frames/chase/$(basename "$image")" || differ=$((differ + 1))
 done
 echo "split: chase: $frames images, $differ differ"
 [ "$frames" -gt 0 ] && [ "$differ" = 0 ] || fail=1
