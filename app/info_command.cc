@@ -243,7 +243,7 @@ const char* kUsage =
     "                (default: the bundled sample level); a scene file is first read in a\n"
     "                separate process, so that a file that crashes assimp is an error\n"
     "  --isolate     read a manifest's assets that way too\n"
-    "  --json        machine-readable output (docs/info-json.md)\n"
+    "  --json        machine-readable output (docs/reference/info-json.md)\n"
     "  --up AXIS     up axis of a scene file that does not say: x, -x, y, -y, z, -z\n"
     "  --unit-scale  metres per unit of a scene file that does not say\n";
 

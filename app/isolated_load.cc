@@ -151,7 +151,7 @@ void CheckLoadsInIsolation(const std::string& file, const scene::AssetConversion
     throw scene::LevelError(where + ": " + reader + " crashed reading it (" +
                             SignalName(WTERMSIG(status)) + "); the file is corrupt or shows a bug of " +
                             reader +
-                            " (docs/reliability.md), or reading it needed more than its [level] "
+                            " (docs/explanation/reliability.md), or reading it needed more than its [level] "
                             "max_import_mb = " +
                             std::to_string(limits.max_import_mb));
   }

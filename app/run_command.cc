@@ -43,9 +43,9 @@ const char* kUsage =
     "                 the user may (root, CAP_SYS_NICE or ulimit -r); off: normal priority\n"
     "  --no-sensors   run no sensor (robots' STATE and STATUS are still published)\n"
     "  --frames-only  run no sensor and publish nothing: only render the cameras, beside a\n"
-    "                 sandbox that scans the same pose stream (docs/distributed.md)\n"
+    "                 sandbox that scans the same pose stream (docs/how-to/distributed.md)\n"
     "Inputs per robot: <ROBOT>/POSE, /BONES, /ACTORS, /CAMERA (trailing pan, tilt, zoom).\n"
-    "Outputs: <ROBOT>/SCAN_FACE, /GROUND, /LIDAR, /RANGE, /STATE, /STATUS (docs/bridge.md).\n";
+    "Outputs: <ROBOT>/SCAN_FACE, /GROUND, /LIDAR, /RANGE, /STATE, /STATUS (docs/reference/bridge.md).\n";
 
 }  // namespace
 

@@ -95,7 +95,7 @@ RunOptions ParseRunOptions(const ParsedArgs& args) {
     options.ticks = std::int64_t(ticks);
   }
   // Splitting the work over two sandboxes on one pose stream: one scans and
-  // publishes, the other only renders (docs/distributed.md).
+  // publishes, the other only renders (docs/how-to/distributed.md).
   options.publish = args.flags.count("--frames-only") == 0;
   options.sensors = options.publish && args.flags.count("--no-sensors") == 0;
   if (!options.publish) {

@@ -1,7 +1,7 @@
 #pragma once
 // The loop of `sandbox run`: a conductor that calls each part once per tick,
 // in the order of ../shared/DESIGN.md, "One tick of the loop"
-// (docs/architecture.md shows where each step lives):
+// (docs/explanation/architecture.md shows where each step lives):
 //   1-2. the inputs drained and applied (bridge::RobotFeed, one per robot);
 //   3.   the sensors that are due run (sensors::Sensor; several at once over
 //        the caster's threads, each on a one-thread caster);

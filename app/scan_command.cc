@@ -40,7 +40,7 @@ const char* kUsage =
     "                 ground: row,col,valid,x,y,z; ray: hit,x,y,z,range) or PLY when it ends\n"
     "                 in .ply (occupied points red, free points green); face scans also as a\n"
     "                 sheet when it ends in .png (the six faces as distance images, unfolded\n"
-    "                 cube, colour bar); see docs/sensors.md\n";
+    "                 cube, colour bar); see docs/reference/sensors.md\n";
 
 // One sample for the writers.
 struct Sample {

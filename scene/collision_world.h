@@ -6,7 +6,7 @@
 // Precision: Bullet is the float build. Positions cross this interface in
 // double and are taken relative to a floating origin (SetOrigin) before they
 // reach Bullet, so queries near the origin keep sub-millimetre precision
-// however far the world extends (see docs/levels.md).
+// however far the world extends (see docs/reference/levels.md).
 //
 // Threads: one thread (the loop thread) owns the world; CastRay uses
 // btCollisionWorld::rayTest, which is not safe to call from several threads.

@@ -1,7 +1,7 @@
 #pragma once
 // What loading one level may take. A level over a limit fails to load with an
 // error naming the file, what it would take and the limit's key; a manifest's
-// [level] table may set each (docs/levels.md). They guard against files that
+// [level] table may set each (docs/reference/levels.md). They guard against files that
 // claim sizes they do not have (a 389 KB PNG of 20000 x 20000 pixels, a GLB
 // whose header lies) as much as against files too big for the machine.
 

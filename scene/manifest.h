@@ -1,5 +1,5 @@
 #pragma once
-// The TOML level manifest (docs/levels.md is the reference). Parsing only:
+// The TOML level manifest (docs/reference/levels.md is the reference). Parsing only:
 // values are checked here, files are read by the level loader.
 
 #include <Eigen/Geometry>

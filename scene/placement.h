@@ -19,7 +19,7 @@ class LevelError : public std::runtime_error {
 
 // How to read a plain scene file given as a level (a manifest says it per actor).
 // Unset fields take the file's own statement or the format's convention
-// (docs/levels.md lists them).
+// (docs/reference/levels.md lists them).
 struct AssetConversion {
   std::optional<UpAxis> up;
   std::optional<double> unit_scale_m;  // metres per file unit

@@ -113,7 +113,7 @@ struct CrsLink {
 // Why `crs` claims an EPSG code that PROJ's database gives to another kind of
 // coordinate system (a GeoTIFF's geographic key holding a geocentric code), or
 // "". PROJ 9.1 dereferences null making a transformation from some of them
-// (docs/reliability.md): such a raster is refused before one is made.
+// (docs/explanation/reliability.md): such a raster is refused before one is made.
 std::string IdentityProblem(OGRSpatialReferenceH crs) {
   const auto kind = [](OGRSpatialReferenceH s) {
     return OSRIsCompound(s)     ? "compound"

@@ -1,5 +1,5 @@
 #pragma once
-// Terrain tiles streamed by position (docs/large-worlds.md). A worker thread
+// Terrain tiles streamed by position (docs/how-to/large-worlds.md). A worker thread
 // keeps the tiles near the robots built: fine tiles (collision and cameras)
 // within TerrainSpec::collision_radius_m of each robot and of where it will
 // be prefetch_s from now, coarse tiles (cameras only) within view_radius_m,

@@ -26,7 +26,7 @@ inline constexpr double kMaxHeightAboveEllipsoid_m = 12000.0;
 inline constexpr double kMaxTerrainRadius_m = 2.0e7;
 inline constexpr double kMaxAnchorHeight_m = 100000.0;
 
-// One [[terrain]] table (docs/large-worlds.md).
+// One [[terrain]] table (docs/how-to/large-worlds.md).
 struct TerrainSpec {
   std::string name{"terrain"};                   // the actor rays report as hit
   std::vector<std::filesystem::path> elevation;  // rasters GDAL reads: heights in metres

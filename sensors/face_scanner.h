@@ -34,7 +34,7 @@ enum class Alignment {
   kWorld,  // the box keeps the world axes (only the sensor position counts)
 };
 
-// How a face scanner's faces are published (docs/bridge.md): as points
+// How a face scanner's faces are published (docs/reference/bridge.md): as points
 // (scan_face_t, three floats a sample) or compact (scan_face_compact_t, a
 // distance a grid cell, in 16-bit millimetres or float metres).
 enum class FaceEncoding { kPoints, kMillimetres, kFloat };
@@ -48,7 +48,7 @@ struct FaceScannerConfig {
   // refused at load. The default admits 6 x 501 x 501 (25 m at 0.1 m).
   double sample_budget{2e6};
   // The most any scanner may be given: a run with one such scanner peaks at
-  // about 0.9 GB (docs/sensors.md).
+  // about 0.9 GB (docs/reference/sensors.md).
   static constexpr double kMaxSampleBudget = 2e7;
   FaceEncoding encoding{FaceEncoding::kPoints};
 
@@ -58,7 +58,7 @@ struct FaceScannerConfig {
   void ValidateOrThrow() const;
   int points_per_side() const;  // n
 
-  // The [[robot.sensor]] table's own keys (docs/levels.md); throws scene::LevelError
+  // The [[robot.sensor]] table's own keys (docs/reference/levels.md); throws scene::LevelError
   // naming the key.
   static FaceScannerConfig Read(scene::SettingsReader& read);
   std::string Summary() const;  // "51x51x6 at 1 m"

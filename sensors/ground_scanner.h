@@ -22,7 +22,7 @@ struct GroundScannerConfig {
   double depth_m{100.0};         // how far below the sensor to look
   void ValidateOrThrow() const;  // throws std::invalid_argument naming the field
 
-  // The [[robot.sensor]] table's own keys (docs/levels.md); throws scene::LevelError
+  // The [[robot.sensor]] table's own keys (docs/reference/levels.md); throws scene::LevelError
   // naming the key.
   static GroundScannerConfig Read(scene::SettingsReader& read);
   std::string Summary() const;  // "+-25 m at 1 m"

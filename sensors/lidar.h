@@ -34,7 +34,7 @@ struct LidarConfig {
   void ValidateOrThrow() const;
   int channels() const { return static_cast<int>(elevations_rad.size()); }
 
-  // The [[robot.sensor]] table's own keys (docs/levels.md); throws scene::LevelError
+  // The [[robot.sensor]] table's own keys (docs/reference/levels.md); throws scene::LevelError
   // naming the key.
   static LidarConfig Read(scene::SettingsReader& read);
   std::string Summary() const;  // "16x1024, 100 m"

@@ -16,7 +16,7 @@ struct RangeSensorConfig {
   double range_m{100.0};
   void ValidateOrThrow() const;  // throws std::invalid_argument naming the field
 
-  // The [[robot.sensor]] table's own keys (docs/levels.md); throws scene::LevelError
+  // The [[robot.sensor]] table's own keys (docs/reference/levels.md); throws scene::LevelError
   // naming the key.
   static RangeSensorConfig Read(scene::SettingsReader& read);
   std::string Summary() const;  // "100 m"

@@ -204,7 +204,7 @@ inline bool MeetsCornerBox(const Eigen::Vector3f corner[3], const Eigen::Vector3
   return t_enter * (1.0f - kSlack) <= t_exit * (1.0f + kSlack);
 }
 
-// The watertight ray-triangle test (docs/sensors.md, "Grazing and origin
+// The watertight ray-triangle test (docs/reference/sensors.md, "Grazing and origin
 // rules"): corners relative to the ray origin, a signed edge function per edge
 // (the same value, negated, for the neighbour sharing the edge), both faces.
 // A ray parallel to the plane (in it or not) misses; one whose origin lies on

@@ -6,7 +6,7 @@
 // level's triangle arrays read-only, with its own stack; nothing of Bullet's
 // mutable query state (btCollisionWorld::rayTest) is used.
 //
-// Hits are watertight (docs/sensors.md, "Grazing and origin rules"): each
+// Hits are watertight (docs/reference/sensors.md, "Grazing and origin rules"): each
 // triangle is tested in the Bullet frame with its corners placed as Bullet
 // places them; a ray through a shared edge hits one of the two triangles, a
 // ray lying in a triangle's plane does not hit it, and a ray whose origin lies
@@ -98,7 +98,7 @@ class RayCaster {
   // are found once and each is tested against exactly the rays its shadow on
   // the grid covers, with Cast()'s own per-ray test. Same hits as Cast():
   // the same rays hit, at the same distances (Cast()'s arithmetic; see
-  // docs/sensors.md for the one difference a tie can make) when the batch's
+  // docs/reference/sensors.md for the one difference a tie can make) when the batch's
   // rays run along their block's direction for its length. Throws
   // std::invalid_argument when the blocks do not cover the batch in order or
   // a block's direction is not unit or its length not positive.

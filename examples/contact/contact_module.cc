@@ -4,7 +4,7 @@
 // (<ROBOT>/STATE) it takes that pose's scan faces (<ROBOT>/SCAN_FACE), finds
 // the scan points inside the robot's shape, and publishes the penalty
 // contact's force and torque about the centre of mass (<ROBOT>/WRENCH).
-// docs/contact.md explains the chain and the law.
+// docs/how-to/contact.md explains the chain and the law.
 //
 //   contact_module --mesh FILE --resolution M [options]   (--help lists them)
 

@@ -5,7 +5,7 @@
 // Forces and torques about the centre of mass are summed in a fixed order
 // with compensated sums, so symmetric contact gives zero torque to rounding.
 //
-// The law, per point (docs/contact.md): with s the signed distance of the
+// The law, per point (docs/how-to/contact.md): with s the signed distance of the
 // point from the robot's surface (negative inside), n the surface's outward
 // normal there, v the robot's velocity at the point and A the area a scan
 // point stands for (the scanner's resolution squared):

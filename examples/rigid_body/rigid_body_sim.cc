@@ -1,7 +1,7 @@
 // An external physics model in miniature: one rigid body under gravity and
 // the contact wrench an external module computes (<ROBOT>/WRENCH), integrated
 // with a fixed step and published as the robot's pose (<ROBOT>/POSE) for the
-// sandbox to show and scan. docs/contact.md explains the chain.
+// sandbox to show and scan. docs/how-to/contact.md explains the chain.
 //
 //   rigid_body --mass KG (--box-size X,Y,Z | --inertia IXX,IYY,IZZ) [options]
 //

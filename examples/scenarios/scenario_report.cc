@@ -1,4 +1,4 @@
-// The closed-loop scenarios' settings and figures (docs/contact.md):
+// The closed-loop scenarios' settings and figures (docs/how-to/contact.md):
 //
 //   scenario_report SCENARIO --args model|contact    the rigid body's or contact module's options
 //   scenario_report SCENARIO --poses CSV --contacts CSV [--plot PNG] [--check]

@@ -245,7 +245,7 @@ TEST(ManyRobotsTest, EachRobotsScannerSeesTheOtherBentAndNeverItself) {
     // The other robot is seen, at hundreds of points.
     EXPECT_GT(against_bent[r].occupied, 300);
     // Where it is bent: the loop's rigid collision pieces are off the skin
-    // only in the joints' blend zones (docs/robots.md), so a few grazing
+    // only in the joints' blend zones (docs/reference/robots.md), so a few grazing
     // rays may differ.
     EXPECT_LT(against_bent[r].occupancy_differs, against_bent[r].occupied / 50)
         << against_bent[r].occupied << " occupied";

@@ -177,7 +177,7 @@ TEST(OutputContractTest, LidarStepsAreCastFromThePoseAtTheirTime) {
   EXPECT_GT(worst_uncompensated_m, 0.5);   // cast from the end pose, they are metres off
 }
 
-// Face f's in-plane axes (u, v) in the box frame (docs/sensors.md).
+// Face f's in-plane axes (u, v) in the box frame (docs/reference/sensors.md).
 void FaceAxes(int f, Eigen::Vector3d* u, Eigen::Vector3d* v, Eigen::Vector3d* axis) {
   *u = f < 2 ? Eigen::Vector3d::UnitY() : Eigen::Vector3d::UnitX();
   *v = f < 4 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitY();

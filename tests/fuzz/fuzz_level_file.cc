@@ -4,7 +4,7 @@
 // with the extension of one format, chosen by the first byte among
 // SANDBOX_FUZZ_FORMATS (a comma list, e.g. "obj,ply"; default: all of kFormats). Every input loads
 // or gives one LevelError. A crash inside assimp stops this process: such formats are listed in
-// docs/reliability.md, and `sandbox --isolate` contains them.
+// docs/explanation/reliability.md, and `sandbox --isolate` contains them.
 
 #include <unistd.h>
 

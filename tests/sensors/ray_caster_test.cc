@@ -271,7 +271,7 @@ scene::Level Room(const testing::TempDir& dir) {
 }
 
 // The first hit of a ray on the room's box faces, computed here in double
-// from the rules (docs/sensors.md): faces are closed rectangles; a ray lying
+// from the rules (docs/reference/sensors.md): faces are closed rectangles; a ray lying
 // in a face's plane does not hit it; one whose origin lies on a face hits it
 // at 0; a ray running along a face's upper bound on an axis it does not move
 // along misses it (past its origin); nothing at or beyond the ray's length.

@@ -152,7 +152,7 @@ TEST(StructuredScanTest, SameHitsOnABentRobotSeenFromBesideIt) {
 
 // A terrain of 1 m squares with integer corners, scanned at whole metres: the
 // rays run exactly through its vertices and along its edges, where the
-// watertight rules decide (docs/sensors.md).
+// watertight rules decide (docs/reference/sensors.md).
 TEST(StructuredScanTest, SameHitsWhereRaysRunThroughVerticesAndAlongEdges) {
   testing::TempDir dir;
   {
