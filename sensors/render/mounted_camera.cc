@@ -40,17 +40,9 @@ void ReadLook(const scene::SensorSpec& spec, scene::SettingsReader* read, Render
   look->haze = read->Flag("haze", look->haze);
   look->fxaa = read->Flag("fxaa", look->fxaa);
   look->msaa_samples = read->Whole("msaa", look->msaa_samples);
-  if (look->msaa_samples != 0 && look->msaa_samples != 1 && look->msaa_samples != 4) {
-    read->Fail("msaa", "'msaa' must be 0 (off) or 4 samples");
-  }
   look->anisotropy = read->Whole("anisotropy", look->anisotropy);
-  if (look->anisotropy < 1 || look->anisotropy > 16) {
-    read->Fail("anisotropy", "'anisotropy' must be 1 (off) to 16");
-  }
   const double lod_px = read->Number("lod_px", look->lod_px);
-  if (!(lod_px >= 0.0 && lod_px <= 8.0)) {
-    read->Fail("lod_px", "'lod_px' must be 0 (meshes as given) to 8 pixels");
-  }
+  if (!(std::abs(lod_px) <= 1e6)) read->Fail("lod_px", "'lod_px' must be 0 to 8 pixels");
   look->lod_px = float(lod_px);
   look->cull_hidden_back_faces = read->Flag("cull_hidden_back_faces", look->cull_hidden_back_faces);
   look->images = kColorImage;
@@ -64,6 +56,11 @@ void ReadLook(const scene::SensorSpec& spec, scene::SettingsReader* read, Render
       }
     }
     if (look->images == 0) read->Fail("images", "'images' must name at least one image kind");
+  }
+  // RenderSettings' own rules, named by the manifest's keys.
+  if (const auto problem = look->FindProblem()) {
+    const std::string key = problem->field == "msaa_samples" ? "msaa" : problem->field;
+    read->Fail(key, "'" + key + "' " + problem->why);
   }
 }
 

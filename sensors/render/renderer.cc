@@ -402,8 +402,9 @@ class OsMesaRenderer : public Renderer {
                                overlay->line_rgb.size() * 2 != overlay->lines_W.size())) {
       throw std::invalid_argument("Renderer: an overlay needs one colour per point and per line");
     }
+    settings.ValidateOrThrow();
     const ImageKinds kinds = settings.images;
-    const int samples = settings.msaa_samples > 1 ? std::min(settings.msaa_samples, 8) : 0;
+    const int samples = settings.msaa_samples > 1 ? settings.msaa_samples : 0;
     Resize(view.width, view.height, samples);
     clip_control_(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
     actor_poses_ = &actor_poses;
@@ -433,7 +434,7 @@ class OsMesaRenderer : public Renderer {
     const Eigen::Vector3f sun = settings.sun_direction_W.normalized();
 
     // Levels of detail in colour-only frames; depth, segmentation and normals are measurements.
-    lod_px_ = kinds == kColorImage ? std::max(settings.lod_px, 0.f) : 0.f;
+    lod_px_ = kinds == kColorImage ? settings.lod_px : 0.f;
     pixel_angle_ = float(2.0 * std::tan(0.5 * view.fov_y_rad) / view.height);
     ChooseMovingLevels();
 
@@ -445,9 +446,8 @@ class OsMesaRenderer : public Renderer {
     std::vector<ShadowCascade> cascades;
     if (shadows) {
       cascades = FitShadowCascades(view, sun.cast<double>(), settings.shadow_distance_m,
-                                   std::clamp(settings.shadow_cascades, 1, 4),
-                                   std::clamp(settings.shadow_map_px, 256, 8192), 1500.0);
-      DrawShadowMaps(cascades, sun, std::clamp(settings.shadow_map_px, 256, 8192), deferred);
+                                   settings.shadow_cascades, settings.shadow_map_px, 1500.0);
+      DrawShadowMaps(cascades, sun, settings.shadow_map_px, deferred);
     }
 
     // The look; each program gets this frame's uniforms at its first use in it.
@@ -766,7 +766,11 @@ class OsMesaRenderer : public Renderer {
     u.R_CW = view.X_WC.linear().transpose().cast<float>();
     u.cascades = cascades;
     // Anisotropic filtering of material textures (the sampler repeats at the edges).
-    const float anisotropy = std::clamp(float(settings.anisotropy), 1.f, max_anisotropy_);
+    const float anisotropy = float(settings.anisotropy);
+    if (anisotropy > max_anisotropy_) {
+      throw std::invalid_argument("Renderer: anisotropy " + std::to_string(settings.anisotropy) +
+                                  " is beyond this GL's " + std::to_string(int(max_anisotropy_)));
+    }
     if (anisotropy > 1.f) {
       glSamplerParameterf(anisotropic_, GL_TEXTURE_MAX_ANISOTROPY, anisotropy);
       glBindSampler(0, anisotropic_);

@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -91,6 +92,15 @@ struct RenderSettings {
   ImageKinds images{kColorImage | kDepthImage};
 
   static RenderSettings Preset(Quality quality);
+
+  // A field outside its range (render_settings.cc): the field's name and why.
+  struct Problem {
+    std::string field, why;
+  };
+  std::optional<Problem> FindProblem() const;
+  // Throws std::invalid_argument "RenderSettings: 'field' why". The renderer
+  // calls it for every frame: it fixes no setting itself.
+  void ValidateOrThrow() const;
 };
 
 class Renderer {

@@ -265,7 +265,14 @@ TEST(SensorTest, CameraMistakesNameTheCameraAndField) {
       CameraError("type = \"drone\"\n"),
       "level.toml:8: camera 'c': 'type' must be chase, trailing, payload or fixed, got 'drone'");
   EXPECT_EQ(CameraError("type = \"chase\"\nlod_px = -1\n"),
-            "level.toml:9: camera 'c': 'lod_px' must be 0 (meshes as given) to 8 pixels");
+            "level.toml:9: camera 'c': 'lod_px' must be 0 (meshes as given) to 8 pixels, got -1");
+  // The look's settings the renderer once clamped, refused with the camera and key named.
+  EXPECT_EQ(CameraError("type = \"chase\"\nmsaa = 8\n"),
+            "level.toml:9: camera 'c': 'msaa' must be 0 (off), 1 (off) or 4 samples, got 8");
+  EXPECT_EQ(CameraError("type = \"chase\"\nanisotropy = 32\n"),
+            "level.toml:9: camera 'c': 'anisotropy' must be 1 (off) to 16, got 32");
+  EXPECT_EQ(CameraError("type = \"chase\"\nanisotropy = 0\n"),
+            "level.toml:9: camera 'c': 'anisotropy' must be 1 (off) to 16, got 0");
   EXPECT_EQ(CameraError("type = \"chase\"\nlod_px = 0.5\n"), "no error");
   EXPECT_EQ(CameraError("type = \"chase\"\ncull_hidden_back_faces = false\n"), "no error");
   EXPECT_EQ(CameraError("type = \"chase\"\ncull_hidden_back_faces = 1\n"),
