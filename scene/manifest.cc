@@ -17,7 +17,8 @@ namespace {
 namespace fs = std::filesystem;
 
 // Reads typed values out of one TOML table, naming file, line and context in
-// every error, and rejects keys it was never asked about.
+// every error, and rejects keys it was never asked about. Its verbs are
+// SettingsReader's (settings.h): Text, Flag, Number, Whole, Numbers.
 class TableReader {
  public:
   TableReader(const fs::path& file, const toml::table& table, std::string context)
@@ -36,14 +37,14 @@ class TableReader {
     return table_.get(key);
   }
 
-  std::optional<std::string> String(const std::string& key) {
+  std::optional<std::string> Text(const std::string& key) {
     const toml::node* node = Find(key);
     if (node == nullptr) return std::nullopt;
     if (!node->is_string()) Fail(node, "'" + key + "' must be a string");
     return node->value<std::string>();
   }
 
-  std::optional<bool> Bool(const std::string& key) {
+  std::optional<bool> Flag(const std::string& key) {
     const toml::node* node = Find(key);
     if (node == nullptr) return std::nullopt;
     if (!node->is_boolean()) Fail(node, "'" + key + "' must be true or false");
@@ -66,14 +67,15 @@ class TableReader {
     return value;
   }
 
-  // A whole number from 0 to `max`.
-  std::optional<std::uint64_t> Count(const std::string& key, std::uint64_t max) {
+  // A whole number from `low` to `high`.
+  std::optional<std::int64_t> Whole(const std::string& key, std::int64_t low, std::int64_t high) {
     const std::optional<double> value = Number(key);
     if (!value) return std::nullopt;
-    if (!(*value >= 0.0 && *value <= double(max)) || *value != std::floor(*value)) {
-      Fail(Find(key), "'" + key + "' must be a whole number from 0 to " + std::to_string(max));
+    if (!(*value >= double(low) && *value <= double(high)) || *value != std::floor(*value)) {
+      Fail(Find(key), "'" + key + "' must be a whole number from " + std::to_string(low) +
+                          " to " + std::to_string(high));
     }
-    return std::uint64_t(*value);
+    return std::int64_t(*value);
   }
 
   std::optional<double> Number(const std::string& key) {
@@ -121,7 +123,7 @@ class TableReader {
 std::string ParseName(const fs::path& file, const toml::table& table, const std::string& kind,
                       int index) {
   TableReader named(file, table, kind + " " + std::to_string(index) + ": ");
-  const std::optional<std::string> name = named.String("name");
+  const std::optional<std::string> name = named.Text("name");
   if (!name || name->empty()) named.Fail(nullptr, "'name' is required");
   return *name;
 }
@@ -164,7 +166,7 @@ Placement ParsePlacement(TableReader& read) {
     }
   }
   // How to read the asset when its file does not say.
-  if (const auto up = read.String("up")) {
+  if (const auto up = read.Text("up")) {
     placement.conversion.up = ParseUpAxis(*up);
     if (!placement.conversion.up) {
       read.Fail(read.Find("up"), "'up' must be one of x, -x, y, -y, z, -z, got '" + *up + "'");
@@ -185,8 +187,8 @@ ActorSpec ParseActor(const fs::path& file, const toml::table& table, int index) 
   read.Find("name");
 
   // What to place: an asset file or a heightmap image.
-  const std::optional<std::string> asset = read.String("file");
-  const std::optional<std::string> heightmap = read.String("heightmap");
+  const std::optional<std::string> asset = read.Text("file");
+  const std::optional<std::string> heightmap = read.Text("heightmap");
   if (asset.has_value() == heightmap.has_value()) {
     read.Fail(nullptr, "give exactly one of 'file' and 'heightmap'");
   }
@@ -200,9 +202,9 @@ ActorSpec ParseActor(const fs::path& file, const toml::table& table, int index) 
     read.Fail(nullptr, "a heightmap needs 'size' = [x, y, height] in metres");
   }
   actor.placement = ParsePlacement(read);
-  actor.collision = read.Bool("collision").value_or(true);
-  actor.movable = read.Bool("movable").value_or(false);
-  if (const auto surface = read.String("surface")) {
+  actor.collision = read.Flag("collision").value_or(true);
+  actor.movable = read.Flag("movable").value_or(false);
+  if (const auto surface = read.Text("surface")) {
     const std::pair<const char*, Surface> kSurfaces[] = {
         {"plain", Surface::kPlain}, {"terrain", Surface::kTerrain}, {"water", Surface::kWater}};
     for (const auto& [name, value] : kSurfaces) {
@@ -279,17 +281,17 @@ SensorSpec ParseSensor(const fs::path& file, const toml::table& table, int index
   sensor.name = ParseName(file, table, kind, index);
   TableReader read(file, table, kind + " '" + sensor.name + "': ");
   read.Find("name");
-  const std::optional<std::string> type = read.String("type");
+  const std::optional<std::string> type = read.Text("type");
   if (!type) read.Fail(nullptr, "'type' is required");
   sensor.type = *type;
   const int type_line = static_cast<int>(read.Find("type")->source().begin.line);
-  sensor.mount = read.String("mount").value_or("");
+  sensor.mount = read.Text("mount").value_or("");
   const Placement placement = ParsePlacement(read);
   if (!placement.scale.isOnes() || placement.conversion.up || placement.conversion.unit_scale_m) {
     read.Fail(nullptr, "a sensor takes position and rpy_deg or quaternion_wxyz only");
   }
   sensor.X_MS = placement.pose();
-  if (const auto channel = read.String("channel")) {
+  if (const auto channel = read.Text("channel")) {
     if (kind == "camera") read.Fail(read.Find("channel"), "a camera publishes no channel");
     if (channel->empty() || channel->find_first_of(" \t\n") != std::string::npos) {
       read.Fail(read.Find("channel"),
@@ -316,11 +318,11 @@ RobotSpec ParseRobot(const fs::path& file, const toml::table& table, int index) 
   robot.name = ParseName(file, table, "robot", index);
   TableReader read(file, table, "robot '" + robot.name + "': ");
   read.Find("name");
-  const std::optional<std::string> model = read.String("file");
+  const std::optional<std::string> model = read.Text("file");
   if (!model) read.Fail(nullptr, "'file' is required");
   robot.file = AssetPath(file, *model);
   robot.placement = ParsePlacement(read);
-  robot.collision = read.Bool("collision").value_or(true);
+  robot.collision = read.Flag("collision").value_or(true);
 
   // The bone map and how each bone's rotation is given.
   if (const toml::node* bones = read.Find("bones")) {
@@ -334,7 +336,7 @@ RobotSpec ParseRobot(const fs::path& file, const toml::table& table, int index) 
       robot.bones.push_back(*name);
     }
   }
-  const std::string rotation = read.String("rotation").value_or("quaternion");
+  const std::string rotation = read.Text("rotation").value_or("quaternion");
   if (rotation == "angles") {
     robot.rotation = BoneRotation::kAngles;
   } else if (rotation != "quaternion") {
@@ -434,13 +436,7 @@ TerrainSpec ParseTerrain(const fs::path& file, const toml::table& table, int ind
   }
   terrain.anchor = {(*anchor)[0], (*anchor)[1], (*anchor)[2]};
   auto whole = [&](const char* key, int low, int high, int* value) {
-    if (const auto set = read.Number(key)) {
-      if (*set < low || *set > high || *set != std::floor(*set)) {
-        read.Fail(read.Find(key), std::string("'") + key + "' must be a whole number from " +
-                                      std::to_string(low) + " to " + std::to_string(high));
-      }
-      *value = int(*set);
-    }
+    if (const auto set = read.Whole(key, low, high)) *value = int(*set);
   };
   whole("tile_samples", 2, 4096, &terrain.tile_samples);
   whole("coarse_factor", 1, 64, &terrain.coarse_factor);
@@ -466,7 +462,7 @@ TerrainSpec ParseTerrain(const fs::path& file, const toml::table& table, int ind
   if (terrain.view_radius_m < terrain.collision_radius_m) {
     read.Fail(read.Find("view_radius_m"), "'view_radius_m' must not be below 'collision_radius_m'");
   }
-  if (const auto cache = read.String("cache")) terrain.cache = AssetPath(file, *cache);
+  if (const auto cache = read.Text("cache")) terrain.cache = AssetPath(file, *cache);
   read.RejectUnknownKeys();
   return terrain;
 }
@@ -534,10 +530,10 @@ LevelManifest ParseManifestText(std::string_view text, const fs::path& file) {
   if (const toml::node* level = top.Find("level")) {
     if (!level->is_table()) top.Fail(level, "'level' must be a table: [level]");
     TableReader read(file, *level->as_table(), "[level]: ");
-    if (const auto name = read.String("name")) manifest.name = *name;
+    if (const auto name = read.Text("name")) manifest.name = *name;
     // What loading the level may take (scene/load_limits.h).
     LoadLimits& limits = manifest.limits;
-    const std::uint64_t kHuge = std::uint64_t(1) << 50;
+    constexpr std::int64_t kHuge = std::int64_t(1) << 50;
     for (const auto& [key, value] :
          {std::pair<const char*, std::uint64_t*>{"max_file_mb", &limits.max_file_mb},
           {"max_heightmap_samples", &limits.max_heightmap_samples},
@@ -549,7 +545,7 @@ LevelManifest ParseManifestText(std::string_view text, const fs::path& file) {
           {"max_terrain_mb", &limits.max_terrain_mb},
           {"max_tile_samples", &limits.max_tile_samples},
           {"max_imagery_window_px", &limits.max_imagery_window_px}}) {
-      if (const auto set = read.Count(key, kHuge)) *value = *set;
+      if (const auto set = read.Whole(key, 0, kHuge)) *value = std::uint64_t(*set);
     }
     read.RejectUnknownKeys();
   }

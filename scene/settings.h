@@ -33,7 +33,8 @@ struct SettingsTable {
 std::string ChoiceList(const std::vector<std::string_view>& choices);
 
 // Typed access; remembers which keys were read so that the rest can be
-// rejected as unknown.
+// rejected as unknown. The manifest's own TableReader (manifest.cc) uses the
+// same verbs: Text, Flag, Number, Whole, Numbers.
 class SettingsReader {
  public:
   explicit SettingsReader(const SettingsTable& table) : table_(table) {}
