@@ -37,10 +37,10 @@ struct LoadFigures {
 // A level's [[terrain]] as its rasters give it (the terrain actor has no
 // meshes: its tiles are built while running).
 struct TerrainFigures {
-  int usable{0};                    // elevation rasters that serve
-  double fine_tile_m{0.0};          // a fine tile's side
-  Eigen::AlignedBox3d bounds_W;     // TerrainSource::Bounds_W
-  Eigen::AlignedBox2d ground_W;     // TerrainSource::InnerFootprint_W
+  int usable{0};                 // elevation rasters that serve
+  double fine_tile_m{0.0};       // a fine tile's side
+  Eigen::AlignedBox3d bounds_W;  // TerrainSource::Bounds_W
+  Eigen::AlignedBox2d ground_W;  // TerrainSource::InnerFootprint_W
 };
 
 std::optional<TerrainFigures> TerrainOf(const Level& level) {
@@ -146,9 +146,9 @@ void PrintJson(const Level& level, const std::vector<sensors::MountedSensor>& se
         << ", \"collision_radius_m\": " << t.collision_radius_m
         << ", \"view_radius_m\": " << t.view_radius_m
         << ", \"bounds_min\": " << JsonVector(Lo(terrain->bounds_W))
-        << ", \"bounds_max\": " << JsonVector(Hi(terrain->bounds_W)) << ", \"ground_min\": "
-        << xy(g.isEmpty() ? Eigen::Vector2d::Zero() : g.min()) << ", \"ground_max\": "
-        << xy(g.isEmpty() ? Eigen::Vector2d::Zero() : g.max()) << "},\n";
+        << ", \"bounds_max\": " << JsonVector(Hi(terrain->bounds_W))
+        << ", \"ground_min\": " << xy(g.isEmpty() ? Eigen::Vector2d::Zero() : g.min())
+        << ", \"ground_max\": " << xy(g.isEmpty() ? Eigen::Vector2d::Zero() : g.max()) << "},\n";
   }
   const Eigen::AlignedBox3d bounds = BoundsOf(level, terrain);
   out << "  \"totals\": {\"actors\": " << level.actors.size()
@@ -222,11 +222,12 @@ void PrintText(const Level& level, const std::vector<sensors::MountedSensor>& se
   out << "\ntotal " << level.actors.size() << " actors, " << level.num_triangles() << " triangles, "
       << level.materials.size() << " materials, " << level.textures.size() << " embedded textures, "
       << figures.collision_objects << " collision objects\n";
-  out << "rays  " << (figures.merged_static_triangles > 0
-                          ? "the static actors' " + std::to_string(figures.merged_static_triangles) +
-                                " triangles in one hierarchy"
-                          : std::string("a hierarchy per object (fewer than two static objects, "
-                                        "or over 2^20 static triangles)"))
+  out << "rays  "
+      << (figures.merged_static_triangles > 0
+              ? "the static actors' " + std::to_string(figures.merged_static_triangles) +
+                    " triangles in one hierarchy"
+              : std::string("a hierarchy per object (fewer than two static objects, "
+                            "or over 2^20 static triangles)"))
       << "\n";
   out << "size  " << size.x() << " x " << size.y() << " x " << size.z() << " m, from ("
       << Lo(bounds).x() << ", " << Lo(bounds).y() << ", " << Lo(bounds).z() << ") to ("

@@ -148,12 +148,12 @@ void CheckLoadsInIsolation(const std::string& file, const scene::AssetConversion
                             " s of CPU ([level] max_import_s in a level manifest)");
   }
   if (WIFSIGNALED(status)) {
-    throw scene::LevelError(where + ": " + reader + " crashed reading it (" +
-                            SignalName(WTERMSIG(status)) + "); the file is corrupt or shows a bug of " +
-                            reader +
-                            " (docs/explanation/reliability.md), or reading it needed more than its [level] "
-                            "max_import_mb = " +
-                            std::to_string(limits.max_import_mb));
+    throw scene::LevelError(
+        where + ": " + reader + " crashed reading it (" + SignalName(WTERMSIG(status)) +
+        "); the file is corrupt or shows a bug of " + reader +
+        " (docs/explanation/reliability.md), or reading it needed more than its [level] "
+        "max_import_mb = " +
+        std::to_string(limits.max_import_mb));
   }
   throw scene::LevelError(where + ": loading it apart failed (exit code " +
                           std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")");

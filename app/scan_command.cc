@@ -169,8 +169,7 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
           const int occupancy = scan.faces[std::size_t(f)].occupancy[std::size_t(k)];
           samples.push_back({std::to_string(f) + "," + std::to_string(k / scan.n) + "," +
                                  std::to_string(k % scan.n) + "," + std::to_string(occupancy) + ",",
-                             occupancy == sensors::kOccupied,
-                             scan.PointW(f, std::size_t(k)), ""});
+                             occupancy == sensors::kOccupied, scan.PointW(f, std::size_t(k)), ""});
         }
       }
     } else if (sensor == "ground") {

@@ -72,8 +72,8 @@ class TableReader {
     const std::optional<double> value = Number(key);
     if (!value) return std::nullopt;
     if (!(*value >= double(low) && *value <= double(high)) || *value != std::floor(*value)) {
-      Fail(Find(key), "'" + key + "' must be a whole number from " + std::to_string(low) +
-                          " to " + std::to_string(high));
+      Fail(Find(key), "'" + key + "' must be a whole number from " + std::to_string(low) + " to " +
+                          std::to_string(high));
     }
     return std::int64_t(*value);
   }

@@ -135,9 +135,9 @@ std::string IdentityProblem(OGRSpatialReferenceH crs) {
   std::string problem;
   if (OSRImportFromEPSG(known, int(number)) == OGRERR_NONE &&
       std::string(kind(known)) != kind(crs)) {
-    problem = std::string("its coordinate system is ") + kind(crs) + " but calls itself EPSG:" +
-              code + ", which is " + kind(known) + " (" + OSRGetName(known) +
-              "): a GeoTIFF key with the wrong kind of code";
+    problem = std::string("its coordinate system is ") + kind(crs) +
+              " but calls itself EPSG:" + code + ", which is " + kind(known) + " (" +
+              OSRGetName(known) + "): a GeoTIFF key with the wrong kind of code";
   }
   OSRDestroySpatialReference(known);
   return problem;

@@ -33,7 +33,7 @@ class TerrainStreamer {
  public:
   struct Figures {
     std::int64_t built{0}, fine_built{0}, dropped{0}, failed{0};
-    std::int64_t from_cache{0};  // of `built`: read back from the tile cache
+    std::int64_t from_cache{0};                         // of `built`: read back from the tile cache
     double longest_build_ms{0.0}, total_build_ms{0.0};  // reading or building, and the shape
     double longest_swap_ms{0.0};  // tiles in and out of the collision world, on the loop
     std::int64_t waits{0};        // updates that waited for fine tiles (lock-step)

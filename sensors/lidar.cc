@@ -41,8 +41,7 @@ void LidarConfig::ValidateOrThrow() const {
 
 Lidar::Lidar(const LidarConfig& config) : config_(config) { config_.ValidateOrThrow(); }
 
-RayBatch Lidar::Rays(const Eigen::Isometry3d& X_WS_start,
-                     const Eigen::Isometry3d& X_WS_end) const {
+RayBatch Lidar::Rays(const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3d& X_WS_end) const {
   const int channels = config_.channels(), steps = config_.azimuth_steps;
   RayBatch rays;
   rays.origin_W = X_WS_start.translation();

@@ -386,7 +386,7 @@ inline __m128 MeetsCornerBox4(const Vec4& low, const Vec4& high, const Vec4& o, 
 // kernel reads them: origins in the Bullet frame and results, indexed by cell
 // (a band's ray from its first).
 struct GridBand {
-  __m128 dx, dy, dz;                          // the block's direction
+  __m128 dx, dy, dz;                      // the block's direction
   __m128 ox, oy, oz;                      // the batch origin (a ray starts at it plus its start)
   const Eigen::Vector3f* start{nullptr};  // the cells' rays' starts
   float* t_max{nullptr};                  // their entries of RayHits::distance_m
@@ -571,8 +571,8 @@ struct GridCull {
     cull.w0 = _mm_loadu_ps(w0);
     cull.margin = _mm_loadu_ps(margin);
     cull.limit = _mm_loadu_ps(limit);
-    cull.integral = _mm_castsi128_ps(integral_first_two ? _mm_setr_epi32(-1, -1, 0, 0)
-                                                        : _mm_setzero_si128());
+    cull.integral =
+        _mm_castsi128_ps(integral_first_two ? _mm_setr_epi32(-1, -1, 0, 0) : _mm_setzero_si128());
     return cull;
   }
 };
@@ -928,8 +928,7 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
     total += grid_costs_[b].seconds;
   }
   known = known && total > 0.0;
-  const int even_split =
-      (4 * threads() + int(grids.size()) - 1) / std::max(1, int(grids.size()));
+  const int even_split = (4 * threads() + int(grids.size()) - 1) / std::max(1, int(grids.size()));
   for (std::size_t b = 0; b < grids.size(); ++b) {
     const RayGrid& grid = grids[b];
     const double cost = known ? grid_costs_[b].seconds : 1.0;
@@ -1035,8 +1034,8 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
         const __m128 span_to = _mm_min_ps(top, high);
         if ((_mm_movemask_ps(_mm_cmpge_ps(span_to, span_from)) & 7) != 7) return;
         const __m128i whole = _mm_cvttps_epi32(span_from);
-        const __m128i least = _mm_sub_epi32(
-            whole, _mm_castps_si128(_mm_cmplt_ps(_mm_cvtepi32_ps(whole), span_from)));
+        const __m128i least =
+            _mm_sub_epi32(whole, _mm_castps_si128(_mm_cmplt_ps(_mm_cvtepi32_ps(whole), span_from)));
         const __m128i last = _mm_cvttps_epi32(span_to);
         if (_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpgt_epi32(least, last))) & 3) return;
         alignas(16) std::int32_t firsts[4], lasts[4];
@@ -1044,9 +1043,7 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
         _mm_store_si128(reinterpret_cast<__m128i*>(lasts), last);
         const int c0 = firsts[0], r0 = firsts[1], c1 = lasts[0], r1 = lasts[1];
         const float near = _mm_cvtss_f32(_mm_movehl_ps(low, low));
-        auto add = [&](int r, int c) {
-          band.Add(corners, body, r * cols + c, near, HitPairs);
-        };
+        auto add = [&](int r, int c) { band.Add(corners, body, r * cols + c, near, HitPairs); };
         if ((r1 - r0 + 1) * (c1 - c0 + 1) <= 4) {  // the box's few cells
           for (int r = r0; r <= r1; ++r) {
             for (int c = c0; c <= c1; ++c) add(r, c);

@@ -22,8 +22,7 @@ namespace sandbox::testing {
 inline void WriteRaster(const std::filesystem::path& file, int cols, int rows, double lon0,
                         double lat0, double spacing_deg, int bands, GDALDataType type,
                         const std::function<double(int, int, int)>& value,
-                        std::vector<std::string> options = {},
-                        const std::string& crs_wkt = "") {
+                        std::vector<std::string> options = {}, const std::string& crs_wkt = "") {
   GDALAllRegister();
   std::vector<char*> list;
   for (std::string& option : options) list.push_back(option.data());

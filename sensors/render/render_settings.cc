@@ -19,8 +19,8 @@ std::string Text(double value) {
 
 std::optional<RenderSettings::Problem> RenderSettings::FindProblem() const {
   if (msaa_samples != 0 && msaa_samples != 1 && msaa_samples != 4) {
-    return Problem{"msaa_samples", "must be 0 (off), 1 (off) or 4 samples, got " +
-                                       std::to_string(msaa_samples)};
+    return Problem{"msaa_samples",
+                   "must be 0 (off), 1 (off) or 4 samples, got " + std::to_string(msaa_samples)};
   }
   if (anisotropy < 1 || anisotropy > 16) {
     return Problem{"anisotropy", "must be 1 (off) to 16, got " + std::to_string(anisotropy)};

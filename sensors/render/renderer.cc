@@ -1452,9 +1452,8 @@ class OsMesaRenderer : public Renderer {
         const bool has_lightmap_uvs = mesh.lightmap_uvs.size() == mesh.positions_A.size();
         const bool has_colors = mesh.colors.size() == mesh.positions_A.size();
         for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
-          const Eigen::Vector3d c = (p_S[mesh.indices[t]] + p_S[mesh.indices[t + 1]] +
-                                     p_S[mesh.indices[t + 2]]) /
-                                    3.0;
+          const Eigen::Vector3d c =
+              (p_S[mesh.indices[t]] + p_S[mesh.indices[t + 1]] + p_S[mesh.indices[t + 2]]) / 3.0;
           const std::tuple<int, int, long, long, int> key{
               mesh.material, surface, std::lround(std::floor(c.x() / kChunkCell_m)),
               std::lround(std::floor(c.y() / kChunkCell_m)), kind};

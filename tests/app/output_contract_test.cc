@@ -96,8 +96,8 @@ fs::path Replay(const testing::TempDir& dir, const fs::path& level,
                 const std::vector<Eigen::Isometry3d>& poses, std::string* out = nullptr) {
   const fs::path log = dir.path() / "flight.lcmlog", recording = dir.path() / "out.lcmlog";
   WritePoses(log, poses, 10'000);
-  const auto run = RunSandbox("run " + level.string() + " --replay " + log.string() +
-                              " --record " + recording.string());
+  const auto run = RunSandbox("run " + level.string() + " --replay " + log.string() + " --record " +
+                              recording.string());
   EXPECT_EQ(run.exit_code, 0) << run.out;
   if (out != nullptr) *out = run.out;
   return recording;
@@ -124,10 +124,10 @@ Eigen::Isometry3d FastPass(double tau_s) {
 TEST(OutputContractTest, LidarStepsAreCastFromThePoseAtTheirTime) {
   testing::TempDir dir;
   dir.Write("wall.obj", testing::ObjBox("wall", 600, 1, 60, -200, 20, -30));
-  const fs::path level = WriteLevel(
-      dir, "[[actor]]\nname = \"wall\"\nfile = \"wall.obj\"\n",
-      "[[robot.sensor]]\nname = \"lidar\"\ntype = \"lidar\"\nelevations_deg = [0]\n"
-      "azimuth_steps = 360\nrange_m = 100\nrotation_hz = 10\nrate_hz = 10\n");
+  const fs::path level =
+      WriteLevel(dir, "[[actor]]\nname = \"wall\"\nfile = \"wall.obj\"\n",
+                 "[[robot.sensor]]\nname = \"lidar\"\ntype = \"lidar\"\nelevations_deg = [0]\n"
+                 "azimuth_steps = 360\nrange_m = 100\nrotation_hz = 10\nrate_hz = 10\n");
   std::vector<Eigen::Isometry3d> poses;
   for (int i = 0; i < 100; ++i) poses.push_back(FastPass(0.01 * i));
   const fs::path recording = Replay(dir, level, poses);
@@ -173,8 +173,8 @@ TEST(OutputContractTest, LidarStepsAreCastFromThePoseAtTheirTime) {
     }
   }
   EXPECT_GT(checked, 500);
-  EXPECT_LT(worst_m, 0.01);                // every point on the wall to 1 cm
-  EXPECT_GT(worst_uncompensated_m, 0.5);   // cast from the end pose, they are metres off
+  EXPECT_LT(worst_m, 0.01);               // every point on the wall to 1 cm
+  EXPECT_GT(worst_uncompensated_m, 0.5);  // cast from the end pose, they are metres off
 }
 
 // Face f's in-plane axes (u, v) in the box frame (docs/reference/sensors.md).
@@ -252,9 +252,9 @@ TEST(OutputContractTest, StateFaceFramesAreTheBoxesTheFacesWereScannedIn) {
     const Eigen::Quaterniond mount = Rpy(10 * M_PI / 180, 20 * M_PI / 180, 30 * M_PI / 180);
     const Eigen::Isometry3d X_RF = FaceFrame(states.back(), 5);
     const Eigen::Isometry3d X_WR = poses.back();
-    const Eigen::Isometry3d expected =
-        aligned == "body" ? X_WR * Pose({1, -2, 0.5}, mount)
-                          : Pose(X_WR * Eigen::Vector3d(1, -2, 0.5), Eigen::Quaterniond::Identity());
+    const Eigen::Isometry3d expected = aligned == "body" ? X_WR * Pose({1, -2, 0.5}, mount)
+                                                         : Pose(X_WR * Eigen::Vector3d(1, -2, 0.5),
+                                                                Eigen::Quaterniond::Identity());
     EXPECT_LT((X_RF.matrix() - expected.matrix()).norm(), 1e-9);
     // Faces scanned at earlier poses differ from the mount now (the robot turned).
     EXPECT_GT((FaceFrame(states.back(), 0).matrix() - expected.matrix()).norm(), 0.1);
@@ -265,14 +265,15 @@ TEST(OutputContractTest, ScansTwoHundredKilometresOutAreAsPreciseAsAtTheOrigin) 
   testing::TempDir dir;
   // A 10 m box whose top is at z = 5, placed 200 km east.
   dir.Write("box.obj", testing::ObjBox("box", 10, 10, 10, -5, -5, -5));
-  const fs::path level = WriteLevel(
-      dir, "[[actor]]\nname = \"far\"\nfile = \"box.obj\"\nposition = [200000, 0, 0]\n",
-      "[[robot.sensor]]\nname = \"faces\"\ntype = \"face\"\nresolution_m = 0.5\n"
-      "half_extent_m = 20\nrefresh = \"full\"\n");
+  const fs::path level =
+      WriteLevel(dir, "[[actor]]\nname = \"far\"\nfile = \"box.obj\"\nposition = [200000, 0, 0]\n",
+                 "[[robot.sensor]]\nname = \"faces\"\ntype = \"face\"\nresolution_m = 0.5\n"
+                 "half_extent_m = 20\nrefresh = \"full\"\n");
   // Out from the origin in 5 km steps, then three ticks over the box.
   const Eigen::Vector3d over(200000.37, 0.21, 20.13);
   std::vector<Eigen::Isometry3d> poses;
-  for (int i = 0; i <= 40; ++i) poses.push_back(Pose(over * i / 40.0, Eigen::Quaterniond::Identity()));
+  for (int i = 0; i <= 40; ++i)
+    poses.push_back(Pose(over * i / 40.0, Eigen::Quaterniond::Identity()));
   for (int i = 0; i < 3; ++i) poses.push_back(Pose(over, Eigen::Quaterniond::Identity()));
   std::string out;
   const fs::path recording = Replay(dir, level, poses, &out);
@@ -322,7 +323,8 @@ TEST(OutputContractTest, ScansTwoHundredKilometresOutAreAsPreciseAsAtTheOrigin) 
   const fs::path one_shot = dir.path() / "one_shot.csv";
   const auto scan = RunSandbox("scan " + level.string() +
                                " --at 200000.37,0.21,20.13 --resolution 0.5 --half-extent 20 "
-                               "--out " + one_shot.string());
+                               "--out " +
+                               one_shot.string());
   ASSERT_EQ(scan.exit_code, 0) << scan.out;
   std::ifstream csv(one_shot);
   std::string line;
@@ -331,17 +333,16 @@ TEST(OutputContractTest, ScansTwoHundredKilometresOutAreAsPreciseAsAtTheOrigin) 
   while (std::getline(csv, line)) {
     int f, r, c, occupancy;
     double x, y, z;
-    ASSERT_EQ(std::sscanf(line.c_str(), "%d,%d,%d,%d,%lf,%lf,%lf", &f, &r, &c, &occupancy, &x, &y,
-                          &z),
-              7)
+    ASSERT_EQ(
+        std::sscanf(line.c_str(), "%d,%d,%d,%d,%lf,%lf,%lf", &f, &r, &c, &occupancy, &x, &y, &z), 7)
         << line;
     const sandbox_msgs::scan_face_t& face = faces[faces.size() - 6 + std::size_t(f)];
     ASSERT_EQ(face.face, f);
     const int k = r * face.n + c;
     EXPECT_EQ(face.occupancy[k], occupancy) << line;
-    const Eigen::Vector3d point = Eigen::Vector3d(face.origin[0], face.origin[1], face.origin[2]) +
-                                  Eigen::Vector3d(face.xyz[3 * k], face.xyz[3 * k + 1],
-                                                  face.xyz[3 * k + 2]);
+    const Eigen::Vector3d point =
+        Eigen::Vector3d(face.origin[0], face.origin[1], face.origin[2]) +
+        Eigen::Vector3d(face.xyz[3 * k], face.xyz[3 * k + 1], face.xyz[3 * k + 2]);
     EXPECT_LT((point - Eigen::Vector3d(x, y, z)).norm(), 1e-3) << line;
     ++compared;
   }
@@ -356,7 +357,8 @@ TEST(OutputContractTest, OutputsFromUdpDoublesCarryThePacketsOwnSeqAndTime) {
   const fs::path level = dir.Write(
       "level.toml", "[[robot]]\nname = \"W\"\nfile = \"" + Wing() +
                         "\"\nbones = [\"root\"]\n\n[robot.bridge]\nbind_address = \"127.0.0.1\"\n"
-                        "udp_doubles_port = " + std::to_string(port) +
+                        "udp_doubles_port = " +
+                        std::to_string(port) +
                         "\nudp_doubles_layout = [\"time\", \"seq\", \"position\"]\n");
   const fs::path recording = dir.path() / "out.lcmlog";
   std::atomic<bool> done{false};
@@ -373,8 +375,8 @@ TEST(OutputContractTest, OutputsFromUdpDoublesCarryThePacketsOwnSeqAndTime) {
     }
     ::close(s);
   });
-  const auto run = RunSandbox("run " + level.string() + " --lcm-url memq:// --duration 3 --record " +
-                              recording.string());
+  const auto run = RunSandbox("run " + level.string() +
+                              " --lcm-url memq:// --duration 3 --record " + recording.string());
   done = true;
   sender.join();
   ASSERT_EQ(run.exit_code, 0) << run.out;

@@ -19,7 +19,8 @@ std::string WriteLog(const testing::TempDir& dir) {
   const std::string path = (dir.path() / "run.lcmlog").string();
   LogWriter log(path);
   const std::vector<std::uint8_t> big(500'000, 7), small(10, 1);
-  for (int i = 0; i < 10; ++i) log.Write("ELAHA/SCAN_FACE", big.data(), unsigned(big.size()), 1'000'000);
+  for (int i = 0; i < 10; ++i)
+    log.Write("ELAHA/SCAN_FACE", big.data(), unsigned(big.size()), 1'000'000);
   for (int k = 1; k <= 100; ++k) {
     log.Write("ELAHA/POSE", small.data(), unsigned(small.size()), 1'000'000 + k * 100'000);
   }

@@ -1,8 +1,8 @@
 // The terrain's inputs as an outside tester tries them: rasters that are
 // FIFOs or name FIFOs, sparse giants, absurd heights, damaged imagery and
 // tile-cache files, rasters across the antimeridian and past a pole, lying
-// coordinate systems, and settings beyond any physical sense. Every raster is written here with GDAL;
-// expected heights come from the values written, not from the terrain code.
+// coordinate systems, and settings beyond any physical sense. Every raster is written here with
+// GDAL; expected heights come from the values written, not from the terrain code.
 
 #include <gdal.h>
 #include <gtest/gtest.h>
@@ -309,15 +309,17 @@ TEST(TerrainInputTest, ARasterWhoseCoordinateSystemClaimsAnotherKindOfCodeIsLeft
            "AUTHORITY[\"EPSG\",\"" +
            code + "\"]]";
   };
-  WriteRaster(dir.path() / "geocentric.tif", 64, 64, 8.0, 46.0, 0.001, 1, GDT_Float32,
-              [](int, int, int) { return kGround_m; }, {}, geographic("4342"));
+  WriteRaster(
+      dir.path() / "geocentric.tif", 64, 64, 8.0, 46.0, 0.001, 1, GDT_Float32,
+      [](int, int, int) { return kGround_m; }, {}, geographic("4342"));
   const std::string warning = LeftOutWarning(dir, "geocentric.tif");
   EXPECT_NE(warning.find("geocentric.tif: its coordinate system is geographic but calls itself "
                          "EPSG:4342, which is geocentric"),
             std::string::npos)
       << warning;
-  WriteRaster(dir.path() / "honest.tif", 129, 129, 8.0, 46.02, 0.0003, 1, GDT_Float32,
-              [](int, int, int) { return kGround_m; }, {}, geographic("4326"));
+  WriteRaster(
+      dir.path() / "honest.tif", 129, 129, 8.0, 46.02, 0.0003, 1, GDT_Float32,
+      [](int, int, int) { return kGround_m; }, {}, geographic("4326"));
   const Level level =
       LoadLevel(dir.Write("level.toml", TerrainToml("elevation = [\"honest.tif\"]\n")));
   EXPECT_TRUE(level.warnings.empty()) << level.warnings[0];

@@ -100,8 +100,8 @@ TEST_F(RayCasterTest, IgnoringAStaticActorAgreesWithBullet) {
   for (int i = 0; i < 4000; ++i) {
     const Vector3f start(20.f * unit(random), 20.f * unit(random), 10.f * unit(random) + 5.f);
     rays.start.push_back(start);
-    rays.direction.push_back((-start + Vector3f(3.f * unit(random), 3.f * unit(random), 0.f))
-                                 .normalized());
+    rays.direction.push_back(
+        (-start + Vector3f(3.f * unit(random), 3.f * unit(random), 0.f)).normalized());
     rays.length_m.push_back(60.f);
   }
   RayFilter ignore;
