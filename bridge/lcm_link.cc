@@ -236,7 +236,9 @@ bool LogReader::Next(std::string* channel, std::vector<std::uint8_t>* data, std:
 
 double LogReader::fraction_read() const {
   if (end_utime_ > first_utime_) {
-    return std::clamp(double(utime_ - first_utime_) / double(end_utime_ - first_utime_), 0.0, 1.0);
+    // In double: a hostile log's times may be any int64, their differences overflow.
+    const double done = double(utime_) - double(first_utime_);
+    return std::clamp(done / (double(end_utime_) - double(first_utime_)), 0.0, 1.0);
   }
   return double(offset_) / double(size_);
 }

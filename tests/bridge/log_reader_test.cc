@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,30 @@ TEST(LogReaderTest, ALogCutShortCountsProgressByBytes) {
   for (int i = 0; i < 10; ++i) ASSERT_TRUE(reader.Next(&channel, &data, &utime));
   const double bytes = 10.0 * (28 + 15 + 500'000) / double(size - 5);
   EXPECT_NEAR(reader.fraction_read(), bytes, 1e-12);
+}
+
+// Found by the fuzz target: times at the ends of int64 (their differences
+// overflow) still give a fraction from 0 to 1.
+TEST(LogReaderTest, TimesAtTheEndsOfInt64GiveAFractionFrom0To1) {
+  testing::TempDir dir;
+  const std::string path = (dir.path() / "extreme.lcmlog").string();
+  {
+    LogWriter log(path);
+    const std::uint8_t byte = 0;
+    log.Write("A", &byte, 1, std::numeric_limits<std::int64_t>::min());
+    log.Write("A", &byte, 1, std::numeric_limits<std::int64_t>::max());
+    log.Write("A", &byte, 1, std::numeric_limits<std::int64_t>::max());
+    ASSERT_TRUE(log.Close());
+  }
+  LogReader reader(path);
+  std::string channel;
+  std::vector<std::uint8_t> data;
+  std::int64_t utime = 0;
+  while (reader.Next(&channel, &data, &utime)) {
+    EXPECT_GE(reader.fraction_read(), 0.0);
+    EXPECT_LE(reader.fraction_read(), 1.0);
+  }
+  EXPECT_DOUBLE_EQ(reader.fraction_read(), 1.0);
 }
 
 }  // namespace
