@@ -42,7 +42,6 @@ void ReadLook(const scene::SensorSpec& spec, scene::SettingsReader* read, Render
   look->msaa_samples = read->Whole("msaa", look->msaa_samples);
   look->anisotropy = read->Whole("anisotropy", look->anisotropy);
   const double lod_px = read->Number("lod_px", look->lod_px);
-  if (!(std::abs(lod_px) <= 1e6)) read->Fail("lod_px", "'lod_px' must be 0 to 8 pixels");
   look->lod_px = float(lod_px);
   look->cull_hidden_back_faces = read->Flag("cull_hidden_back_faces", look->cull_hidden_back_faces);
   look->images = kColorImage;
