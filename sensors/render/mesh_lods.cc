@@ -13,12 +13,36 @@ const MeshLods::Level& LevelFor(const std::vector<MeshLods::Level>& levels, floa
   return levels[best];
 }
 
+std::size_t NextLevel(const std::vector<MeshLods::Level>& levels, std::size_t current,
+                      float error_m) {
+  auto index = [&](float e) { return std::size_t(&LevelFor(levels, e) - levels.data()); };
+  const std::size_t k = index(error_m);
+  return k > current ? std::max(index(error_m / 1.5f), current) : k;
+}
+
+float PixelError(float lod_px, float pixel_angle_rad, const Eigen::AlignedBox3f& box_C) {
+  if (lod_px <= 0.f || box_C.isEmpty()) return 0.f;
+  return lod_px * pixel_angle_rad * box_C.exteriorDistance(Eigen::Vector3f::Zero());
+}
+
+float UnderShadowTexel(float error_m, const std::vector<ShadowCascade>& cascades,
+                       const Eigen::Vector3f& view_axis, const Eigen::AlignedBox3f& box_C) {
+  if (cascades.empty()) return error_m;
+  const float depth =
+      view_axis.dot(box_C.center()) - 0.5f * box_C.sizes().dot(view_axis.cwiseAbs());
+  std::size_t c = 0;
+  while (c + 1 < cascades.size() && depth > cascades[c].far_m) ++c;
+  if (depth <= cascades.back().far_m) return std::min(error_m, float(cascades[c].texel_m) / 5.f);
+  return error_m;
+}
+
 std::vector<std::uint32_t> WeldIdentical(const std::vector<std::uint32_t>& indices,
                                          std::size_t vertex_count,
                                          const std::vector<VertexStream>& streams) {
   std::vector<meshopt_Stream> meshopt_streams;
   for (const VertexStream& stream : streams) {
-    if (stream.data != nullptr) meshopt_streams.push_back({stream.data, stream.bytes, stream.bytes});
+    if (stream.data != nullptr)
+      meshopt_streams.push_back({stream.data, stream.bytes, stream.bytes});
   }
   std::vector<std::uint32_t> welded(indices.size());
   if (indices.empty() || meshopt_streams.empty()) return indices;
@@ -35,14 +59,14 @@ MeshLods MakeMeshLods(const std::vector<Eigen::Vector3f>& positions,
   lods.indices = indices;
   lods.levels.push_back({0, std::uint32_t(indices.size()), 0.f});
   if (positions.empty() || indices.size() < 3 * 64) return lods;
-  const float scale = meshopt_simplifyScale(positions[0].data(), positions.size(),
-                                            sizeof(Eigen::Vector3f));
+  const float scale =
+      meshopt_simplifyScale(positions[0].data(), positions.size(), sizeof(Eigen::Vector3f));
   if (!(scale > 0.f)) return lods;
   // The triangles by group (one group without `vertex_group`), each over the
   // vertices it uses alone (the simplifier takes vertices it is given at one
   // place but not used together as a seam); the triangles across groups apart.
   struct Group {
-    std::vector<std::uint32_t> vertices;   // local to the mesh's
+    std::vector<std::uint32_t> vertices;  // local to the mesh's
     std::vector<Eigen::Vector3f> positions;
     std::vector<std::uint32_t> triangles;  // local
     std::map<std::uint32_t, std::uint32_t> local;

@@ -7,6 +7,25 @@
 #include "sensors/render/renderer.h"
 
 namespace sandbox::render {
+
+Quality ParseQuality(const std::string& word) {
+  if (word == "plain") return Quality::kPlain;
+  if (word == "fast") return Quality::kFast;
+  if (word == "high") return Quality::kHigh;
+  throw std::invalid_argument("quality must be \"fast\" or \"high\" (or \"plain\"), got '" + word +
+                              "'");
+}
+
+RenderSettings RenderSettings::Preset(Quality quality) {
+  RenderSettings settings;
+  settings.shadows = quality == Quality::kHigh;
+  settings.msaa_samples = 0;
+  settings.fxaa = quality == Quality::kHigh;
+  settings.gamma_correct = quality != Quality::kPlain;
+  settings.materials = quality != Quality::kPlain;
+  return settings;
+}
+
 namespace {
 
 std::string Text(double value) {

@@ -8,8 +8,8 @@
 // distance haze, FXAA or 4x multisampling; colour, depth, segmentation and normal
 // images read back. Depth is reversed (1 near, 0 far, in a float buffer):
 // precise from 0.1 m to hundreds of kilometres.
-// GL stays inside renderer.cc; nothing else sees a GL header (the types it
-// takes and gives are in view.h).
+// GL stays inside the renderer's parts (renderer.cc lists them); nothing
+// else sees a GL header (the types it takes and gives are in view.h).
 //
 // Threads: a Renderer and everything it renders belong to one thread (the
 // render thread); make it there. Several renderers on one thread may take

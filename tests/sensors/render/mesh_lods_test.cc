@@ -8,7 +8,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-
 #include <cmath>
 #include <map>
 #include <set>
@@ -105,9 +104,10 @@ TEST(MeshLodsTest, AWavySurfaceStaysWithinEachLevelsErrorOfItsFunction) {
                             c = grid.positions[t[i + 2]].cast<double>();
       // Points across the triangle; slopes reach 0.25, so a vertical gap is
       // at most 3% more than the distance.
-      for (const Eigen::Vector3d& w : {Eigen::Vector3d(1.0 / 3, 1.0 / 3, 1.0 / 3), Eigen::Vector3d(0.5, 0.5, 0),
-                                       Eigen::Vector3d(0, 0.5, 0.5), Eigen::Vector3d(0.5, 0, 0.5),
-                                       Eigen::Vector3d(0.7, 0.2, 0.1)}) {
+      for (const Eigen::Vector3d& w :
+           {Eigen::Vector3d(1.0 / 3, 1.0 / 3, 1.0 / 3), Eigen::Vector3d(0.5, 0.5, 0),
+            Eigen::Vector3d(0, 0.5, 0.5), Eigen::Vector3d(0.5, 0, 0.5),
+            Eigen::Vector3d(0.7, 0.2, 0.1)}) {
         const Eigen::Vector3d p = w.x() * a + w.y() * b + w.z() * c;
         worst = std::max(worst, std::abs(p.z() - z(p.x(), p.y())) / 1.03 - 0.002);
       }
@@ -150,7 +150,8 @@ TEST(MeshLodsTest, WeldedTriangleSoupsSimplifyAndKeepTheirAttributes) {
   for (std::size_t i = 0; i < grid.indices.size(); ++i) {
     positions.push_back(grid.positions[grid.indices[i]]);
     // Two kinds of normal: the left half's corners differ from the right half's.
-    normals.push_back(positions.back().x() < 5.f ? Eigen::Vector3f::UnitZ() : Eigen::Vector3f::UnitX());
+    normals.push_back(positions.back().x() < 5.f ? Eigen::Vector3f::UnitZ()
+                                                 : Eigen::Vector3f::UnitX());
     soup.push_back(std::uint32_t(i));
   }
   EXPECT_EQ(MakeMeshLods(positions, soup).levels.size(), 1u) << "no triangle shares an edge";
@@ -183,6 +184,48 @@ TEST(MeshLodsTest, SmallMeshesGetNoLevels) {
   const MeshLods lods = MakeMeshLods(grid.positions, grid.indices);
   ASSERT_EQ(lods.levels.size(), 1u);
   EXPECT_EQ(lods.indices, grid.indices);
+}
+
+// Levels at 0, 1 cm, 3 cm, 9 cm (errors), for choosing.
+std::vector<MeshLods::Level> Levels() {
+  return {{0, 300, 0.f}, {300, 200, 0.01f}, {500, 100, 0.03f}, {600, 50, 0.09f}};
+}
+
+TEST(MeshLodsTest, ALevelGoesCoarserOnlyWellWithinItsError) {
+  const std::vector<MeshLods::Level> levels = Levels();
+  EXPECT_EQ(NextLevel(levels, 0, 0.f), 0u);
+  EXPECT_EQ(NextLevel(levels, 0, 0.035f), 1u);  // 3 cm allowed, but 3.5 / 1.5 < 3 cm: one step
+  EXPECT_EQ(NextLevel(levels, 0, 0.05f), 2u);   // 5 / 1.5 = 3.3 cm: level 2
+  EXPECT_EQ(NextLevel(levels, 2, 0.035f), 2u);  // stays
+  EXPECT_EQ(NextLevel(levels, 2, 0.02f), 1u);   // finer at once when the error shrinks
+  EXPECT_EQ(NextLevel(levels, 3, 1.f), 3u);
+}
+
+TEST(MeshLodsTest, PixelErrorIsWhatThePixelsSpanAtTheNearestPoint) {
+  // A box 100 m ahead (its near face at x = 100): 2 pixels of 1 mrad span 0.2 m.
+  const Eigen::AlignedBox3f box(Eigen::Vector3f(100, -5, -5), Eigen::Vector3f(110, 5, 5));
+  EXPECT_NEAR(PixelError(2.f, 0.001f, box), 0.2f, 1e-6f);
+  EXPECT_EQ(PixelError(0.f, 0.001f, box), 0.f);
+  EXPECT_EQ(PixelError(2.f, 0.001f, Eigen::AlignedBox3f()), 0.f);
+  // The eye inside the box: no simplification at all.
+  EXPECT_EQ(PixelError(2.f, 0.001f,
+                       Eigen::AlignedBox3f(Eigen::Vector3f(-1, -1, -1), Eigen::Vector3f(1, 1, 1))),
+            0.f);
+}
+
+TEST(MeshLodsTest, UnderShadowsTheErrorIsAFifthOfTheCascadesTexel) {
+  std::vector<ShadowCascade> cascades(2);
+  cascades[0].far_m = 50.0, cascades[0].texel_m = 0.05;
+  cascades[1].far_m = 300.0, cascades[1].texel_m = 0.5;
+  const Eigen::Vector3f axis(1, 0, 0);
+  auto box_at = [](float x) {
+    return Eigen::AlignedBox3f(Eigen::Vector3f(x, -1, -1), Eigen::Vector3f(x + 2, 1, 1));
+  };
+  EXPECT_NEAR(UnderShadowTexel(1.f, cascades, axis, box_at(20)), 0.01f, 1e-7f);     // first cascade
+  EXPECT_NEAR(UnderShadowTexel(1.f, cascades, axis, box_at(100)), 0.1f, 1e-7f);     // second
+  EXPECT_NEAR(UnderShadowTexel(0.05f, cascades, axis, box_at(100)), 0.05f, 1e-7f);  // smaller kept
+  EXPECT_EQ(UnderShadowTexel(1.f, cascades, axis, box_at(400)), 1.f);  // beyond the shadows
+  EXPECT_EQ(UnderShadowTexel(1.f, {}, axis, box_at(20)), 1.f);
 }
 
 }  // namespace

@@ -819,7 +819,8 @@ TEST(RendererWingTest, BendingMovesTheSilhouetteToTheAnalyticTip) {
 // The sample level with its wing mid-turn, as bench_render's looks show it.
 struct SampleWithWing {
   SampleWithWing()
-      : level(scene::LoadLevel(testing::SampleLevel())), renderer(MakeRenderer()),
+      : level(scene::LoadLevel(testing::SampleLevel())),
+        renderer(MakeRenderer()),
         wing(level.robots[0]) {
     renderer->SetLevel(level, {});
     wing.SetPose(Eigen::Translation3d(-40, -30, 25) * Eigen::AngleAxisd(0.6, Vector3d::UnitZ()));
