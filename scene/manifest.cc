@@ -97,14 +97,18 @@ class TableReader {
     return out;
   }
 
-  // Every key of the table must have been asked for.
-  void RejectUnknownKeys() const {
+  // Every key of the table must have been asked for; `table` names its kind
+  // for ReportKeys (settings.h).
+  void RejectUnknownKeys(const std::string& table) const {
+    ReportKeys(table, known_);
     for (const auto& [key, value] : table_) {
       if (known_.count(std::string(key.str())) == 0) {
         Fail(&value, "unknown key '" + std::string(key.str()) + "'");
       }
     }
   }
+
+  const std::set<std::string>& asked() const { return known_; }
 
   static std::string Format(double value) {
     std::ostringstream out;
@@ -217,7 +221,7 @@ ActorSpec ParseActor(const fs::path& file, const toml::table& table, int index) 
   } else if (actor.is_heightmap) {
     actor.surface = Surface::kTerrain;
   }
-  read.RejectUnknownKeys();
+  read.RejectUnknownKeys("[[actor]]");
   return actor;
 }
 
@@ -309,6 +313,10 @@ SensorSpec ParseSensor(const fs::path& file, const toml::table& table, int index
                                   "channel", "quaternion_wxyz", "scale", "up", "unit_scale"},
                                  kind + " '" + sensor.name + "'");
   sensor.settings.lines["type"] = type_line;  // for the message of an unknown type
+  // The keys of every type (a placement's scale, up and unit_scale are refused above).
+  std::set<std::string> common = read.asked();
+  for (const char* refused : {"scale", "up", "unit_scale"}) common.erase(refused);
+  ReportKeys("[[robot." + kind + "]]", common);
   return sensor;
 }
 
@@ -389,7 +397,7 @@ RobotSpec ParseRobot(const fs::path& file, const toml::table& table, int index) 
     robot.bridge = ReadSettings(file, *bridge->as_table(), bridge_read, {},
                                 "robot '" + robot.name + "' bridge");
   }
-  read.RejectUnknownKeys();
+  read.RejectUnknownKeys("[[robot]]");
   return robot;
 }
 
@@ -463,7 +471,7 @@ TerrainSpec ParseTerrain(const fs::path& file, const toml::table& table, int ind
     read.Fail(read.Find("view_radius_m"), "'view_radius_m' must not be below 'collision_radius_m'");
   }
   if (const auto cache = read.Text("cache")) terrain.cache = AssetPath(file, *cache);
-  read.RejectUnknownKeys();
+  read.RejectUnknownKeys("[[terrain]]");
   return terrain;
 }
 
@@ -547,7 +555,7 @@ LevelManifest ParseManifestText(std::string_view text, const fs::path& file) {
           {"max_imagery_window_px", &limits.max_imagery_window_px}}) {
       if (const auto set = read.Whole(key, 0, kHuge)) *value = std::uint64_t(*set);
     }
-    read.RejectUnknownKeys();
+    read.RejectUnknownKeys("[level]");
   }
 
   manifest.actors = ParseTables<ActorSpec>(file, top, "actor", ParseActor);
@@ -580,10 +588,10 @@ LevelManifest ParseManifestText(std::string_view text, const fs::path& file) {
         read.Fail(read.Find("visibility_m"), "'visibility_m' must be at least 1 m");
       spec.visibility_m = *visibility;
     }
-    read.RejectUnknownKeys();
+    read.RejectUnknownKeys("[horizon]");
     manifest.horizon = spec;
   }
-  top.RejectUnknownKeys();
+  top.RejectUnknownKeys("(the file's top level)");
   if (manifest.actors.empty() && manifest.robots.empty() && !manifest.terrain) {
     throw LevelError(
         file.string() +

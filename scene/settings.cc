@@ -29,6 +29,12 @@ const SettingValue* SettingsReader::Find(const std::string& key) {
   return it == table_.values.end() ? nullptr : &it->second;
 }
 
+bool SettingsReader::Has(const std::string& key) { return Find(key) != nullptr; }
+
+void SettingsReader::Removed(const std::string& key, const std::string& instead) const {
+  if (table_.values.count(key) > 0) Fail(key, "'" + key + "' is no longer a key: " + instead);
+}
+
 double SettingsReader::Number(const std::string& key, double fallback) {
   const SettingValue* value = Find(key);
   if (value == nullptr) return fallback;
@@ -76,7 +82,21 @@ std::vector<std::string> SettingsReader::Texts(const std::string& key) {
   return std::get<std::vector<std::string>>(*value);
 }
 
+namespace {
+KeyListener& Listener() {
+  static KeyListener listener;
+  return listener;
+}
+}  // namespace
+
+void SetKeyListener(KeyListener listener) { Listener() = std::move(listener); }
+
+void ReportKeys(const std::string& table, const std::set<std::string>& keys) {
+  if (Listener()) Listener()(table, keys);
+}
+
 void SettingsReader::RejectUnknownKeys(const std::string& kind) const {
+  ReportKeys(kind, read_);
   for (const auto& [key, value] : table_.values) {
     if (read_.count(key) == 0) Fail(key, "unknown key '" + key + "' for a " + kind);
   }

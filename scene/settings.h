@@ -4,6 +4,7 @@
 // clear LevelError per mistake.
 
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <set>
 #include <string>
@@ -46,7 +47,10 @@ class SettingsReader {
   std::string Text(const std::string& key, const std::string& fallback);
   std::vector<double> Numbers(const std::string& key);
   std::vector<std::string> Texts(const std::string& key);
-  bool Has(const std::string& key) const { return table_.values.count(key) > 0; }
+  // Whether the table sets `key` (asked for, as by the verbs above).
+  bool Has(const std::string& key);
+  // A key that is no more: throws naming it and `instead` when the table sets it.
+  void Removed(const std::string& key, const std::string& instead) const;
   // Throws for every key not read, naming `kind` ("face sensor").
   void RejectUnknownKeys(const std::string& kind) const;
 
@@ -55,5 +59,15 @@ class SettingsReader {
   const SettingsTable& table_;
   std::set<std::string> read_;
 };
+
+// The keys each kind of manifest table accepts, as its readers ask for them:
+// every reader reports, when it checks for keys it did not ask for, the
+// table's kind ("[[actor]]", "face sensor") and the keys it asked for. For
+// the docs-against-code test (docs/reference/manifest.md); nothing is kept
+// unless a listener is set. Set it before loading, on one thread.
+using KeyListener =
+    std::function<void(const std::string& table, const std::set<std::string>& keys)>;
+void SetKeyListener(KeyListener listener);
+void ReportKeys(const std::string& table, const std::set<std::string>& keys);
 
 }  // namespace sandbox::scene

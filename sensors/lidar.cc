@@ -113,12 +113,10 @@ LidarConfig LidarConfig::Read(scene::SettingsReader& read) {
   lidar.azimuth_steps = read.Whole("azimuth_steps", 1024);
   lidar.range_m = read.Number("range_m", 100.0);
   lidar.rotation_hz = read.Number("rotation_hz", 10.0);
-  if (read.Has("kernel")) {
-    read.Fail("kernel",
-              "'kernel' is no longer a key: every lidar is cast by the general caster, faster "
-              "than the structured sweep kernel on every level measured "
-              "(docs/decisions/001-no-structured-lidar-kernel.md); delete the key");
-  }
+  read.Removed("kernel",
+               "every lidar is cast by the general caster, faster than the structured sweep "
+               "kernel on every level measured (docs/decisions/001-no-structured-lidar-kernel.md); "
+               "delete the key");
   return lidar;
 }
 
