@@ -23,6 +23,8 @@ void RobotMeshes::Pose(const std::vector<const scene::RobotState*>& robots) {
   for (const scene::RobotState* state : robots) {
     const scene::RobotModel& model = state->model();
     std::vector<GpuMesh>& meshes = meshes_[&model];
+    // (Room for all first: pointers into `meshes` are kept below.)
+    meshes.reserve(model.meshes.size());
     std::vector<const GpuMesh*> drawn;
     Eigen::AlignedBox3f bounds_B;
     for (std::size_t m = 0; m < model.meshes.size(); ++m) {

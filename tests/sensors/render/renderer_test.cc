@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -814,6 +815,39 @@ TEST(RendererWingTest, BendingMovesTheSilhouetteToTheAnalyticTip) {
   };
   EXPECT_FALSE(is_sky(frame_bent)) << px.transpose();     // the bent tip is drawn there
   EXPECT_TRUE(is_sky(frame_straight)) << px.transpose();  // the straight wing is not
+}
+
+// A robot of several meshes (the quadrotor: body and rotors) is drawn whole
+// from the first frame that sees it, as it is in the next (its meshes are
+// uploaded in that first frame: ASan would catch a pointer kept into the
+// list while it grew).
+TEST(RendererRobotTest, ARobotOfSeveralMeshesIsDrawnTheSameFromItsFirstFrame) {
+  const scene::Level level =
+      scene::LoadLevel(std::filesystem::path(SANDBOX_SOURCE_DIR) / "assets/robots/robots.toml");
+  const scene::RobotModel* quad = nullptr;
+  for (const scene::RobotModel& robot : level.robots) {
+    if (robot.name == "QUAD") quad = &robot;
+  }
+  ASSERT_NE(quad, nullptr);
+  ASSERT_GT(quad->meshes.size(), 2u);
+  scene::RobotState state(*quad);
+  state.SetPose(Isometry3d(Eigen::Translation3d(0, 0, 100)));
+  state.Update();
+  CameraView view;
+  view.width = 160, view.height = 120;
+  view.X_WC = LookAt(Vector3d(0.5, 0, 100.6), Vector3d(0, 0, 100));  // 0.8 m from the 0.4 m quad
+  RenderSettings settings;
+  settings.images = kSegmentationImage;
+  auto renderer = MakeRenderer();
+  renderer->SetLevel(level, {});
+  Frame first, second;
+  renderer->Render(view, {}, {&state}, settings, &first);
+  renderer->Render(view, {}, {&state}, settings, &second);
+  const auto robot_pixels = std::count_if(first.segment.begin(), first.segment.end(),
+                                          [](std::uint32_t id) { return id != 0; });
+  // Body, arms and rotors: about 1,000 pixels at this distance (the arms 3 pixels wide).
+  EXPECT_GT(robot_pixels, 600);
+  EXPECT_EQ(first.segment, second.segment);
 }
 
 // The sample level with its wing mid-turn, as bench_render's looks show it.
