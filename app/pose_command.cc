@@ -26,7 +26,7 @@ const char* kUsage =
     "                    [--bones FILE|LIST] [--isolate] --out MESH.ply\n"
     "  LEVEL         a level manifest with [[robot]] tables (default: the sample level)\n"
     "  --robot       which robot (default: the first)\n"
-    "  --robot-pose  world position in metres, roll/pitch/yaw in degees (default: spawn pose)\n"
+    "  --robot-pose  world position in metres, roll/pitch/yaw in degrees (default: spawn pose)\n"
     "  --bones       bone values, entries 'BONE V1 [V2 ...]' separated by ';' or new lines,\n"
     "                BONE a name or bone-map index; angles in degrees, quaternions w x y z;\n"
     "                or a file with one entry a line ('#' starts a comment)\n"

@@ -494,6 +494,10 @@ AssimpScene ReadAssimpScene(Assimp::Importer& importer, const fs::path& file,
   return out;
 }
 
+std::string_view AssetReader(const fs::path& file) {
+  return FormatOf(file) == Format::kTerragen ? "the Terragen reader" : "assimp";
+}
+
 ImportedAsset ImportAsset(const fs::path& file, const AssetConversion& conversion,
                           const LoadLimits& limits) {
   CheckReadable(file, limits);

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "scene/imported_asset.h"
@@ -13,6 +14,10 @@
 #include "scene/placement.h"
 
 namespace sandbox::scene {
+
+// Which library ImportAsset reads `file` with: "assimp", or "the Terragen
+// reader" (for the messages of an isolated load, app/isolated_load.h).
+std::string_view AssetReader(const std::filesystem::path& file);
 
 // Reads a scene file with assimp (or a Terragen .ter terrain natively).
 // Throws LevelError naming the file when it is missing, not a regular file,

@@ -66,7 +66,7 @@ std::string AssetKey(const ActorSpec& spec) {
 // A scene file as a level: one actor per node with meshes, posed at the
 // node's rigid transform.
 Level LoadSceneFile(const fs::path& file, const LoadOptions& options) {
-  Reading(options, file, "assimp");
+  Reading(options, file, AssetReader(file));
   ImportedAsset asset = ImportAsset(file, options.conversion, options.limits);
   Level level;
   level.file = file;
@@ -103,7 +103,8 @@ Level LoadManifest(const fs::path& file, const LoadOptions& options) {
     auto read = read_once.find(AssetKey(spec));
     if (read == read_once.end()) {
       ImportedAsset asset;
-      Reading(options, spec.file, spec.is_heightmap ? "the heightmap reader (libpng)" : "assimp");
+      Reading(options, spec.file,
+              spec.is_heightmap ? "the heightmap reader (libpng)" : AssetReader(spec.file));
       try {
         asset = spec.is_heightmap
                     ? ImportHeightmapImage(spec.file, spec.heightmap_size_m, level.limits)
@@ -162,7 +163,7 @@ Level LoadManifest(const fs::path& file, const LoadOptions& options) {
     level.horizon->visibility_m = manifest.horizon->visibility_m;
   }
   for (const RobotSpec& spec : manifest.robots) {
-    Reading(options, spec.file, "assimp");
+    Reading(options, spec.file, AssetReader(spec.file));
     level.robots.push_back(LoadRobotModel(spec, file, &level));
     CheckTriangles(spec.file, level);
   }

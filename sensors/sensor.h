@@ -5,7 +5,7 @@
 // gives one output value, a SensorOutput. The bridge publishes any output
 // through one call (bridge::RobotOutputs::Publish).
 //
-// Adding a kind (docs/reference/sensors.md, "Adding a sensor"): its class (with Config,
+// Adding a kind (docs/how-to/add-a-sensor.md): its class (with Config,
 // Output, Run), then one line in each of the lists below, then its publish
 // function in bridge/outputs.cc.
 
