@@ -1,3 +1,5 @@
+// Over 600 lines: the engine that draws a frame as its passes, with the state those
+// passes share; everything it draws with is a part of its own beside it.
 // The OSMesa renderer: the level's meshes, robots, terrain and horizon drawn
 // by the parts beside this file, in a frame's passes (Render). Its parts:
 // gl_context (the context), gl_program and scene_programs (shaders),

@@ -1,3 +1,5 @@
+// Over 600 lines: the renderer's image tests, each on its own scene; split by
+// subject when it grows again.
 // The OSMesa renderer and the cameras: colours, depth against the ray caster,
 // textures (a generated quad, CesiumMan's embedded texture), the bent wing's silhouette, the chase
 // camera's aim and lag.
