@@ -14,8 +14,8 @@
 //     in the same run (ratio); the looks take turns a frame at a time.
 //
 //   bench_render [--seconds S] [--looks [--rounds N] [--only NAME]]
-//   (--looks: section 4 only; --only: the look of that row name alone, beside
-//   plain colour: a quick A/B or a profile of one look)
+//   (sections 1 to 3; --looks: section 4 alone; --only: the look of that row
+//   name alone, beside plain colour: a quick A/B or a profile of one look)
 
 #include <algorithm>
 #include <atomic>
