@@ -1,7 +1,6 @@
 #include "sensors/render/projection.h"
 
 #include <cmath>
-#include <limits>
 
 namespace sandbox::render {
 
@@ -32,12 +31,6 @@ double NearReach(const CameraView& view) {
 
 float PixelAngle(const CameraView& view) {
   return float(2.0 * std::tan(0.5 * view.fov_y_rad) / view.height);
-}
-
-float DepthToMetres(float depth, double near_m, double far_m) {
-  const float scale = float(far_m - near_m), numerator = float(near_m * far_m),
-              near = float(near_m);
-  return depth <= 0.f ? std::numeric_limits<float>::infinity() : numerator / (depth * scale + near);
 }
 
 bool InFrustum(const Eigen::Matrix4f& M, const Eigen::AlignedBox3f& box) {

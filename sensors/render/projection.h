@@ -6,6 +6,7 @@
 // kilometres). Clip space as glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE).
 
 #include <Eigen/Geometry>
+#include <limits>
 
 #include "sensors/render/view.h"
 
@@ -24,9 +25,21 @@ double NearReach(const CameraView& view);
 // The angle one pixel spans at the image's centre (radians, small angles).
 float PixelAngle(const CameraView& view);
 
-// A reversed depth-buffer value to the distance along the optical axis:
-// n f / (d (f - n) + n); 0 (nothing drawn) is infinity.
-float DepthToMetres(float depth, double near_m, double far_m);
+// Reversed depth-buffer values to distances along the optical axis:
+// n f / (d (f - n) + n); 0 (nothing drawn) is infinity. Inline: read-back
+// converts every pixel of a depth image.
+class ReversedDepth {
+ public:
+  ReversedDepth(double near_m, double far_m)
+      : scale_(float(far_m - near_m)), numerator_(float(near_m * far_m)), near_(float(near_m)) {}
+  float Metres(float depth) const {
+    return depth <= 0.f ? std::numeric_limits<float>::infinity()
+                        : numerator_ / (depth * scale_ + near_);
+  }
+
+ private:
+  float scale_, numerator_, near_;
+};
 
 // False when the box lies wholly outside one plane of the frustum of clip
 // matrix M (rows of M combined as in Gribb and Hartmann). Orthographic

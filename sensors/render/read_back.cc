@@ -12,10 +12,11 @@ void DepthImage(const std::vector<float>& depth, int width, int height, double n
                 std::vector<float>* depth_m) {
   const std::size_t w = std::size_t(width);
   depth_m->resize(w * std::size_t(height));
+  const ReversedDepth depth_to_m(near_m, far_m);
   FlipRows(height, [&](std::size_t from, std::size_t to) {
     const float* src = &depth[from * w];
     float* dst = &(*depth_m)[to * w];
-    for (std::size_t x = 0; x < w; ++x) dst[x] = DepthToMetres(src[x], near_m, far_m);
+    for (std::size_t x = 0; x < w; ++x) dst[x] = depth_to_m.Metres(src[x]);
   });
 }
 

@@ -68,9 +68,10 @@ TEST(ProjectionTest, ADepthReadBackIsTheDistanceItCameFrom) {
   const CameraView view = View();
   for (const double d : {0.5, 1.0, 37.5, 1999.0}) {
     const double depth = Ndc(view, view.X_WC.translation() + Eigen::Vector3d(0, d, 0)).z();
-    EXPECT_NEAR(DepthToMetres(float(depth), view.near_m, view.far_m), d, d * 1e-5) << d;
+    EXPECT_NEAR(ReversedDepth(view.near_m, view.far_m).Metres(float(depth)), d, d * 1e-5) << d;
   }
-  EXPECT_EQ(DepthToMetres(0.f, view.near_m, view.far_m), std::numeric_limits<float>::infinity());
+  EXPECT_EQ(ReversedDepth(view.near_m, view.far_m).Metres(0.f),
+            std::numeric_limits<float>::infinity());
 }
 
 TEST(ProjectionTest, ABoxOutsideOnePlaneIsOutsideTheFrustum) {
