@@ -27,7 +27,7 @@ void FrameTargets::Resize(int width, int height, int samples) {
   };
   auto check = [&](const char* what) {
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-      throw std::runtime_error(std::string("Renderer: ") + what + " framebuffer of " +
+      throw std::runtime_error(std::string("FrameTargets::Resize(): ") + what + " framebuffer of " +
                                std::to_string(width) + " x " + std::to_string(height) +
                                " is incomplete");
     }

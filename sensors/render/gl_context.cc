@@ -20,7 +20,7 @@ GlContext::GlContext() {
                             0};
   context_ = OSMesaCreateContextAttribs(attributes, nullptr);
   if (context_ == nullptr)
-    throw std::runtime_error("Renderer: cannot create an OSMesa GL 4.5 context");
+    throw std::runtime_error("GlContext::GlContext(): cannot create an OSMesa GL 4.5 context");
   backing_.resize(4);
   MakeCurrent();
   description_ = std::string("OpenGL ") + reinterpret_cast<const char*>(glGetString(GL_VERSION)) +
@@ -29,7 +29,7 @@ GlContext::GlContext() {
   clip_control_ = reinterpret_cast<PFNGLCLIPCONTROLPROC>(OSMesaGetProcAddress("glClipControl"));
   if (clip_control_ == nullptr) {
     OSMesaDestroyContext(context_);
-    throw std::runtime_error("Renderer: no glClipControl");
+    throw std::runtime_error("GlContext::GlContext(): no glClipControl");
   }
 }
 
@@ -38,7 +38,7 @@ GlContext::~GlContext() { OSMesaDestroyContext(context_); }
 void GlContext::MakeCurrent() {
   if (OSMesaGetCurrentContext() == context_) return;
   if (!OSMesaMakeCurrent(context_, backing_.data(), GL_UNSIGNED_BYTE, 1, 1)) {
-    throw std::runtime_error("Renderer: cannot make the OSMesa context current");
+    throw std::runtime_error("GlContext::MakeCurrent(): cannot make the OSMesa context current");
   }
 }
 

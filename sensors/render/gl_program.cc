@@ -18,7 +18,7 @@ GLuint Compile(GLenum type, const std::string& program, const std::string& sourc
     char log[4096];
     glGetShaderInfoLog(shader, sizeof(log), nullptr, log);
     glDeleteShader(shader);
-    throw std::runtime_error("Renderer: the " + program + " program's " +
+    throw std::runtime_error("GlProgram::GlProgram(): the " + program + " program's " +
                              (type == GL_VERTEX_SHADER ? "vertex" : "fragment") +
                              " shader does not compile: " + log);
   }
@@ -65,7 +65,7 @@ GlProgram::GlProgram(std::string name, const std::string& vertex, const std::str
   if (!ok) {
     char log[4096];
     glGetProgramInfoLog(id_, sizeof(log), nullptr, log);
-    throw std::runtime_error("Renderer: the " + name_ + " program does not link: " + log);
+    throw std::runtime_error("GlProgram::GlProgram(): the " + name_ + " program does not link: " + log);
   }
   declared_ = DeclaredUniforms(vertex);
   declared_.merge(DeclaredUniforms(fragment));
@@ -75,7 +75,7 @@ GLint GlProgram::Uniform(const std::string& name) {
   const auto found = locations_.find(name);
   if (found != locations_.end()) return found->second;
   if (!declared_.count(name.substr(0, name.find('[')))) {
-    throw std::logic_error("Renderer: the " + name_ + " program declares no uniform '" + name +
+    throw std::logic_error("GlProgram::Uniform(): the " + name_ + " program declares no uniform '" + name +
                            "'");
   }
   return locations_[name] = glGetUniformLocation(id_, name.c_str());

@@ -25,7 +25,7 @@ class GlProgram {
   // The location of the uniform `name` ("shadow_clip[1]": an array's
   // element). -1 when the sources declare it but the compiler left it out
   // (unused in this variant): setting it does nothing. Throws
-  // std::logic_error "Renderer: the NAME program declares no uniform 'x'"
+  // std::logic_error "GlProgram::Uniform(): the NAME program declares no uniform 'x'"
   // when no source declares it.
   GLint Uniform(const std::string& name);
 

@@ -132,11 +132,11 @@ class OsMesaRenderer : public Renderer {
     view.ValidateOrThrow();
     if (overlay != nullptr && (overlay->point_rgb.size() != overlay->points_W.size() ||
                                overlay->line_rgb.size() * 2 != overlay->lines_W.size())) {
-      throw std::invalid_argument("Renderer: an overlay needs one colour per point and per line");
+      throw std::invalid_argument("Renderer::Render(): an overlay needs one colour per point and per line");
     }
     settings.ValidateOrThrow();
     if (settings.anisotropy > max_anisotropy_) {
-      throw std::invalid_argument("Renderer: anisotropy " + std::to_string(settings.anisotropy) +
+      throw std::invalid_argument("Renderer::Render(): anisotropy " + std::to_string(settings.anisotropy) +
                                   " is beyond this GL's " + std::to_string(int(max_anisotropy_)));
     }
     const FramePlan plan = Plan(settings, overlay);

@@ -98,7 +98,7 @@ struct RenderSettings {
     std::string field, why;
   };
   std::optional<Problem> FindProblem() const;
-  // Throws std::invalid_argument "RenderSettings: 'field' why". The renderer
+  // Throws std::invalid_argument "RenderSettings::ValidateOrThrow(): 'field' why". The renderer
   // calls it for every frame: it fixes no setting itself.
   void ValidateOrThrow() const;
 };

@@ -44,7 +44,7 @@ TEST(GlProgramTest, AnUndeclaredUniformThrowsNamingProgramAndUniform) {
     program.Uniform("tnit");
     FAIL() << "a misspelt uniform was looked up";
   } catch (const std::logic_error& e) {
-    EXPECT_STREQ(e.what(), "Renderer: the test program declares no uniform 'tnit'");
+    EXPECT_STREQ(e.what(), "GlProgram::Uniform(): the test program declares no uniform 'tnit'");
   }
   EXPECT_THROW(program.Uniform("commented_out"), std::logic_error);
 }
