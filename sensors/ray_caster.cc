@@ -1,5 +1,3 @@
-// Over 600 lines: the caster and its packet walks are one unit until issue 38 splits
-// them into per-instruction-set kernels.
 #include "sensors/ray_caster.h"
 
 #include <Eigen/Geometry>
@@ -7,272 +5,61 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <iostream>
 #include <limits>
 #include <stdexcept>
 #include <string>
 
-#if defined(__SSE2__)
-#include <immintrin.h>
-#endif
-
 #include "scene/collision_world_internal.h"
+#include "sensors/lanes4.h"
+#include "sensors/ray_kernels.h"
 #include "sensors/walk_stack.h"
 
 namespace sandbox::sensors {
 namespace {
 
 constexpr int kRaysPerChunk = 256;
-constexpr int kStackInPlace = RayCaster::kStackInPlace;
 
-// One Bullet object as a ray sees it: where it is, its BVH nodes and triangles.
-struct Target {
-  int body{-1};
-  std::uint32_t group{0};  // the object's collision group (scene::kWorldStatic, ...)
-  // The box around this object and the other objects of its body next to it
-  // in the list (a robot's pieces): a packet that misses it skips them all.
-  Eigen::Vector3f body_min{Eigen::Vector3f::Zero()}, body_max{Eigen::Vector3f::Zero()};
-  Eigen::Vector3f aabb_min, aabb_max;  // in the Bullet frame (world minus origin)
-  Eigen::Matrix3f R_LB;                // local from Bullet frame
-  Eigen::Vector3f p_LB;
-  btTransform X_BL;      // Bullet frame from local: where triangles are tested
-  bool identity{false};  // X_BL is exactly the identity
-  const btQuantizedBvhNode* nodes{nullptr};
-  Eigen::Vector3f bvh_min, quantization;  // quantized = (local - bvh_min) * quantization
-  // The object's own hierarchy (local frame), and how far its boxes are grown
-  // for the rounding of rays taken into that frame.
-  const scene::TriangleBvh* bvh{nullptr};
-  float box_margin{0.f};
-  // The merged static objects' target (scene::MergedStatic) has a body per
-  // leaf part (BodyOf); any other, its one body.
-  const std::int32_t* body_of_part{nullptr};
-  int BodyOf(int part) const { return body_of_part != nullptr ? body_of_part[part] : body; }
-  struct Part {
-    const unsigned char* vertices;
-    int vertex_stride;
-    const unsigned char* indices;
-    int index_stride;
-  };
-  std::vector<Part> parts;
+// A packet kernel (sensors/ray_kernels.h).
+struct Kernel {
+  const char* name;
+  CastRaysKernel cast_rays;
+  HitPairsKernel hit_pairs;
 };
 
-Eigen::Vector3f ToEigen(const btVector3& v) { return {float(v.x()), float(v.y()), float(v.z())}; }
-
-// The margin of a target's boxes: a few thousand ulps of the coordinates
-// involved (the boxes' and the placement's).
-float BoxMargin(const scene::TriangleBvh& bvh, const Eigen::Vector3f& p_LB,
-                const Eigen::Vector3f& p_BL) {
-  const float scale = std::max({bvh.lower.cwiseAbs().maxCoeff(), bvh.upper.cwiseAbs().maxCoeff(),
-                                p_LB.cwiseAbs().maxCoeff(), p_BL.cwiseAbs().maxCoeff()});
-  return 1e-5f * scale + 1e-6f;
-}
-
-// The target of the world's merged static objects, placed for the world's
-// origin now (its corners are where Bullet placed them at the origin it was
-// built at: a whole-metre shift moves them as a translation).
-Target MergedTarget(const scene::CollisionWorld& world) {
-  const scene::MergedStatic& merged = world.internals().merged_static;
-  Target t;
-  t.body = -2;  // none: each lane's is BodyOf its part
-  t.group = scene::kWorldStatic;
-  t.bvh = merged.bvh.get();
-  t.body_of_part = merged.body_of_part.data();
-  const btVector3 offset = scene::ToBullet(merged.p_WO - world.origin());
-  t.X_BL.setIdentity();
-  t.X_BL.setOrigin(offset);
-  t.identity = offset == btVector3(0, 0, 0);
-  t.R_LB.setIdentity();
-  t.p_LB = -ToEigen(offset);
-  t.box_margin = BoxMargin(*t.bvh, t.p_LB, ToEigen(offset));
-  t.aabb_min = t.bvh->lower - t.p_LB - Eigen::Vector3f::Constant(t.box_margin);
-  t.aabb_max = t.bvh->upper - t.p_LB + Eigen::Vector3f::Constant(t.box_margin);
-  t.body_min = t.aabb_min, t.body_max = t.aabb_max;
-  return t;
-}
-
-// Every object of the world, in the world's order (a body's objects next to
-// each other), with the boxes around each run of one body's objects.
-std::vector<Target> CollectTargets(const scene::CollisionWorld& world) {
-  const scene::CollisionWorld::Impl& w = world.internals();
-  std::vector<Target> targets;
-  for (const scene::MeshObject& object : w.objects) {
-    const btCollisionObject& o = *object.object;
-    Target t;
-    t.body = o.getUserIndex();
-    t.group = static_cast<std::uint32_t>(o.getBroadphaseHandle()->m_collisionFilterGroup);
-    t.aabb_min = ToEigen(o.getBroadphaseHandle()->m_aabbMin);
-    t.aabb_max = ToEigen(o.getBroadphaseHandle()->m_aabbMax);
-    const btTransform& X = o.getWorldTransform();
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) t.R_LB(c, r) = float(X.getBasis()[r][c]);
+// The widest kernel the CPU runs, or the one SANDBOX_RAY_KERNEL names (tests
+// run each; the results are the same). A name the CPU cannot run, or no
+// kernel's, is said on stderr and the widest taken.
+const Kernel& ChosenKernel() {
+  static const Kernel chosen = [] {
+    const bool fma = __builtin_cpu_supports("fma");
+    const bool avx512 =
+        fma && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
+    const struct {
+      Kernel kernel;
+      bool runs;
+    } kernels[] = {{{"avx512", avx512::CastRays, avx512::HitPairs}, avx512},
+                   {{"fma", fma::CastRays, fma::HitPairs}, fma},
+                   {{"sse2", sse2::CastRays, sse2::HitPairs}, true}};
+    const char* asked = std::getenv("SANDBOX_RAY_KERNEL");
+    if (asked != nullptr && *asked != '\0') {
+      for (const auto& k : kernels) {
+        if (std::string(asked) != k.kernel.name) continue;
+        if (k.runs) return k.kernel;
+        std::cerr << "RayCaster::kernel(): SANDBOX_RAY_KERNEL=" << asked
+                  << ": this CPU cannot run that kernel; using the widest it can\n";
+      }
+      if (std::string(asked) != "avx512") {
+        std::cerr << "RayCaster::kernel(): SANDBOX_RAY_KERNEL=" << asked
+                  << " is no kernel (avx512, fma, sse2); using the widest this CPU runs\n";
+      }
     }
-    t.X_BL = X;
-    t.identity = X.getBasis() == btMatrix3x3::getIdentity() && X.getOrigin() == btVector3(0, 0, 0);
-    t.p_LB = -(t.R_LB * ToEigen(X.getOrigin()));
-    btQuantizedBvh* bvh = object.shape->getOptimizedBvh();
-    t.nodes = &bvh->getQuantizedNodeArray()[0];
-    // Quantization from the two ends of the range: one quantum apart would
-    // lose the scale to float rounding.
-    const unsigned short zero[3] = {0, 0, 0}, top[3] = {65534, 65534, 65534};
-    t.bvh_min = ToEigen(bvh->unQuantize(zero));
-    t.quantization = 65534.0f * (ToEigen(bvh->unQuantize(top)) - t.bvh_min).cwiseInverse();
-    t.bvh = object.bvh.get();
-    if (t.bvh == nullptr) throw std::logic_error("RayCaster: an object without its hierarchy");
-    t.box_margin = BoxMargin(*t.bvh, t.p_LB, ToEigen(X.getOrigin()));
-    const IndexedMeshArray& meshes = object.mesh_interface->getIndexedMeshArray();
-    for (int m = 0; m < meshes.size(); ++m) {
-      t.parts.push_back({meshes[m].m_vertexBase, meshes[m].m_vertexStride,
-                         meshes[m].m_triangleIndexBase, meshes[m].m_triangleIndexStride});
+    for (const auto& k : kernels) {
+      if (k.runs) return k.kernel;
     }
-    targets.push_back(std::move(t));
-  }
-  for (std::size_t first = 0, end = 0; first < targets.size(); first = end) {
-    Eigen::Vector3f lo = targets[first].aabb_min, hi = targets[first].aabb_max;
-    for (end = first + 1; end < targets.size() && targets[end].body == targets[first].body; ++end) {
-      lo = lo.cwiseMin(targets[end].aabb_min), hi = hi.cwiseMax(targets[end].aabb_max);
-    }
-    for (std::size_t t = first; t < end; ++t) targets[t].body_min = lo, targets[t].body_max = hi;
-  }
-  return targets;
-}
-
-// Entry distance of a ray into a quantized box (grown by one quantum against
-// rounding), or +inf when it misses or enters beyond t_max.
-inline float EnterBox(const btQuantizedBvhNode& node, const Eigen::Vector3f& qo,
-                      const Eigen::Vector3f& inverse, float t_max) {
-  float t_enter = 0.0f, t_exit = t_max;
-  for (int k = 0; k < 3; ++k) {
-    const float t1 = (float(node.m_quantizedAabbMin[k]) - 1.0f - qo[k]) * inverse[k];
-    const float t2 = (float(node.m_quantizedAabbMax[k]) + 1.0f - qo[k]) * inverse[k];
-    t_enter = std::max(t_enter, std::min(t1, t2));
-    t_exit = std::min(t_exit, std::max(t1, t2));
-  }
-  return t_enter <= t_exit ? t_enter : std::numeric_limits<float>::infinity();
-}
-
-// A triangle's corners in the Bullet frame, transformed as Bullet transforms
-// points (so that any caster fed Bullet's world triangles sees the same ones).
-inline void Corners(const Target& target, int part_id, int triangle, Eigen::Vector3f corner[3]) {
-  const Target::Part& part = target.parts[static_cast<std::size_t>(part_id)];
-  const auto* index = reinterpret_cast<const std::uint32_t*>(
-      part.indices + std::ptrdiff_t(triangle) * part.index_stride);
-  for (int k = 0; k < 3; ++k) {
-    const auto* p = reinterpret_cast<const float*>(part.vertices +
-                                                   std::ptrdiff_t(index[k]) * part.vertex_stride);
-    if (target.identity) {
-      corner[k] = Eigen::Vector3f(p[0], p[1], p[2]);
-    } else {
-      corner[k] = ToEigen(target.X_BL * btVector3(p[0], p[1], p[2]));
-    }
-  }
-}
-
-// The triangle normal from its edges (e0 + e1 + e2 = 0), each component
-// from whichever of e0 x e1 and e1 x e2 suffers less cancellation.
-inline Eigen::Vector3f StableNormal(const Eigen::Vector3f& a, const Eigen::Vector3f& b,
-                                    const Eigen::Vector3f& c) {
-  const float ab_x = a.z() * b.y(), ab_y = a.x() * b.z(), ab_z = a.y() * b.x();
-  const float bc_x = b.z() * c.y(), bc_y = b.x() * c.z(), bc_z = b.y() * c.x();
-  return {std::abs(ab_x) < std::abs(bc_x) ? a.y() * b.z() - ab_x : b.y() * c.z() - bc_x,
-          std::abs(ab_y) < std::abs(bc_y) ? a.z() * b.x() - ab_y : b.z() * c.x() - bc_y,
-          std::abs(ab_z) < std::abs(bc_z) ? a.x() * b.y() - ab_z : b.x() * c.y() - bc_z};
-}
-
-// Whether the ray, up to t, meets the triangle's own bounding box (with two
-// ulps of slack on the distances). A hit the edge test admits within its
-// rounding tolerance but that lies outside the triangle's box is no hit: a ray
-// passing a hair outside an outer edge misses, as a watertight caster's box
-// test has it. A direction component of exactly 0 counts as an
-// infinitesimally positive one (Embree's convention): a ray running along the
-// box's upper bound on that axis leaves the box at once, along its lower bound
-// stays in it; of two surfaces that abut there without sharing an edge, the
-// ray meets exactly one.
-constexpr float kHuge = 1e30f;
-
-inline bool MeetsCornerBox(const Eigen::Vector3f corner[3], const Eigen::Vector3f& o,
-                           const Eigen::Vector3f& d, float t) {
-  float t_enter = 0.0f, t_exit = t;
-  for (int k = 0; k < 3; ++k) {
-    const float lo = std::min({corner[0][k], corner[1][k], corner[2][k]});
-    const float hi = std::max({corner[0][k], corner[1][k], corner[2][k]});
-    // A zero component counts as an infinitesimally positive one.
-    const float inverse = d[k] == 0.0f ? kHuge : 1.0f / d[k];
-    const float t1 = (lo - o[k]) * inverse, t2 = (hi - o[k]) * inverse;
-    t_enter = std::max(t_enter, std::min(t1, t2));
-    t_exit = std::min(t_exit, std::max(t1, t2));
-  }
-  constexpr float kSlack = 2.0f * std::numeric_limits<float>::epsilon();
-  return t_enter * (1.0f - kSlack) <= t_exit * (1.0f + kSlack);
-}
-
-// The watertight ray-triangle test (docs/reference/sensors.md, "Grazing and origin
-// rules"): corners relative to the ray origin, a signed edge function per edge
-// (the same value, negated, for the neighbour sharing the edge), both faces.
-// A ray parallel to the plane (in it or not) misses; one whose origin lies on
-// the triangle hits at 0. Updates t_max and the normal on a closer hit.
-inline bool HitTriangle(const Target& target, int part_id, int triangle, const Eigen::Vector3f& o,
-                        const Eigen::Vector3f& d, float* t_max, Eigen::Vector3f* normal) {
-  Eigen::Vector3f corner[3];
-  Corners(target, part_id, triangle, corner);
-  const Eigen::Vector3f v0 = corner[0] - o, v1 = corner[1] - o, v2 = corner[2] - o;
-  const Eigen::Vector3f e0 = v2 - v0, e1 = v0 - v1, e2 = v1 - v2;
-  const float u = e0.cross(v2 + v0).dot(d);
-  const float v = e1.cross(v0 + v1).dot(d);
-  const float w = e2.cross(v1 + v2).dot(d);
-  const float eps = std::numeric_limits<float>::epsilon() * std::abs(u + v + w);
-  const bool inside = std::min({u, v, w}) >= -eps || std::max({u, v, w}) <= eps;
-  if (!inside) return false;
-  const Eigen::Vector3f n = StableNormal(e0, e1, e2);
-  const float den = 2.0f * n.dot(d);
-  if (den == 0.0f) return false;
-  const float t = 2.0f * v0.dot(n) / den;
-  if (!(t >= 0.0f && t < *t_max)) return false;
-  if (!MeetsCornerBox(corner, o, d, t)) return false;
-  *t_max = t;
-  *normal = n;
-  return true;
-}
-
-// Nearest-first walk of one object's quantized BVH, shortening the ray at
-// every hit. Returns true when the object holds a hit closer than *t_max.
-bool WalkTarget(const Target& target, const Eigen::Vector3f& o_B, const Eigen::Vector3f& d_B,
-                float* t_max, Eigen::Vector3f* normal_B) {
-  const Eigen::Vector3f o = target.R_LB * o_B + target.p_LB;
-  const Eigen::Vector3f d = target.R_LB * d_B;
-  const Eigen::Vector3f qo = (o - target.bvh_min).cwiseProduct(target.quantization);
-  Eigen::Vector3f inverse;
-  for (int k = 0; k < 3; ++k) {
-    const float qd = d[k] * target.quantization[k];
-    inverse[k] = 1.0f / (std::abs(qd) > 1e-30f ? qd : std::copysign(1e-30f, qd));
-  }
-  struct Entry {
-    int node;
-    float t_enter;
-  };
-  WalkStack<Entry, kStackInPlace> stack;
-  bool hit = false;
-  const btQuantizedBvhNode* nodes = target.nodes;
-  if (EnterBox(nodes[0], qo, inverse, *t_max) <= *t_max) stack.Push({0, 0.0f});
-  while (!stack.empty()) {
-    const Entry entry = stack.Pop();
-    if (entry.t_enter > *t_max) continue;
-    const btQuantizedBvhNode& node = nodes[entry.node];
-    if (node.isLeafNode()) {
-      const int packed = node.m_escapeIndexOrTriangleIndex;
-      hit |= HitTriangle(target, packed >> 21, packed & ((1 << 21) - 1), o_B, d_B, t_max, normal_B);
-      continue;
-    }
-    const int left = entry.node + 1;
-    const int right = left + (nodes[left].isLeafNode() ? 1 : nodes[left].getEscapeIndex());
-    const float t_left = EnterBox(nodes[left], qo, inverse, *t_max);
-    const float t_right = EnterBox(nodes[right], qo, inverse, *t_max);
-    // Push the far child first so that the near one is walked first.
-    const bool left_first = t_left <= t_right;
-    const Entry near_child = left_first ? Entry{left, t_left} : Entry{right, t_right};
-    const Entry far_child = left_first ? Entry{right, t_right} : Entry{left, t_left};
-    if (std::isfinite(far_child.t_enter)) stack.Push(far_child);
-    if (std::isfinite(near_child.t_enter)) stack.Push(near_child);
-  }
-  return hit;
+    return kernels[2].kernel;
+  }();
+  return chosen;
 }
 
 // Sizes `hits` for n rays (normals only when asked for).
@@ -293,204 +80,26 @@ struct Visible {
   }
 };
 
-// Ray r's result: its distance, the body hit and, when asked for, the unit
-// normal facing the ray (zero without a hit).
-inline void WriteHit(std::size_t r, float t, int body, const Eigen::Vector3f& normal,
-                     const Eigen::Vector3f& direction, RayHits* hits) {
-  hits->distance_m[r] = t;
-  hits->body[r] = body;
-  if (!hits->with_normals) return;
-  if (body == RayHits::kNoHit) {
-    hits->normal_W[r].setZero();
-    return;
+// The objects of `seen` whose boxes meet the box around rays [first, end),
+// into `near` (a run of one body's objects stays a run).
+void TargetsNear(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t first,
+                 std::size_t end, const std::vector<const Target*>& seen,
+                 std::vector<const Target*>* near) {
+  Eigen::Vector3f chunk_min = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
+  Eigen::Vector3f chunk_max = -chunk_min;
+  for (std::size_t r = first; r < end; ++r) {
+    const Eigen::Vector3f a = origin_B + rays.start[r];
+    const Eigen::Vector3f b = a + rays.length_m[r] * rays.direction[r];
+    chunk_min = chunk_min.cwiseMin(a.cwiseMin(b));
+    chunk_max = chunk_max.cwiseMax(a.cwiseMax(b));
   }
-  const Eigen::Vector3f unit = normal.normalized();
-  hits->normal_W[r] = unit.dot(direction) > 0.0f ? -unit : unit;
-}
-
-// Whether the ray enters an axis-aligned box before t_max.
-inline bool RayMeetsBox(const Eigen::Vector3f& o, const Eigen::Vector3f& inverse_d,
-                        const Eigen::Vector3f& lo, const Eigen::Vector3f& hi, float t_max) {
-  float t_enter = 0.0f, t_exit = t_max;
-  for (int k = 0; k < 3; ++k) {
-    const float t1 = (lo[k] - o[k]) * inverse_d[k], t2 = (hi[k] - o[k]) * inverse_d[k];
-    t_enter = std::max(t_enter, std::min(t1, t2));
-    t_exit = std::min(t_exit, std::max(t1, t2));
-  }
-  return t_enter <= t_exit;
-}
-
-#if defined(__SSE2__)
-// Four rays walked together (SSE2): a node is visited when any of them
-// enters it, and every test is done for the four at once. Rays of a sensor
-// are coherent (neighbouring beams or grid points), so the four mostly agree.
-struct Packet {
-  __m128 ox, oy, oz, dx, dy, dz;  // Bullet frame
-  __m128 t_max;                   // per lane
-  __m128 active;                  // all bits set in lanes that hold a ray
-  int body[4];
-  Eigen::Vector3f normal[4];  // in the Bullet frame, unnormalised
-};
-
-inline __m128 AwayFromZero(__m128 x) {
-  const __m128 sign = _mm_and_ps(x, _mm_set1_ps(-0.0f));
-  const __m128 magnitude = _mm_max_ps(_mm_andnot_ps(_mm_set1_ps(-0.0f), x), _mm_set1_ps(1e-30f));
-  return _mm_or_ps(magnitude, sign);
-}
-
-inline __m128 Mul(__m128 a, __m128 b) { return _mm_mul_ps(a, b); }
-inline __m128 Add(__m128 a, __m128 b) { return _mm_add_ps(a, b); }
-inline __m128 Sub(__m128 a, __m128 b) { return _mm_sub_ps(a, b); }
-
-struct Vec4 {  // a vector per lane
-  __m128 x, y, z;
-};
-inline Vec4 Sub(const Vec4& a, const Vec4& b) {
-  return {Sub(a.x, b.x), Sub(a.y, b.y), Sub(a.z, b.z)};
-}
-inline Vec4 Add(const Vec4& a, const Vec4& b) {
-  return {Add(a.x, b.x), Add(a.y, b.y), Add(a.z, b.z)};
-}
-inline __m128 Abs(__m128 x) { return _mm_andnot_ps(_mm_set1_ps(-0.0f), x); }
-inline __m128 L1(const Vec4& a) { return Add(Add(Abs(a.x), Abs(a.y)), Abs(a.z)); }
-// The lanes whose bits are set in `bits` (a movemask), all bits set.
-inline __m128 LaneMask(int bits) {
-  const __m128i bit = _mm_setr_epi32(1, 2, 4, 8);
-  return _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(bits), bit), bit));
-}
-inline __m128 Select(__m128 mask, __m128 a, __m128 b) {
-  return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
-}
-// MeetsCornerBox, per lane, for the boxes [low, high] around each lane's corners.
-inline __m128 MeetsCornerBox4(const Vec4& low, const Vec4& high, const Vec4& o, const Vec4& d,
-                              __m128 t) {
-  const __m128 origin[3] = {o.x, o.y, o.z}, direction[3] = {d.x, d.y, d.z};
-  const __m128 lo[3] = {low.x, low.y, low.z}, hi[3] = {high.x, high.y, high.z};
-  __m128 t_enter = _mm_setzero_ps(), t_exit = t;
-  for (int k = 0; k < 3; ++k) {
-    // A zero component counts as an infinitesimally positive one.
-    const __m128 zero = _mm_cmpeq_ps(direction[k], _mm_setzero_ps());
-    const __m128 inverse =
-        Select(zero, _mm_set1_ps(kHuge), _mm_div_ps(_mm_set1_ps(1.0f), direction[k]));
-    const __m128 t1 = Mul(Sub(lo[k], origin[k]), inverse);
-    const __m128 t2 = Mul(Sub(hi[k], origin[k]), inverse);
-    t_enter = _mm_max_ps(t_enter, _mm_min_ps(t1, t2));
-    t_exit = _mm_min_ps(t_exit, _mm_max_ps(t1, t2));
-  }
-  const float slack = 2.0f * std::numeric_limits<float>::epsilon();
-  return _mm_cmple_ps(Mul(t_enter, _mm_set1_ps(1.0f - slack)),
-                      Mul(t_exit, _mm_set1_ps(1.0f + slack)));
-}
-
-// The rays of a band of rows of one grid block (RayGrid), as the structured
-// kernel reads them: origins in the Bullet frame and results, indexed by cell
-// (a band's ray from its first).
-struct GridBand {
-  __m128 dx, dy, dz;                      // the block's direction
-  __m128 ox, oy, oz;                      // the batch origin (a ray starts at it plus its start)
-  const Eigen::Vector3f* start{nullptr};  // the cells' rays' starts
-  float* t_max{nullptr};                  // their entries of RayHits::distance_m
-  std::int32_t* body{nullptr};            // of RayHits::body
-  Eigen::Vector3f* normal{nullptr};       // unnormalised, or null: none asked for
-  std::vector<Eigen::Vector3f> normals;   // their storage
-  // Triangle-ray pairs waiting for a test (HitPairs), in lanes' order.
-  struct Pairs {
-    static constexpr int kCapacity = 64;
-    int count{0};
-    alignas(16) float corner[9][kCapacity];  // x, y, z of corner 0, 1, 2
-    alignas(16) float near[kCapacity];
-    int cell[kCapacity], body[kCapacity];
-  } pairs;
-
-  // Queues the triangle with these corners against ray `cell`; tests the
-  // queue when full (test: HitPairs of the kernel in use).
-  template <typename Test>
-  void Add(const Eigen::Vector3f corner[3], int body_id, int cell_index, float near_depth,
-           Test test) {
-    const int k = pairs.count++;
-    for (int j = 0; j < 3; ++j) {
-      for (int a = 0; a < 3; ++a) pairs.corner[3 * j + a][k] = corner[j][a];
+  near->clear();
+  for (const Target* target : seen) {
+    if ((target->aabb_min.array() > chunk_max.array()).any() ||
+        (target->aabb_max.array() < chunk_min.array()).any()) {
+      continue;
     }
-    pairs.near[k] = near_depth;
-    pairs.cell[k] = cell_index;
-    pairs.body[k] = body_id;
-    if (pairs.count == Pairs::kCapacity) test(this);
-  }
-};
-
-// The packet's BVH walk and triangle test (sensors/packet_walk.inc), compiled twice:
-// for any SSE2 CPU, in plain arithmetic redone fused (emulated) where
-// rounding could turn a decision; and for CPUs with an FMA unit, fused
-// throughout. Fused multiply-adds are what Embree's kernels use on such CPUs,
-// the reference the grazing rules are matched to; both give the same results
-// but for the emulation's rare double rounding (see FusedMulAdd).
-namespace sse2_kernel {
-// a b + c (or a b - c) rounded once: the product of two floats is exact in
-// double, so only the sum rounds, to double and then to float (a double
-// rounding that differs from a single one needs a tie at float precision
-// after rounding to double: about once in 2^29 operations).
-inline __m128 FusedMulAdd(__m128 a, __m128 b, __m128 c, bool subtract) {
-  const __m128d a_lo = _mm_cvtps_pd(a), b_lo = _mm_cvtps_pd(b), c_lo = _mm_cvtps_pd(c);
-  const __m128d a_hi = _mm_cvtps_pd(_mm_movehl_ps(a, a)), b_hi = _mm_cvtps_pd(_mm_movehl_ps(b, b));
-  const __m128d c_hi = _mm_cvtps_pd(_mm_movehl_ps(c, c));
-  const __m128d lo = subtract ? _mm_sub_pd(_mm_mul_pd(a_lo, b_lo), c_lo)
-                              : _mm_add_pd(_mm_mul_pd(a_lo, b_lo), c_lo);
-  const __m128d hi = subtract ? _mm_sub_pd(_mm_mul_pd(a_hi, b_hi), c_hi)
-                              : _mm_add_pd(_mm_mul_pd(a_hi, b_hi), c_hi);
-  return _mm_movelh_ps(_mm_cvtpd_ps(lo), _mm_cvtpd_ps(hi));
-}
-constexpr bool kPlainFirst = true;
-#define SANDBOX_KERNEL_TARGET
-#include "sensors/packet_walk.inc"
-#undef SANDBOX_KERNEL_TARGET
-}  // namespace sse2_kernel
-
-namespace fma_kernel {
-__attribute__((target("fma"))) inline __m128 FusedMulAdd(__m128 a, __m128 b, __m128 c,
-                                                         bool subtract) {
-  return subtract ? _mm_fmsub_ps(a, b, c) : _mm_fmadd_ps(a, b, c);
-}
-constexpr bool kPlainFirst = false;
-#define SANDBOX_KERNEL_TARGET __attribute__((target("fma")))
-#include "sensors/packet_walk.inc"
-#undef SANDBOX_KERNEL_TARGET
-}  // namespace fma_kernel
-
-namespace avx512_kernel {
-#include "sensors/packet_walk16.inc"
-}  // namespace avx512_kernel
-
-// The FMA kernel where the CPU has the unit, unless SANDBOX_RAY_KERNEL=sse2
-// asks for the portable one; Cast()'s packets of sixteen rays (and the
-// structured kernels' sixteen pairs a test) where it has AVX-512 too, unless
-// SANDBOX_RAY_KERNEL=fma or sse2 asks for packets of four (tests run each;
-// the results are the same).
-const bool kHasFma = [] {
-  const char* kernel = std::getenv("SANDBOX_RAY_KERNEL");
-  return __builtin_cpu_supports("fma") && !(kernel != nullptr && std::string(kernel) == "sse2");
-}();
-const bool kHasAvx512 = [] {
-  const char* kernel = std::getenv("SANDBOX_RAY_KERNEL");
-  return kHasFma && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
-         !(kernel != nullptr && std::string(kernel) == "fma");
-}();
-
-// The object's own hierarchy (every object has one: CollectTargets).
-inline void WalkWide4(const Target& target, Packet* packet) {
-  if (kHasFma) {
-    fma_kernel::WalkWide4(target, packet);
-  } else {
-    sse2_kernel::WalkWide4(target, packet);
-  }
-}
-
-inline void HitPairs(GridBand* band) {
-  if (kHasAvx512) {
-    avx512_kernel::HitPairs16(band);
-  } else if (kHasFma) {
-    fma_kernel::HitPairs(band);
-  } else {
-    sse2_kernel::HitPairs(band);
+    near->push_back(target);
   }
 }
 
@@ -662,20 +271,227 @@ void ForEachTriangleOverGridWide(const Target& target, const GridCull& cull, Vis
   }
 }
 
-// Lanes whose rays enter an axis-aligned box (Bullet frame) before their t_max.
-inline int PacketMeetsBox(const Packet& packet, const __m128 inverse[3],
-                          const Eigen::Vector3f& box_min, const Eigen::Vector3f& box_max) {
-  const __m128 o[3] = {packet.ox, packet.oy, packet.oz};
-  __m128 t_enter = _mm_setzero_ps(), t_exit = packet.t_max;
-  for (int k = 0; k < 3; ++k) {
-    const __m128 t1 = Mul(Sub(_mm_set1_ps(box_min[k]), o[k]), inverse[k]);
-    const __m128 t2 = Mul(Sub(_mm_set1_ps(box_max[k]), o[k]), inverse[k]);
-    t_enter = _mm_max_ps(t_enter, _mm_min_ps(t1, t2));
-    t_exit = _mm_min_ps(t_exit, _mm_max_ps(t1, t2));
+// One band of rows of one grid block: CastGrids()'s unit of work.
+struct BandJob {
+  const RayGrid* grid;
+  int block, row_begin, row_end;
+  double cost;
+};
+
+// A band's place in the Bullet frame, in the grid's coordinates (BandFrame),
+// with the box around its rays and the bounds a triangle's cells must meet.
+struct BandArea {
+  int rows, cols;
+  BandFrame frame;
+  Eigen::Vector3d corner, to_column, to_row, direction;
+  double margin, margin_columns, margin_rows;
+  Eigen::Vector3f box_min, box_max;
+  // Per lane (column, row, depth): the margins, and the bounds of the cells'
+  // columns and rows and of the rays' depths (the fourth lane: none).
+  __m128 lane_margins, cap, top;
+};
+
+// The band's area. The margin covers the float rounding of the rays' origins
+// and of the triangle test's tolerance.
+BandArea AreaOf(const BandJob& band, const Eigen::Vector3d& world_origin) {
+  const RayGrid& grid = *band.grid;
+  const int rows = band.row_end - band.row_begin, cols = grid.cols;
+  const float length = grid.length_m;
+  // A point's column is (p - corner) . to_column, its row (p - corner) .
+  // to_row, its depth along the rays (p - corner) . direction.
+  const Eigen::Vector3d corner = grid.corner_W - world_origin + band.row_begin * grid.step_v_W;
+  const double step_u = grid.step_u_W.norm(), step_v = grid.step_v_W.norm();
+  const Eigen::Vector3d to_column = grid.step_u_W / (step_u * step_u);
+  const Eigen::Vector3d to_row = grid.step_v_W / (step_v * step_v);
+  const Eigen::Vector3d direction = grid.direction.cast<double>();
+  const double margin =
+      1e-5 * (corner.norm() + cols * step_u + rows * step_v + double(length)) + 1e-5;
+  const double margin_columns = margin / step_u, margin_rows = margin / step_v;
+  Eigen::AlignedBox3d box;
+  for (const double u : {-margin_columns, cols - 1 + margin_columns}) {
+    for (const double v : {-margin_rows, rows - 1 + margin_rows}) {
+      for (const double s : {-margin, double(length) + margin}) {
+        box.extend(corner + u * grid.step_u_W + v * grid.step_v_W + s * direction);
+      }
+    }
   }
-  return _mm_movemask_ps(_mm_and_ps(packet.active, _mm_cmple_ps(t_enter, t_exit)));
+  const BandFrame frame(corner, to_column, to_row, direction, margin, margin_columns, margin_rows);
+  return {rows,
+          cols,
+          frame,
+          corner,
+          to_column,
+          to_row,
+          direction,
+          margin,
+          margin_columns,
+          margin_rows,
+          (box.min().array() - margin).cast<float>(),
+          (box.max().array() + margin).cast<float>(),
+          _mm_setr_ps(frame.margin_columns, frame.margin_rows, frame.margin, 0.0f),
+          _mm_setr_ps(float(cols), float(rows), kHuge, kHuge),
+          _mm_setr_ps(float(cols - 1), float(rows - 1), length, kHuge)};
 }
-#endif
+
+// Queues the triangle with these corners (Bullet frame) against each ray of
+// the band whose cell its shadow on the grid covers.
+void QueueTriangle(const Eigen::Vector3f corners[3], int body, const BandArea& area,
+                   HitPairsKernel hit_pairs, GridBand* band) {
+  const BandFrame& frame = area.frame;
+  const int cols = area.cols;
+  // Columns u, rows v and depths s of the corners (SSE, a lane each).
+  const __m128 x = Sub(_mm_setr_ps(corners[0].x(), corners[1].x(), corners[2].x(), corners[2].x()),
+                       frame.corner[0]);
+  const __m128 y = Sub(_mm_setr_ps(corners[0].y(), corners[1].y(), corners[2].y(), corners[2].y()),
+                       frame.corner[1]);
+  const __m128 z = Sub(_mm_setr_ps(corners[0].z(), corners[1].z(), corners[2].z(), corners[2].z()),
+                       frame.corner[2]);
+  const __m128 column = frame.Along(0, x, y, z), row = frame.Along(1, x, y, z);
+  // A corner a vector (column, row, depth, depth), then their least and
+  // greatest coordinates, widened by the margins.
+  __m128 p0 = column, p1 = row, p2 = frame.Along(2, x, y, z), p3 = p2;
+  _MM_TRANSPOSE4_PS(p0, p1, p2, p3);
+  const __m128 low = Sub(_mm_min_ps(_mm_min_ps(p0, p1), p2), area.lane_margins);
+  const __m128 high = Add(_mm_max_ps(_mm_max_ps(p0, p1), p2), area.lane_margins);
+  // The columns, rows and depths within the grid that it spans, if any:
+  // from the least whole column and row at or above `span_from`, to the
+  // greatest at or below `span_to`.
+  const __m128 span_from = _mm_min_ps(_mm_max_ps(low, _mm_setzero_ps()), area.cap);
+  const __m128 span_to = _mm_min_ps(area.top, high);
+  if ((_mm_movemask_ps(_mm_cmpge_ps(span_to, span_from)) & 7) != 7) return;
+  const __m128i whole = _mm_cvttps_epi32(span_from);
+  const __m128i least =
+      _mm_sub_epi32(whole, _mm_castps_si128(_mm_cmplt_ps(_mm_cvtepi32_ps(whole), span_from)));
+  const __m128i last = _mm_cvttps_epi32(span_to);
+  if (_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpgt_epi32(least, last))) & 3) return;
+  alignas(16) std::int32_t firsts[4], lasts[4];
+  _mm_store_si128(reinterpret_cast<__m128i*>(firsts), least);
+  _mm_store_si128(reinterpret_cast<__m128i*>(lasts), last);
+  const int c0 = firsts[0], r0 = firsts[1], c1 = lasts[0], r1 = lasts[1];
+  const float near = _mm_cvtss_f32(_mm_movehl_ps(low, low));
+  auto add = [&](int r, int c) { band->Add(corners, body, r * cols + c, near, hit_pairs); };
+  if ((r1 - r0 + 1) * (c1 - c0 + 1) <= 4) {  // the box's few cells
+    for (int r = r0; r <= r1; ++r) {
+      for (int c = c0; c <= c1; ++c) add(r, c);
+    }
+    return;
+  }
+  // Row by row, the cells within the triangle's span.
+  alignas(16) float u[4], v[4];
+  _mm_store_ps(u, column), _mm_store_ps(v, row);
+  for (int r = r0; r <= r1; ++r) {
+    float from, to;
+    if (!RowSpan(u, v, float(r), frame.margin_rows, &from, &to)) continue;
+    const int first_column = std::max(c0, CeilNotBelowZero(from - frame.margin_columns, cols));
+    const int last_column = std::min(c1, FloorNotAbove(to + frame.margin_columns, cols - 1));
+    for (int c = first_column; c <= last_column; ++c) add(r, c);
+  }
+}
+
+// The rays of one band against the targets `wanted` lets them see, by
+// `hit_pairs`, into `hits`.
+void CastBand(const BandJob& this_band, const RayBatch& rays, const Eigen::Vector3f& origin_B,
+              const Eigen::Vector3d& world_origin, const std::vector<Target>& targets,
+              const Visible& wanted, HitPairsKernel hit_pairs, RayHits* hits) {
+  const RayGrid& grid = *this_band.grid;
+  const BandArea area = AreaOf(this_band, world_origin);
+  const std::size_t first = grid.first + std::size_t(this_band.row_begin) * std::size_t(grid.cols);
+  const std::size_t count = std::size_t(area.rows) * std::size_t(grid.cols);
+  const Eigen::Vector3f d = grid.direction;
+  const float length = grid.length_m;
+  thread_local GridBand band;
+  band.dx = _mm_set1_ps(d.x()), band.dy = _mm_set1_ps(d.y()), band.dz = _mm_set1_ps(d.z());
+  band.ox = _mm_set1_ps(origin_B.x()), band.oy = _mm_set1_ps(origin_B.y());
+  band.oz = _mm_set1_ps(origin_B.z());
+  band.start = rays.start.data() + first;
+  band.t_max = hits->distance_m.data() + first;
+  band.body = hits->body.data() + first;
+  std::fill(band.t_max, band.t_max + count, length);
+  std::fill(band.body, band.body + count, RayHits::kNoHit);
+  band.normal = nullptr;
+  if (hits->with_normals) {
+    band.normals.resize(count);
+    band.normal = band.normals.data();
+  }
+  band.pairs.count = 0;
+  for (const Target& target : targets) {
+    if (!wanted(target) || (target.aabb_min.array() > area.box_max.array()).any() ||
+        (target.aabb_max.array() < area.box_min.array()).any()) {
+      continue;
+    }
+    const Eigen::Vector3d* axes[3] = {&area.to_column, &area.to_row, &area.direction};
+    const double limit[3] = {double(area.cols - 1), double(area.rows - 1), double(length)};
+    const double margins[3] = {area.margin_columns, area.margin_rows, area.margin};
+    const GridCull cull = CullForWide(target, area.corner, axes, 3, limit, margins, true);
+    ForEachTriangleOverGridWide(target, cull, [&](const Eigen::Vector3f* corners, int body) {
+      QueueTriangle(corners, body, area, hit_pairs, &band);
+    });
+  }
+  hit_pairs(&band);
+  if (band.normal != nullptr) {
+    for (std::size_t i = 0; i < count; ++i) {
+      WriteHit(first + i, band.t_max[i], band.body[i], band.normal[i], d, hits);
+    }
+  }
+}
+
+// The bands of rows CastGrids() casts, each a chunk of work (each band walks
+// the BVH from its root, so fewer is less work; at least four rows each).
+// Without a history: four a thread over all blocks. After a call over the
+// same blocks (a scanner's next scan), by what each block took then
+// (`costs`): a block gets as many bands as it took threads' shares of the
+// total (rounded up), and the costliest bands are taken first, so that the
+// threads end together.
+std::vector<BandJob> PlanBands(const std::vector<RayGrid>& grids, const std::vector<BlockCost>& costs,
+                            int threads) {
+  std::vector<BandJob> bands;
+  bool known = threads > 1 && costs.size() == grids.size();
+  double total = 0.0;
+  for (std::size_t b = 0; known && b < grids.size(); ++b) {
+    known = costs[b].rows == grids[b].rows;
+    total += costs[b].seconds;
+  }
+  known = known && total > 0.0;
+  const int even_split = (4 * threads + int(grids.size()) - 1) / std::max(1, int(grids.size()));
+  for (std::size_t b = 0; b < grids.size(); ++b) {
+    const RayGrid& grid = grids[b];
+    const double cost = known ? costs[b].seconds : 1.0;
+    const int split = known ? int(std::ceil(cost / (total / threads))) : even_split;
+    const int rows_per_band = std::max(4, (grid.rows + split - 1) / std::max(1, split));
+    for (int r = 0; r < grid.rows; r += rows_per_band) {
+      const int end = std::min(grid.rows, r + rows_per_band);
+      bands.push_back({&grid, int(b), r, end, cost * (end - r) / std::max(1, grid.rows)});
+    }
+  }
+  if (known) {
+    std::stable_sort(bands.begin(), bands.end(),
+                     [](const BandJob& a, const BandJob& b) { return a.cost > b.cost; });
+  }
+  return bands;
+}
+
+// Throws std::invalid_argument unless the blocks cover the batch's n rays in
+// order, each with a unit direction and a positive length.
+void CheckGrids(const std::vector<RayGrid>& grids, std::size_t n) {
+  std::size_t next = 0;
+  for (const RayGrid& grid : grids) {
+    if (grid.first != next || grid.rows < 0 || grid.cols <= 0 ||
+        grid.first + std::size_t(grid.rows) * std::size_t(grid.cols) > n) {
+      throw std::invalid_argument("RayCaster::CastGrids(): the blocks do not cover the batch's " +
+                                  std::to_string(n) + " rays in order");
+    }
+    next = grid.first + std::size_t(grid.rows) * std::size_t(grid.cols);
+    if (!(std::abs(grid.direction.norm() - 1.0f) < 1e-5f) ||
+        !(std::isfinite(grid.length_m) && grid.length_m > 0.0f)) {
+      throw std::invalid_argument(
+          "RayCaster::CastGrids(): a block's direction must be unit and its length positive");
+    }
+  }
+  if (next != n) {
+    throw std::invalid_argument("RayCaster::CastGrids(): the blocks cover " + std::to_string(next) +
+                                " of the batch's " + std::to_string(n) + " rays");
+  }
+}
 
 }  // namespace
 
@@ -697,13 +513,7 @@ struct RayCaster::Targets {
   }
 };
 
-const char* RayCaster::kernel() {
-#if defined(__SSE2__)
-  return kHasAvx512 ? "avx512" : kHasFma ? "fma" : "sse2";
-#else
-  return "scalar";
-#endif
-}
+const char* RayCaster::kernel() { return ChosenKernel().name; }
 
 void RayBatch::Resize(std::size_t n) {
   start.resize(n);
@@ -746,339 +556,57 @@ void RayCaster::Cast(const scene::CollisionWorld& world, const RayBatch& rays,
   if (n == 0) return;
   // The batch in Bullet's frame (world minus the floating origin).
   const Eigen::Vector3f origin_B = (rays.origin_W - world.origin()).cast<float>();
-  // (Without SSE2 the rays walk Bullet's trees, which the merged target has not.)
-#if defined(__SSE2__)
-  const std::vector<Target>& all_targets = TargetsOf(world).For(filter);
-#else
-  const std::vector<Target>& all_targets = TargetsOf(world).all;
-#endif
   const Visible wanted{filter, world.internals().num_actors};
   // The objects the rays may see; when they are a few bodies (a packet
   // tests each body's box, then each object's), every chunk takes them all.
   std::vector<const Target*> seen;
   int bodies_seen = 0;
-  for (const Target& target : all_targets) {
+  for (const Target& target : TargetsOf(world).For(filter)) {
     if (!wanted(target)) continue;
     bodies_seen += seen.empty() || seen.back()->body != target.body;
     seen.push_back(&target);
   }
   constexpr int kFewBodies = 8;
-
-  const std::function<void(int)> job = [&](int chunk) {
+  const CastRaysKernel cast_rays = ChosenKernel().cast_rays;
+  RunParallel(static_cast<int>((n + kRaysPerChunk - 1) / kRaysPerChunk), [&](int chunk) {
     const std::size_t first = std::size_t(chunk) * kRaysPerChunk;
     const std::size_t end = std::min(n, first + kRaysPerChunk);
-    const Target* const* targets = seen.data();
-    std::size_t num_targets = seen.size();
-    const Target* targets_here[64];
-    std::vector<const Target*> many;
-    if (bodies_seen > kFewBodies) {
-      // Only the objects whose bounds meet this chunk's rays' bounds.
-      Eigen::Vector3f chunk_min = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
-      Eigen::Vector3f chunk_max = -chunk_min;
-      for (std::size_t r = first; r < end; ++r) {
-        const Eigen::Vector3f a = origin_B + rays.start[r];
-        const Eigen::Vector3f b = a + rays.length_m[r] * rays.direction[r];
-        chunk_min = chunk_min.cwiseMin(a.cwiseMin(b));
-        chunk_max = chunk_max.cwiseMax(a.cwiseMax(b));
-      }
-      std::size_t count = 0;
-      for (const Target* target : seen) {
-        if ((target->aabb_min.array() > chunk_max.array()).any() ||
-            (target->aabb_max.array() < chunk_min.array()).any()) {
-          continue;
-        }
-        if (count < 64) {
-          targets_here[count++] = target;
-        } else {
-          if (many.empty()) many.assign(targets_here, targets_here + 64);
-          many.push_back(target);
-        }
-      }
-      targets = many.empty() ? targets_here : many.data();
-      num_targets = many.empty() ? count : many.size();
+    if (bodies_seen <= kFewBodies) {
+      cast_rays(rays, origin_B, first, end, seen.data(), seen.size(), hits);
+      return;
     }
-    std::size_t i = first;
-#if defined(__SSE2__)
-    if (kHasAvx512) {
-      avx512_kernel::CastRays16(rays, origin_B, first, end, targets, num_targets, hits);
-      i = end;
-    }
-    // Four rays at a time; the last packet of the batch may be partly empty.
-    for (; i < end; i += 4) {
-      alignas(16) float lane[7][4];
-      alignas(16) std::uint32_t active[4];
-      for (int l = 0; l < 4; ++l) {
-        const std::size_t r = std::min(i + std::size_t(l), end - 1);
-        const Eigen::Vector3f o = origin_B + rays.start[r];
-        lane[0][l] = o.x(), lane[1][l] = o.y(), lane[2][l] = o.z();
-        lane[3][l] = rays.direction[r].x(), lane[4][l] = rays.direction[r].y();
-        lane[5][l] = rays.direction[r].z(), lane[6][l] = rays.length_m[r];
-        active[l] = i + std::size_t(l) < end ? 0xFFFFFFFFu : 0u;
-      }
-      Packet packet;
-      packet.ox = _mm_load_ps(lane[0]), packet.oy = _mm_load_ps(lane[1]);
-      packet.oz = _mm_load_ps(lane[2]), packet.dx = _mm_load_ps(lane[3]);
-      packet.dy = _mm_load_ps(lane[4]), packet.dz = _mm_load_ps(lane[5]);
-      packet.t_max = _mm_load_ps(lane[6]);
-      packet.active = _mm_load_ps(reinterpret_cast<const float*>(active));
-      const __m128 inverse[3] = {_mm_div_ps(_mm_set1_ps(1.0f), AwayFromZero(packet.dx)),
-                                 _mm_div_ps(_mm_set1_ps(1.0f), AwayFromZero(packet.dy)),
-                                 _mm_div_ps(_mm_set1_ps(1.0f), AwayFromZero(packet.dz))};
-      for (int l = 0; l < 4; ++l) packet.body[l] = RayHits::kNoHit;
-      for (std::size_t t = 0; t < num_targets;) {
-        // A run of one body's objects (a robot's pieces): skipped whole when
-        // the packet misses the box around them.
-        std::size_t run_end = t + 1;
-        while (run_end < num_targets && targets[run_end]->body == targets[t]->body) ++run_end;
-        if (run_end - t > 2 &&
-            PacketMeetsBox(packet, inverse, targets[t]->body_min, targets[t]->body_max) == 0) {
-          t = run_end;
-          continue;
-        }
-        for (; t < run_end; ++t) {
-          const Target& target = *targets[t];
-          if (PacketMeetsBox(packet, inverse, target.aabb_min, target.aabb_max) != 0) {
-            WalkWide4(target, &packet);
-          }
-        }
-      }
-      alignas(16) float t_max[4];
-      _mm_store_ps(t_max, packet.t_max);
-      for (int l = 0; l < 4 && i + std::size_t(l) < end; ++l) {
-        const std::size_t r = i + std::size_t(l);
-        WriteHit(r, t_max[l], packet.body[l], packet.normal[l], rays.direction[r], hits);
-      }
-    }
-#endif
-    for (; i < end; ++i) {
-      const Eigen::Vector3f o = origin_B + rays.start[i];
-      const Eigen::Vector3f& d = rays.direction[i];
-      const Eigen::Vector3f inverse_d = d.unaryExpr(
-          [](float x) { return 1.0f / (std::abs(x) > 1e-30f ? x : std::copysign(1e-30f, x)); });
-      float t_max = rays.length_m[i];
-      int body = RayHits::kNoHit;
-      Eigen::Vector3f normal = Eigen::Vector3f::Zero();
-      for (std::size_t t = 0; t < num_targets; ++t) {
-        const Target& target = *targets[t];
-        if (!RayMeetsBox(o, inverse_d, target.aabb_min, target.aabb_max, t_max)) continue;
-        if (WalkTarget(target, o, d, &t_max, &normal)) body = target.body;
-      }
-      WriteHit(i, t_max, body, normal, d, hits);
-    }
-  };
-  RunParallel(static_cast<int>((n + kRaysPerChunk - 1) / kRaysPerChunk), job);
+    thread_local std::vector<const Target*> near;
+    TargetsNear(rays, origin_B, first, end, seen, &near);
+    cast_rays(rays, origin_B, first, end, near.data(), near.size(), hits);
+  });
 }
 
 void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& rays,
                           const std::vector<RayGrid>& grids, const RayFilter& filter,
                           RayHits* hits) {
   const std::size_t n = rays.size();
-  std::size_t next = 0;
-  for (const RayGrid& grid : grids) {
-    if (grid.first != next || grid.rows < 0 || grid.cols <= 0 ||
-        grid.first + std::size_t(grid.rows) * std::size_t(grid.cols) > n) {
-      throw std::invalid_argument("RayCaster::CastGrids(): the blocks do not cover the batch's " +
-                                  std::to_string(n) + " rays in order");
-    }
-    next = grid.first + std::size_t(grid.rows) * std::size_t(grid.cols);
-    if (!(std::abs(grid.direction.norm() - 1.0f) < 1e-5f) ||
-        !(std::isfinite(grid.length_m) && grid.length_m > 0.0f)) {
-      throw std::invalid_argument(
-          "RayCaster::CastGrids(): a block's direction must be unit and its length positive");
-    }
-  }
-  if (next != n) {
-    throw std::invalid_argument("RayCaster::CastGrids(): the blocks cover " + std::to_string(next) +
-                                " of the batch's " + std::to_string(n) + " rays");
-  }
-#if !defined(__SSE2__)
-  // Cast() reads the batch's directions and lengths: they must be the blocks'.
-  for (const RayGrid& grid : grids) {
-    for (std::size_t i = grid.first; i < grid.first + std::size_t(grid.rows) * grid.cols; ++i) {
-      if (rays.direction[i] != grid.direction || rays.length_m[i] != grid.length_m) {
-        throw std::invalid_argument("RayCaster::CastGrids(): ray " + std::to_string(i) +
-                                    " differs in direction or length from its block");
-      }
-    }
-  }
-  Cast(world, rays, filter, hits);
-#else
+  CheckGrids(grids, n);
   rays_cast_ += std::int64_t(n);
   SizeHits(n, hits);
   if (n == 0) return;
   const Eigen::Vector3f origin_B = (rays.origin_W - world.origin()).cast<float>();
-  const std::vector<Target>& all_targets = TargetsOf(world).For(filter);
+  const std::vector<Target>& targets = TargetsOf(world).For(filter);
   const Visible wanted{filter, world.internals().num_actors};
-  // Bands of rows, each a chunk of work (each band walks the BVH from its
-  // root, so fewer is less work; at least four rows each). Without a history:
-  // four a thread over all blocks. After a call over the same blocks (a
-  // scanner's next scan), by what each block took then: a block gets as many
-  // bands as it took threads' shares of the total (rounded up), and the
-  // costliest bands are taken first, so that the threads end together.
-  struct Band {
-    const RayGrid* grid;
-    int block, row_begin, row_end;
-    double cost;
-  };
-  std::vector<Band> bands;
-  bool known = threads() > 1 && grid_costs_.size() == grids.size();
-  double total = 0.0;
-  for (std::size_t b = 0; known && b < grids.size(); ++b) {
-    known = grid_costs_[b].rows == grids[b].rows;
-    total += grid_costs_[b].seconds;
-  }
-  known = known && total > 0.0;
-  const int even_split = (4 * threads() + int(grids.size()) - 1) / std::max(1, int(grids.size()));
-  for (std::size_t b = 0; b < grids.size(); ++b) {
-    const RayGrid& grid = grids[b];
-    const double cost = known ? grid_costs_[b].seconds : 1.0;
-    const int split = known ? int(std::ceil(cost / (total / threads()))) : even_split;
-    const int rows_per_band = std::max(4, (grid.rows + split - 1) / std::max(1, split));
-    for (int r = 0; r < grid.rows; r += rows_per_band) {
-      const int end = std::min(grid.rows, r + rows_per_band);
-      bands.push_back({&grid, int(b), r, end, cost * (end - r) / std::max(1, grid.rows)});
-    }
-  }
-  if (known) {
-    std::stable_sort(bands.begin(), bands.end(),
-                     [](const Band& a, const Band& b) { return a.cost > b.cost; });
-  }
+  const HitPairsKernel hit_pairs = ChosenKernel().hit_pairs;
+  const std::vector<BandJob> bands = PlanBands(grids, grid_costs_, threads());
   std::vector<double> band_seconds(bands.size(), 0.0);
-
-  const std::function<void(int)> job = [&](int band_index) {
+  RunParallel(static_cast<int>(bands.size()), [&](int b) {
     const auto started = std::chrono::steady_clock::now();
-    const Band& this_band = bands[std::size_t(band_index)];
-    const RayGrid& grid = *this_band.grid;
-    const int row_begin = this_band.row_begin;
-    const int rows = this_band.row_end - row_begin, cols = grid.cols;
-    const std::size_t first = grid.first + std::size_t(row_begin) * std::size_t(cols);
-    const std::size_t count = std::size_t(rows) * std::size_t(cols);
-    const Eigen::Vector3f d = grid.direction;
-    const float length = grid.length_m;
-    thread_local GridBand band;
-    band.dx = _mm_set1_ps(d.x()), band.dy = _mm_set1_ps(d.y()), band.dz = _mm_set1_ps(d.z());
-    band.ox = _mm_set1_ps(origin_B.x()), band.oy = _mm_set1_ps(origin_B.y());
-    band.oz = _mm_set1_ps(origin_B.z());
-    band.start = rays.start.data() + first;
-    band.t_max = hits->distance_m.data() + first;
-    band.body = hits->body.data() + first;
-    std::fill(band.t_max, band.t_max + count, length);
-    std::fill(band.body, band.body + count, RayHits::kNoHit);
-    band.normal = nullptr;
-    if (hits->with_normals) {
-      band.normals.resize(count);
-      band.normal = band.normals.data();
-    }
-    band.pairs.count = 0;
-    // The band's grid in the Bullet frame, in double: a point's column is
-    // (p - corner) . to_column, its row (p - corner) . to_row, its depth
-    // along the rays (p - corner) . direction. The margin covers the float
-    // rounding of the rays' origins and of the triangle test's tolerance.
-    const Eigen::Vector3d corner = grid.corner_W - world.origin() + row_begin * grid.step_v_W;
-    const double step_u = grid.step_u_W.norm(), step_v = grid.step_v_W.norm();
-    const Eigen::Vector3d to_column = grid.step_u_W / (step_u * step_u);
-    const Eigen::Vector3d to_row = grid.step_v_W / (step_v * step_v);
-    const Eigen::Vector3d direction = d.cast<double>();
-    const double margin =
-        1e-5 * (corner.norm() + cols * step_u + rows * step_v + double(length)) + 1e-5;
-    const double margin_columns = margin / step_u, margin_rows = margin / step_v;
-    const BandFrame frame(corner, to_column, to_row, direction, margin, margin_columns,
-                          margin_rows);
-    Eigen::AlignedBox3d box;
-    for (const double u : {-margin_columns, cols - 1 + margin_columns}) {
-      for (const double v : {-margin_rows, rows - 1 + margin_rows}) {
-        for (const double s : {-margin, double(length) + margin}) {
-          box.extend(corner + u * grid.step_u_W + v * grid.step_v_W + s * direction);
-        }
-      }
-    }
-    const Eigen::Vector3f box_min = (box.min().array() - margin).cast<float>();
-    const Eigen::Vector3f box_max = (box.max().array() + margin).cast<float>();
-    // Per lane (column, row, depth): the margins, and the bounds of the
-    // cells' columns and rows and of the rays' depths (the fourth lane: none).
-    const __m128 lane_margins =
-        _mm_setr_ps(frame.margin_columns, frame.margin_rows, frame.margin, 0.0f);
-    const __m128 cap = _mm_setr_ps(float(cols), float(rows), kHuge, kHuge);
-    const __m128 top = _mm_setr_ps(float(cols - 1), float(rows - 1), length, kHuge);
-    for (const Target& target : all_targets) {
-      if (!wanted(target) || (target.aabb_min.array() > box_max.array()).any() ||
-          (target.aabb_max.array() < box_min.array()).any()) {
-        continue;
-      }
-      const Eigen::Vector3d* axes[3] = {&to_column, &to_row, &direction};
-      const double limit[3] = {double(cols - 1), double(rows - 1), double(length)};
-      const double margins[3] = {margin_columns, margin_rows, margin};
-      const GridCull cull = CullForWide(target, corner, axes, 3, limit, margins, true);
-      ForEachTriangleOverGridWide(target, cull, [&](const Eigen::Vector3f* corners, int body) {
-        // Columns u, rows v and depths s of the corners (SSE, a lane each).
-        const __m128 x =
-            Sub(_mm_setr_ps(corners[0].x(), corners[1].x(), corners[2].x(), corners[2].x()),
-                frame.corner[0]);
-        const __m128 y =
-            Sub(_mm_setr_ps(corners[0].y(), corners[1].y(), corners[2].y(), corners[2].y()),
-                frame.corner[1]);
-        const __m128 z =
-            Sub(_mm_setr_ps(corners[0].z(), corners[1].z(), corners[2].z(), corners[2].z()),
-                frame.corner[2]);
-        const __m128 column = frame.Along(0, x, y, z), row = frame.Along(1, x, y, z);
-        // A corner a vector (column, row, depth, depth), then their least and
-        // greatest coordinates, widened by the margins.
-        __m128 p0 = column, p1 = row, p2 = frame.Along(2, x, y, z), p3 = p2;
-        _MM_TRANSPOSE4_PS(p0, p1, p2, p3);
-        const __m128 low = Sub(_mm_min_ps(_mm_min_ps(p0, p1), p2), lane_margins);
-        const __m128 high = Add(_mm_max_ps(_mm_max_ps(p0, p1), p2), lane_margins);
-        // The columns, rows and depths within the grid that it spans, if any:
-        // from the least whole column and row at or above `span_from`, to the
-        // greatest at or below `span_to`.
-        const __m128 span_from = _mm_min_ps(_mm_max_ps(low, _mm_setzero_ps()), cap);
-        const __m128 span_to = _mm_min_ps(top, high);
-        if ((_mm_movemask_ps(_mm_cmpge_ps(span_to, span_from)) & 7) != 7) return;
-        const __m128i whole = _mm_cvttps_epi32(span_from);
-        const __m128i least =
-            _mm_sub_epi32(whole, _mm_castps_si128(_mm_cmplt_ps(_mm_cvtepi32_ps(whole), span_from)));
-        const __m128i last = _mm_cvttps_epi32(span_to);
-        if (_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpgt_epi32(least, last))) & 3) return;
-        alignas(16) std::int32_t firsts[4], lasts[4];
-        _mm_store_si128(reinterpret_cast<__m128i*>(firsts), least);
-        _mm_store_si128(reinterpret_cast<__m128i*>(lasts), last);
-        const int c0 = firsts[0], r0 = firsts[1], c1 = lasts[0], r1 = lasts[1];
-        const float near = _mm_cvtss_f32(_mm_movehl_ps(low, low));
-        auto add = [&](int r, int c) { band.Add(corners, body, r * cols + c, near, HitPairs); };
-        if ((r1 - r0 + 1) * (c1 - c0 + 1) <= 4) {  // the box's few cells
-          for (int r = r0; r <= r1; ++r) {
-            for (int c = c0; c <= c1; ++c) add(r, c);
-          }
-          return;
-        }
-        // Row by row, the cells within the triangle's span.
-        alignas(16) float u[4], v[4];
-        _mm_store_ps(u, column), _mm_store_ps(v, row);
-        for (int r = r0; r <= r1; ++r) {
-          float from, to;
-          if (!RowSpan(u, v, float(r), frame.margin_rows, &from, &to)) continue;
-          const int first_column =
-              std::max(c0, CeilNotBelowZero(from - frame.margin_columns, cols));
-          const int last_column = std::min(c1, FloorNotAbove(to + frame.margin_columns, cols - 1));
-          for (int c = first_column; c <= last_column; ++c) add(r, c);
-        }
-      });
-    }
-    HitPairs(&band);
-    if (band.normal != nullptr) {
-      for (std::size_t i = 0; i < count; ++i) {
-        WriteHit(first + i, band.t_max[i], band.body[i], band.normal[i], d, hits);
-      }
-    }
-    band_seconds[std::size_t(band_index)] =
+    CastBand(bands[std::size_t(b)], rays, origin_B, world.origin(), targets, wanted, hit_pairs,
+             hits);
+    band_seconds[std::size_t(b)] =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  };
-  RunParallel(static_cast<int>(bands.size()), job);
-  grid_costs_.assign(grids.size(), GridCost{0, 0.0});
+  });
+  grid_costs_.assign(grids.size(), BlockCost{});
   for (std::size_t b = 0; b < grids.size(); ++b) grid_costs_[b].rows = grids[b].rows;
   for (std::size_t i = 0; i < bands.size(); ++i) {
     grid_costs_[std::size_t(bands[i].block)].seconds += band_seconds[i];
   }
-#endif
 }
 
 }  // namespace sandbox::sensors

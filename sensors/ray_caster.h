@@ -2,9 +2,9 @@
 // Batched ray casting over the Bullet world, split over worker threads.
 // Thread-safe by construction: every ray walks each object's own hierarchy
 // (scene::TriangleBvh, one over all static actors where the scene merged them:
-// scene::MergedStatic; the lidar sweep kernel, Bullet's quantized BVH) and the
-// level's triangle arrays read-only, with its own stack; nothing of Bullet's
-// mutable query state (btCollisionWorld::rayTest) is used.
+// scene::MergedStatic) read-only, with its own stack; nothing of Bullet's
+// mutable query state (btCollisionWorld::rayTest) is used. The kernels that
+// test rays against triangles are built per instruction set (ray_kernels.h).
 //
 // Hits are watertight (docs/reference/sensors.md, "Grazing and origin rules"): each
 // triangle is tested in the Bullet frame with its corners placed as Bullet
@@ -79,6 +79,12 @@ struct RayHits {
   std::size_t size() const { return body.size(); }
 };
 
+// What one block of a CastGrids() call took, its rows and seconds.
+struct BlockCost {
+  int rows{0};
+  double seconds{0.0};
+};
+
 class RayCaster {
  public:
   // Starts `threads` - 1 worker threads (0: one per core); the calling thread
@@ -110,11 +116,10 @@ class RayCaster {
   // (a deeper tree costs an allocation per walk, never a dropped node).
   static constexpr int kStackInPlace = 32;
   // The packet kernel in use: "avx512" (sixteen rays a packet in Cast(),
-  // sixteen triangle-ray pairs a test in CastGrids(); the
-  // FMA kernel's arithmetic), "fma" (the CPU's fused multiply-add unit, four
-  // rays; SANDBOX_RAY_KERNEL=fma forces it), "sse2" (fused operations emulated
-  // where they decide; SANDBOX_RAY_KERNEL=sse2) or "scalar" (no SSE2). All
-  // give the same hits.
+  // sixteen triangle-ray pairs a test in CastGrids(); the FMA kernel's
+  // arithmetic), "fma" (the CPU's fused multiply-add unit, four rays) or
+  // "sse2" (fused operations emulated where they decide). The widest the CPU
+  // runs, unless SANDBOX_RAY_KERNEL names another. All give the same hits.
   static const char* kernel();
   // Rays cast since construction (frame statistics).
   std::int64_t rays_cast() const { return rays_cast_; }
@@ -132,13 +137,9 @@ class RayCaster {
   struct Targets;
   std::unique_ptr<Targets> targets_;
   const Targets& TargetsOf(const scene::CollisionWorld& world);
-  // What each block of the last CastGrids() call took (its rows and seconds):
-  // the next call over the same blocks splits and orders its bands by it.
-  struct GridCost {
-    int rows;
-    double seconds;
-  };
-  std::vector<GridCost> grid_costs_;
+  // What each block of the last CastGrids() call took: the next call over
+  // the same blocks splits and orders its bands by it.
+  std::vector<BlockCost> grid_costs_;
 };
 
 }  // namespace sandbox::sensors

@@ -2,10 +2,14 @@
 // The stack of a BVH walk: kInPlace entries in place, doubling on the heap
 // when a tree is deeper (an entry is never dropped). Bullet's builder keeps
 // its trees within about log_1.5(triangles) levels (37 for its 2^21-triangle
-// limit), so the heap is the exception.
+// limit), so the heap is the exception. The heap's code is out of line
+// (walk_stack.cc): the kernels built for wider instruction sets instantiate
+// no library template (sandbox_isa_kernel in CMakeLists.txt).
 
+#include <cstddef>
 #include <cstdint>
-#include <vector>
+#include <cstring>
+#include <type_traits>
 
 namespace sandbox::sensors {
 
@@ -24,8 +28,24 @@ class WalkEntry {
   std::uint64_t bits_{0};
 };
 
+// Heap memory for entries past the in-place ones.
+class WalkHeap {
+ public:
+  WalkHeap() = default;
+  ~WalkHeap();
+  WalkHeap(const WalkHeap&) = delete;
+  WalkHeap& operator=(const WalkHeap&) = delete;
+  // `bytes` of memory holding the first `kept` bytes of `from`.
+  void* Grow(const void* from, std::size_t kept, std::size_t bytes);
+
+ private:
+  void* data_{nullptr};
+};
+
 template <typename T, int kInPlace>
 class WalkStack {
+  static_assert(std::is_trivially_copyable_v<T>, "entries are moved as bytes");
+
  public:
   WalkStack() = default;
   WalkStack(const WalkStack&) = delete;
@@ -42,14 +62,13 @@ class WalkStack {
 
  private:
   void Grow() {
-    if (heap_.empty()) heap_.assign(in_place_, in_place_ + size_);
     capacity_ *= 2;
-    heap_.resize(static_cast<std::size_t>(capacity_));
-    data_ = heap_.data();
+    data_ = static_cast<T*>(heap_.Grow(data_, sizeof(T) * std::size_t(size_),
+                                       sizeof(T) * std::size_t(capacity_)));
   }
 
   T in_place_[kInPlace];
-  std::vector<T> heap_;
+  WalkHeap heap_;
   T* data_{in_place_};
   int size_{0}, capacity_{kInPlace};
 };

@@ -1,19 +1,15 @@
 #include "sensors/render/deferred_shading.h"
 
-#include <immintrin.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 
+#include "sensors/render/deferred_kernel.h"
+
 namespace sandbox::render {
 namespace {
-
-// The display byte of a linear value, in this many steps from 0 to 1 (fine
-// enough that a step never spans half a display level, even near black).
-constexpr int kSrgbSteps = 16383;
 
 const std::int32_t* SrgbTable() {
   static const std::vector<std::int32_t> table = [] {
@@ -31,46 +27,6 @@ std::uint8_t EncodeSrgb(float linear) {
   const float s = c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.f / 2.4f) - 0.055f;
   return std::uint8_t(std::lround(std::clamp(s, 0.f, 1.f) * 255.f));
 }
-
-// The kernel three times: for AVX-512, for AVX2 with FMA, and for any x86-64
-// (each function of the first two compiled for its instruction set, by GCC's
-// or clang's pragma).
-#if defined(__clang__)
-#pragma clang attribute push(__attribute__((target("avx512f,avx512dq,avx2,fma"))), \
-                             apply_to = function)
-#else
-#pragma GCC push_options
-#pragma GCC target("avx512f,avx512dq,avx2,fma")
-#endif
-namespace avx512 {
-#define SANDBOX_SIMD 512
-#include "sensors/render/deferred_kernel.inc"
-#undef SANDBOX_SIMD
-}  // namespace avx512
-#if defined(__clang__)
-#pragma clang attribute pop
-#pragma clang attribute push(__attribute__((target("avx2,fma"))), apply_to = function)
-#else
-#pragma GCC pop_options
-#pragma GCC push_options
-#pragma GCC target("avx2,fma")
-#endif
-namespace avx2 {
-#define SANDBOX_SIMD 256
-#include "sensors/render/deferred_kernel.inc"
-#undef SANDBOX_SIMD
-}  // namespace avx2
-#if defined(__clang__)
-#pragma clang attribute pop
-#else
-#pragma GCC pop_options
-#endif
-
-namespace sse2 {
-#define SANDBOX_SIMD 0
-#include "sensors/render/deferred_kernel.inc"
-#undef SANDBOX_SIMD
-}  // namespace sse2
 
 std::vector<std::string> DeferredShader::Kernels() {
   std::vector<std::string> kernels;
@@ -136,7 +92,7 @@ DeferredShader::DeferredShader(int threads, const std::string& kernel)
   if (std::find(kernels.begin(), kernels.end(), kernel_) == kernels.end()) {
     std::string known;
     for (const std::string& k : kernels) known += (known.empty() ? "" : ", ") + k;
-    throw std::invalid_argument("DeferredShader: kernel '" + kernel_ +
+    throw std::invalid_argument("DeferredShader::DeferredShader(): kernel '" + kernel_ +
                                 "' is not one this CPU runs (" + known + ")");
   }
   simd_ = kernel_ == "avx512" ? Simd::kAvx512 : kernel_ == "avx2" ? Simd::kAvx2 : Simd::kSse2;
@@ -158,13 +114,13 @@ void DeferredShader::Shade(const LightingFrame& frame, const DetailTextures& det
   pool_.RunParallel(bands, [&](int band) {
     const int begin = band * kBand, end = std::min(h, begin + kBand);
     if (simd_ == Simd::kAvx512) {
-      const avx512::Constants k{&frame, &detail, SrgbTable(), shadow, w, h};
+      const ShadeConstants k{&frame, &detail, SrgbTable(), shadow, w, h};
       avx512::ShadeRows(k, opaque, translucent, begin, end, words, luma_.data());
     } else if (simd_ == Simd::kAvx2) {
-      const avx2::Constants k{&frame, &detail, SrgbTable(), shadow, w, h};
+      const ShadeConstants k{&frame, &detail, SrgbTable(), shadow, w, h};
       avx2::ShadeRows(k, opaque, translucent, begin, end, words, luma_.data());
     } else {
-      const sse2::Constants k{&frame, &detail, SrgbTable(), shadow, w, h};
+      const ShadeConstants k{&frame, &detail, SrgbTable(), shadow, w, h};
       sse2::ShadeRows(k, opaque, translucent, begin, end, words, luma_.data());
     }
   });
@@ -234,16 +190,15 @@ void DeferredShader::FilterEdges(const std::vector<std::uint8_t>& in, int width,
       dst[k] = std::uint8_t(std::lround(std::clamp(chosen[k], 0.f, 1.f) * 255.f));
   };
   constexpr int kBand = 32;
+  int (*const edges_of_row)(const float*, int, int, int, int*) =
+      simd_ == Simd::kAvx512 ? avx512::EdgesOfRow
+      : simd_ == Simd::kAvx2 ? avx2::EdgesOfRow
+                             : sse2::EdgesOfRow;
   pool_.RunParallel((height + kBand - 1) / kBand, [&](int band) {
+    std::vector<int> columns(static_cast<std::size_t>(width));
     for (int y = band * kBand; y < std::min(height, (band + 1) * kBand); ++y) {
-      auto at = [&](int x) { filter(x, y); };
-      if (simd_ == Simd::kAvx512) {
-        avx512::ForEachEdge(luma, width, height, y, at);
-      } else if (simd_ == Simd::kAvx2) {
-        avx2::ForEachEdge(luma, width, height, y, at);
-      } else {
-        sse2::ForEachEdge(luma, width, height, y, at);
-      }
+      const int edges = edges_of_row(luma, width, height, y, columns.data());
+      for (int i = 0; i < edges; ++i) filter(columns[std::size_t(i)], y);
     }
   });
 }

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <functional>
 #include <random>
 
@@ -53,6 +54,14 @@ RayBatch RandomRays(int n, unsigned seed) {
     rays.length_m.push_back(length(random));
   }
   return rays;
+}
+
+// The kernel SANDBOX_RAY_KERNEL names is the one in use (ctest runs the ray
+// tests once on each kernel the machine can run).
+TEST(RayKernelTest, TheKernelAskedForIsTheOneInUse) {
+  const char* asked = std::getenv("SANDBOX_RAY_KERNEL");
+  if (asked == nullptr) GTEST_SKIP() << "SANDBOX_RAY_KERNEL is not set";
+  EXPECT_STREQ(RayCaster::kernel(), asked);
 }
 
 TEST_F(RayCasterTest, AgreesWithBulletsRayTest) {

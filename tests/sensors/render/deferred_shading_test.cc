@@ -133,7 +133,7 @@ TEST(DeferredShadingTest, WhereNothingWasDrawnTheSkyShowsItsGradientAndTheSunsDi
 }
 
 // A surface everywhere 40 m ahead, facing up; the sun's light by Lambert's
-// cosine and the sky's light from above (deferred_kernel.inc's Lit), haze by
+// cosine and the sky's light from above (deferred_kernel.cc's Lit), haze by
 // distance between fog start and end.
 TEST(DeferredShadingTest, LitSurfacesFollowLambertSkyLightAndHaze) {
   const Camera camera{40, 30};

@@ -1,35 +1,41 @@
-// Sixteen rays a packet, for CPUs with AVX-512: the walk of the objects' own
-// hierarchies (WalkWide4's) and the fused watertight triangle test (the FMA
-// kernel's HitLanes4, operation for operation, sixteen lanes wide: the same
-// bits in every lane). Included by sensors/ray_caster.cc in namespace
-// avx512_kernel. Not a header: it is compiled into that kernel only.
+// The packet kernel of sixteen rays (sensors/ray_kernels.h), for CPUs with
+// AVX-512: the walk of the objects' own hierarchies (packet_walk4.cc's
+// WalkWide4) and the fused watertight triangle test (its HitLanes4 as built
+// for fma, operation for operation, sixteen lanes wide: the same bits in
+// every lane). Built once, with -mavx512f -mavx512dq (namespace avx512).
+// Its own code, not packet_walk4.cc's made wide: its masks are registers of
+// their own and it loads sixteen rays by permutes (docs/decisions/005).
 
-#define K16 __attribute__((target("avx512f,avx512dq,fma")))
+#include <Eigen/Core>
+#include <algorithm>
+#include <limits>
+
+#include "sensors/ray_kernels.h"
+#include "sensors/walk_stack.h"
+
+namespace sandbox::sensors::SANDBOX_ISA {
+namespace {
 
 struct V16 {  // a vector per lane
   __m512 x, y, z;
 };
-K16 inline __m512 Set(float v) { return _mm512_set1_ps(v); }
-K16 inline __m512 Mul(__m512 a, __m512 b) { return _mm512_mul_ps(a, b); }
-K16 inline __m512 Add(__m512 a, __m512 b) { return _mm512_add_ps(a, b); }
-K16 inline __m512 Sub(__m512 a, __m512 b) { return _mm512_sub_ps(a, b); }
-K16 inline V16 Sub(const V16& a, const V16& b) {
-  return {Sub(a.x, b.x), Sub(a.y, b.y), Sub(a.z, b.z)};
-}
-K16 inline V16 Add(const V16& a, const V16& b) {
-  return {Add(a.x, b.x), Add(a.y, b.y), Add(a.z, b.z)};
-}
+inline __m512 Set(float v) { return _mm512_set1_ps(v); }
+inline __m512 Mul(__m512 a, __m512 b) { return _mm512_mul_ps(a, b); }
+inline __m512 Add(__m512 a, __m512 b) { return _mm512_add_ps(a, b); }
+inline __m512 Sub(__m512 a, __m512 b) { return _mm512_sub_ps(a, b); }
+inline V16 Sub(const V16& a, const V16& b) { return {Sub(a.x, b.x), Sub(a.y, b.y), Sub(a.z, b.z)}; }
+inline V16 Add(const V16& a, const V16& b) { return {Add(a.x, b.x), Add(a.y, b.y), Add(a.z, b.z)}; }
 // (GCC 12 warns of the unmasked min, max and and-not's undefined source: the
 // all-lanes zero-masked forms are the same operations.)
-K16 inline __m512 Min(__m512 a, __m512 b) { return _mm512_maskz_min_ps(0xFFFF, a, b); }
-K16 inline __m512 Max(__m512 a, __m512 b) { return _mm512_maskz_max_ps(0xFFFF, a, b); }
-K16 inline __m512 Abs(__m512 x) {
+inline __m512 Min(__m512 a, __m512 b) { return _mm512_maskz_min_ps(0xFFFF, a, b); }
+inline __m512 Max(__m512 a, __m512 b) { return _mm512_maskz_max_ps(0xFFFF, a, b); }
+inline __m512 Abs(__m512 x) {
   return _mm512_castsi512_ps(
       _mm512_maskz_andnot_epi32(0xFFFF, _mm512_castps_si512(Set(-0.0f)), _mm512_castps_si512(x)));
 }
-K16 inline __m512 L1(const V16& a) { return Add(Add(Abs(a.x), Abs(a.y)), Abs(a.z)); }
+inline __m512 L1(const V16& a) { return Add(Add(Abs(a.x), Abs(a.y)), Abs(a.z)); }
 // The least of the sixteen lanes.
-K16 inline float ReduceMin(__m512 x) {
+inline float ReduceMin(__m512 x) {
   x = Min(x, _mm512_maskz_shuffle_f32x4(0xFFFF, x, x, _MM_SHUFFLE(1, 0, 3, 2)));
   x = Min(x, _mm512_maskz_shuffle_f32x4(0xFFFF, x, x, _MM_SHUFFLE(2, 3, 0, 1)));
   x = Min(x, _mm512_maskz_permute_ps(0xFFFF, x, _MM_SHUFFLE(1, 0, 3, 2)));
@@ -37,21 +43,21 @@ K16 inline float ReduceMin(__m512 x) {
   return _mm512_cvtss_f32(x);
 }
 // a where the mask is set, b elsewhere.
-K16 inline __m512 Select(__mmask16 mask, __m512 a, __m512 b) {
+inline __m512 Select(__mmask16 mask, __m512 a, __m512 b) {
   return _mm512_mask_blend_ps(mask, b, a);
 }
-K16 inline __m512 Dot(const V16& a, const V16& b) {
+inline __m512 Dot(const V16& a, const V16& b) {
   return _mm512_fmadd_ps(a.x, b.x, _mm512_fmadd_ps(a.y, b.y, Mul(a.z, b.z)));
 }
-K16 inline V16 Cross(const V16& a, const V16& b) {
+inline V16 Cross(const V16& a, const V16& b) {
   return {_mm512_fmsub_ps(a.y, b.z, Mul(a.z, b.y)), _mm512_fmsub_ps(a.z, b.x, Mul(a.x, b.z)),
           _mm512_fmsub_ps(a.x, b.y, Mul(a.y, b.x))};
 }
 // StableNormal4<true>.
-K16 inline V16 StableNormal(const V16& a, const V16& b, const V16& c) {
+inline V16 StableNormal(const V16& a, const V16& b, const V16& c) {
   const __m512 ab_x = Mul(a.z, b.y), ab_y = Mul(a.x, b.z), ab_z = Mul(a.y, b.x);
   const __m512 bc_x = Mul(b.z, c.y), bc_y = Mul(b.x, c.z), bc_z = Mul(b.y, c.x);
-  auto less = [](__m512 p, __m512 q) K16 { return _mm512_cmp_ps_mask(Abs(p), Abs(q), _CMP_LT_OS); };
+  auto less = [](__m512 p, __m512 q) { return _mm512_cmp_ps_mask(Abs(p), Abs(q), _CMP_LT_OS); };
   return {
       Select(less(ab_x, bc_x), _mm512_fmsub_ps(a.y, b.z, ab_x), _mm512_fmsub_ps(b.y, c.z, bc_x)),
       Select(less(ab_y, bc_y), _mm512_fmsub_ps(a.z, b.x, ab_y), _mm512_fmsub_ps(b.z, c.x, bc_y)),
@@ -59,7 +65,7 @@ K16 inline V16 StableNormal(const V16& a, const V16& b, const V16& c) {
 }
 // MeetsCornerBox's inverse directions: a zero component counts as an
 // infinitesimally positive one.
-K16 inline V16 CornerBoxInverse(const V16& d) {
+inline V16 CornerBoxInverse(const V16& d) {
   const __m512 direction[3] = {d.x, d.y, d.z};
   __m512 inverse[3];
   for (int k = 0; k < 3; ++k) {
@@ -69,8 +75,8 @@ K16 inline V16 CornerBoxInverse(const V16& d) {
   return {inverse[0], inverse[1], inverse[2]};
 }
 // MeetsCornerBox4, sixteen lanes (inverse: CornerBoxInverse of the directions).
-K16 inline __mmask16 MeetsCornerBox16(const V16& low, const V16& high, const V16& o,
-                                      const V16& inverse_d, __m512 t) {
+inline __mmask16 MeetsCornerBox16(const V16& low, const V16& high, const V16& o,
+                                  const V16& inverse_d, __m512 t) {
   const __m512 origin[3] = {o.x, o.y, o.z}, inverse[3] = {inverse_d.x, inverse_d.y, inverse_d.z};
   const __m512 lo[3] = {low.x, low.y, low.z}, hi[3] = {high.x, high.y, high.z};
   __m512 t_enter = _mm512_setzero_ps(), t_exit = t;
@@ -87,9 +93,8 @@ K16 inline __mmask16 MeetsCornerBox16(const V16& low, const V16& high, const V16
 
 // HitLanes4 (fused), sixteen lanes: the lanes hit closer than their t_max
 // (or at it, in `ties`) take the distance; the (unnormalised) normals in *normal.
-K16 inline __mmask16 HitLanes16(const V16 c[3], const V16& o, const V16& d,
-                                const V16& box_inverse, __mmask16 lanes, __mmask16 ties,
-                                __m512* t_max, V16* normal) {
+inline __mmask16 HitLanes16(const V16 c[3], const V16& o, const V16& d, const V16& box_inverse,
+                            __mmask16 lanes, __mmask16 ties, __m512* t_max, V16* normal) {
   const V16 v0 = Sub(c[0], o), v1 = Sub(c[1], o), v2 = Sub(c[2], o);
   const V16 e0 = Sub(v2, v0), e1 = Sub(v0, v1), e2 = Sub(v1, v2);
   const __m512 u = Dot(Cross(e0, Add(v2, v0)), d);
@@ -132,8 +137,8 @@ struct Packet16 {
 };
 
 // HitLanes16 for the packet's lanes against one triangle (corners in the Bullet frame).
-K16 inline void HitCorners16(const Eigen::Vector3f corner[3], int body_id, Packet16* packet,
-                             __mmask16 lanes, __m512* t_max) {
+inline void HitCorners16(const Eigen::Vector3f corner[3], int body_id, Packet16* packet,
+                         __mmask16 lanes, __m512* t_max) {
   V16 c[3];
   for (int k = 0; k < 3; ++k) c[k] = {Set(corner[k].x()), Set(corner[k].y()), Set(corner[k].z())};
   V16 n;
@@ -149,8 +154,8 @@ K16 inline void HitCorners16(const Eigen::Vector3f corner[3], int body_id, Packe
 }
 
 // The lanes whose rays enter the box [lo, hi] (Bullet frame) before their t_max.
-K16 inline __mmask16 MeetsBox16(const Packet16& packet, const __m512 inverse[3],
-                                const Eigen::Vector3f& lo, const Eigen::Vector3f& hi) {
+inline __mmask16 MeetsBox16(const Packet16& packet, const __m512 inverse[3],
+                            const Eigen::Vector3f& lo, const Eigen::Vector3f& hi) {
   const __m512 o[3] = {packet.o.x, packet.o.y, packet.o.z};
   __m512 t_enter = _mm512_setzero_ps(), t_exit = packet.t_max;
   for (int k = 0; k < 3; ++k) {
@@ -181,7 +186,7 @@ constexpr DeinterleaveIndex MakeDeinterleaveIndex() {
   return index;
 }
 alignas(64) constexpr DeinterleaveIndex kDeinterleave = MakeDeinterleaveIndex();
-K16 inline V16 Deinterleave(const float* xyz) {
+inline V16 Deinterleave(const float* xyz) {
   const __m512 a = _mm512_loadu_ps(xyz), b = _mm512_loadu_ps(xyz + 16);
   const __m512 c = _mm512_loadu_ps(xyz + 32);
   V16 v;
@@ -192,18 +197,18 @@ K16 inline V16 Deinterleave(const float* xyz) {
   }
   return v;
 }
-K16 inline V16 Splat(const Eigen::Vector3f& v) { return {Set(v.x()), Set(v.y()), Set(v.z())}; }
+inline V16 Splat(const Eigen::Vector3f& v) { return {Set(v.x()), Set(v.y()), Set(v.z())}; }
 
 // x with every component of magnitude under 1e-30 moved to +-1e-30 (the
 // inverse stays finite).
-K16 inline __m512 AwayFromZero16(__m512 x) {
+inline __m512 AwayFromZero16(__m512 x) {
   const __mmask16 tiny = _mm512_cmp_ps_mask(Abs(x), Set(1e-30f), _CMP_LT_OS);
   const __mmask16 negative = _mm512_cmp_ps_mask(x, _mm512_setzero_ps(), _CMP_LT_OS);
   return Select(tiny, Select(negative, Set(-1e-30f), Set(1e-30f)), x);
 }
 // CornerBoxInverse(d) from the inverses of AwayFromZero16(d) (the same
 // values wherever |d| >= 1e-30): divides only in a packet with tiny components.
-K16 inline V16 CornerBoxInverse(const V16& d, const __m512 away_inverse[3]) {
+inline V16 CornerBoxInverse(const V16& d, const __m512 away_inverse[3]) {
   const __m512 direction[3] = {d.x, d.y, d.z};
   __m512 inverse[3];
   for (int k = 0; k < 3; ++k) {
@@ -218,11 +223,11 @@ K16 inline V16 CornerBoxInverse(const V16& d, const __m512 away_inverse[3]) {
 
 // WalkWide4's walk, sixteen rays.
 // (inverse_B: the packet's inverse directions in the Bullet frame.)
-K16 void WalkWide16(const Target& target, const __m512 inverse_B[3], Packet16* packet) {
+void WalkWide16(const Target& target, const __m512 inverse_B[3], Packet16* packet) {
   const scene::TriangleBvh& bvh = *target.bvh;
   if (bvh.root == scene::TriangleBvh::kEmpty) return;
   const Eigen::Matrix3f& R = target.R_LB;
-  auto transform = [&](int row, const V16& v, float offset) K16 {
+  auto transform = [&](int row, const V16& v, float offset) {
     return Add(Add(Mul(Set(R(row, 0)), v.x), Mul(Set(R(row, 1)), v.y)),
                Add(Mul(Set(R(row, 2)), v.z), Set(offset)));
   };
@@ -238,8 +243,8 @@ K16 void WalkWide16(const Target& target, const __m512 inverse_B[3], Packet16* p
     inverse[k] = target.identity
                      ? inverse_B[k]
                      : _mm512_div_ps(Set(1.0f), AwayFromZero16(transform(k, packet->d, 0.0f)));
-    o_inverse[k] = Mul(target.identity ? origin_B[k] : transform(k, packet->o, target.p_LB[k]),
-                       inverse[k]);
+    o_inverse[k] =
+        Mul(target.identity ? origin_B[k] : transform(k, packet->o, target.p_LB[k]), inverse[k]);
     const __mmask16 positive = _mm512_cmp_ps_mask(inverse[k], _mm512_setzero_ps(), _CMP_GT_OS);
     sign[k] = (positive & packet->active) == packet->active ? 1
               : (positive & packet->active) == 0            ? -1
@@ -327,11 +332,12 @@ K16 void WalkWide16(const Target& target, const __m512 inverse_B[3], Packet16* p
   packet->t_max = t_max;
 }
 
-// Cast()'s rays [first, end) sixteen at a time against `targets` (a body's
-// objects next to each other), into `hits`.
-K16 void CastRays16(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t first,
-                    std::size_t end, const Target* const* targets, std::size_t num_targets,
-                    RayHits* hits) {
+}  // namespace
+
+// Sixteen rays at a time.
+void CastRays(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t first,
+              std::size_t end, const Target* const* targets, std::size_t num_targets,
+              RayHits* hits) {
   for (std::size_t i = first; i < end; i += 16) {
     Packet16 packet;
     const bool full = i + 16 <= end;
@@ -395,16 +401,20 @@ K16 void CastRays16(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::
   }
 }
 
+namespace {
+
 // The vectors at xyz (indexes of their x) of an array of them, in `lanes`.
-K16 inline V16 Gather(const float* base, __mmask16 lanes, __m512i xyz) {
+inline V16 Gather(const float* base, __mmask16 lanes, __m512i xyz) {
   return {_mm512_mask_i32gather_ps(_mm512_setzero_ps(), lanes, xyz, base, 4),
           _mm512_mask_i32gather_ps(_mm512_setzero_ps(), lanes, xyz, base + 1, 4),
           _mm512_mask_i32gather_ps(_mm512_setzero_ps(), lanes, xyz, base + 2, 4)};
 }
 
-// HitPairs (sensors/packet_walk.inc), sixteen pairs a test: the same lanes,
-// the same bits, the same order of taking the hits.
-K16 void HitPairs16(GridBand* band) {
+}  // namespace
+
+// packet_walk4.cc's HitPairs, sixteen pairs a test: the same lanes, the same
+// bits, the same order of taking the hits.
+void HitPairs(GridBand* band) {
   GridBand::Pairs& pairs = band->pairs;
   float* t = band->t_max;
   std::int32_t* body = band->body;
@@ -457,4 +467,4 @@ K16 void HitPairs16(GridBand* band) {
   pairs.count = 0;
 }
 
-#undef K16
+}  // namespace sandbox::sensors::SANDBOX_ISA

@@ -1,21 +1,70 @@
-// The BVH walk and watertight triangle test for the four rays of a packet,
-// included by sensors/ray_caster.cc once per arithmetic: it defines, in the
-// including namespace, WalkWide4 and HitPairs from `FusedMulAdd` (a b + c or a b - c
-// rounded once), `kPlainFirst` (plain arithmetic first, fused where rounding
-// could turn a decision) and SANDBOX_KERNEL_TARGET (the functions' target).
-// Not a header: it is compiled into each kernel.
+// The packet kernel of four rays (sensors/ray_kernels.h): the walk of each
+// object's own hierarchy and the watertight triangle test, four rays at a
+// time for Cast() and four triangle-ray pairs at a time for CastGrids().
+// Built twice by sensors/CMakeLists.txt: for any x86-64 (namespace sse2) and
+// with -mfma (namespace fma, __FMA__ defined).
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <limits>
+
+#include "sensors/lanes4.h"
+#include "sensors/ray_kernels.h"
+#include "sensors/walk_stack.h"
+
+namespace sandbox::sensors::SANDBOX_ISA {
+namespace {
+
+#if defined(__FMA__)
+// Fused multiply-adds throughout: what Embree's kernels use on CPUs with the
+// unit, the reference the grazing rules are matched to.
+inline __m128 FusedMulAdd(__m128 a, __m128 b, __m128 c, bool subtract) {
+  return subtract ? _mm_fmsub_ps(a, b, c) : _mm_fmadd_ps(a, b, c);
+}
+constexpr bool kPlainFirst = false;
+#else
+// Plain arithmetic first, fused (emulated) where rounding could turn a
+// decision: the same results as the fused kernel but for the emulation's rare
+// double rounding.
+// a b + c (or a b - c) rounded once: the product of two floats is exact in
+// double, so only the sum rounds, to double and then to float (a double
+// rounding that differs from a single one needs a tie at float precision
+// after rounding to double: about once in 2^29 operations).
+inline __m128 FusedMulAdd(__m128 a, __m128 b, __m128 c, bool subtract) {
+  const __m128d a_lo = _mm_cvtps_pd(a), b_lo = _mm_cvtps_pd(b), c_lo = _mm_cvtps_pd(c);
+  const __m128d a_hi = _mm_cvtps_pd(_mm_movehl_ps(a, a)), b_hi = _mm_cvtps_pd(_mm_movehl_ps(b, b));
+  const __m128d c_hi = _mm_cvtps_pd(_mm_movehl_ps(c, c));
+  const __m128d lo = subtract ? _mm_sub_pd(_mm_mul_pd(a_lo, b_lo), c_lo)
+                              : _mm_add_pd(_mm_mul_pd(a_lo, b_lo), c_lo);
+  const __m128d hi = subtract ? _mm_sub_pd(_mm_mul_pd(a_hi, b_hi), c_hi)
+                              : _mm_add_pd(_mm_mul_pd(a_hi, b_hi), c_hi);
+  return _mm_movelh_ps(_mm_cvtpd_ps(lo), _mm_cvtpd_ps(hi));
+}
+constexpr bool kPlainFirst = true;
+#endif
+
+// Four rays walked together (SSE2): a node is visited when any of them
+// enters it, and every test is done for the four at once. Rays of a sensor
+// are coherent (neighbouring beams or grid points), so the four mostly agree.
+struct Packet {
+  __m128 ox, oy, oz, dx, dy, dz;  // Bullet frame
+  __m128 t_max;                   // per lane
+  __m128 active;                  // all bits set in lanes that hold a ray
+  int body[4];
+  Eigen::Vector3f normal[4];  // in the Bullet frame, unnormalised
+};
 
 template <bool kFused>
-SANDBOX_KERNEL_TARGET inline __m128 MulAdd(__m128 a, __m128 b, __m128 c, bool subtract) {
+inline __m128 MulAdd(__m128 a, __m128 b, __m128 c, bool subtract) {
   if (kFused) return FusedMulAdd(a, b, c, subtract);
   return subtract ? Sub(Mul(a, b), c) : Add(Mul(a, b), c);
 }
 template <bool kFused>
-SANDBOX_KERNEL_TARGET inline __m128 Dot(const Vec4& a, const Vec4& b) {
+inline __m128 Dot(const Vec4& a, const Vec4& b) {
   return MulAdd<kFused>(a.x, b.x, MulAdd<kFused>(a.y, b.y, Mul(a.z, b.z), false), false);
 }
 template <bool kFused>
-SANDBOX_KERNEL_TARGET inline Vec4 Cross(const Vec4& a, const Vec4& b) {
+inline Vec4 Cross(const Vec4& a, const Vec4& b) {
   return {MulAdd<kFused>(a.y, b.z, Mul(a.z, b.y), true),
           MulAdd<kFused>(a.z, b.x, Mul(a.x, b.z), true),
           MulAdd<kFused>(a.x, b.y, Mul(a.y, b.x), true)};
@@ -23,7 +72,7 @@ SANDBOX_KERNEL_TARGET inline Vec4 Cross(const Vec4& a, const Vec4& b) {
 // The triangle normal from its edges (e0 + e1 + e2 = 0), each component
 // from whichever of e0 x e1 and e1 x e2 suffers less cancellation.
 template <bool kFused>
-SANDBOX_KERNEL_TARGET inline Vec4 StableNormal4(const Vec4& a, const Vec4& b, const Vec4& c) {
+inline Vec4 StableNormal4(const Vec4& a, const Vec4& b, const Vec4& c) {
   const __m128 ab_x = Mul(a.z, b.y), ab_y = Mul(a.x, b.z), ab_z = Mul(a.y, b.x);
   const __m128 bc_x = Mul(b.z, c.y), bc_y = Mul(b.x, c.z), bc_z = Mul(b.y, c.x);
   return {Select(_mm_cmplt_ps(Abs(ab_x), Abs(bc_x)), MulAdd<kFused>(a.y, b.z, ab_x, true),
@@ -40,9 +89,8 @@ SANDBOX_KERNEL_TARGET inline Vec4 StableNormal4(const Vec4& a, const Vec4& b, co
 // hit so far is a higher body's), which take the distance; the (unnormalised)
 // normals in *normal. So a tie between bodies goes to the lower body, in
 // whatever order a kernel meets the triangles.
-SANDBOX_KERNEL_TARGET inline __m128 HitLanes4(const Vec4 c[3], const Vec4& o, const Vec4& d,
-                                              __m128 lanes, __m128 ties, __m128* t_max,
-                                              Vec4* normal) {
+inline __m128 HitLanes4(const Vec4 c[3], const Vec4& o, const Vec4& d, __m128 lanes, __m128 ties,
+                        __m128* t_max, Vec4* normal) {
   const Vec4 v0 = Sub(c[0], o), v1 = Sub(c[1], o), v2 = Sub(c[2], o);
   const Vec4 e0 = Sub(v2, v0), e1 = Sub(v0, v1), e2 = Sub(v1, v2);
   // Plain arithmetic moves a value by a few ulps of its terms: an edge
@@ -50,7 +98,7 @@ SANDBOX_KERNEL_TARGET inline __m128 HitLanes4(const Vec4 c[3], const Vec4& o, co
   // |e0| |e1|. Within 1e-5 of them (of 0 or of the edge tolerance), the
   // fused value decides.
   const __m128 doubt = _mm_set1_ps(1e-5f);
-  auto edge = [&](const Vec4& e, const Vec4& sum) SANDBOX_KERNEL_TARGET {
+  auto edge = [&](const Vec4& e, const Vec4& sum) {
     if (!kPlainFirst) return Dot<true>(Cross<true>(e, sum), d);
     const __m128 plain = Dot<false>(Cross<false>(e, sum), d);
     const __m128 near_edge = Mul(doubt, Mul(L1(e), L1(sum)));
@@ -81,8 +129,8 @@ SANDBOX_KERNEL_TARGET inline __m128 HitLanes4(const Vec4 c[3], const Vec4& o, co
   const __m128 t = _mm_div_ps(depth, den);
   hit = _mm_and_ps(hit, _mm_cmpneq_ps(den, _mm_setzero_ps()));
   hit = _mm_and_ps(hit, _mm_cmpge_ps(t, _mm_setzero_ps()));
-  hit = _mm_and_ps(hit, _mm_or_ps(_mm_cmplt_ps(t, *t_max),
-                                  _mm_and_ps(ties, _mm_cmpeq_ps(t, *t_max))));
+  hit = _mm_and_ps(hit,
+                   _mm_or_ps(_mm_cmplt_ps(t, *t_max), _mm_and_ps(ties, _mm_cmpeq_ps(t, *t_max))));
   if (_mm_movemask_ps(hit) == 0) return hit;
   const Vec4 box_low{_mm_min_ps(_mm_min_ps(c[0].x, c[1].x), c[2].x),
                      _mm_min_ps(_mm_min_ps(c[0].y, c[1].y), c[2].y),
@@ -98,18 +146,15 @@ SANDBOX_KERNEL_TARGET inline __m128 HitLanes4(const Vec4 c[3], const Vec4& o, co
 
 // HitLanes4 for four rays against one triangle: the lanes it hits take its
 // distance, `body_id` and its (unnormalised) normal.
-SANDBOX_KERNEL_TARGET inline void HitCorners4(const Eigen::Vector3f corner[3], int body_id,
-                                              const Vec4& o, const Vec4& d, __m128 lanes,
-                                              __m128* t_max, int body[4],
-                                              Eigen::Vector3f normal[4]) {
+inline void HitCorners4(const Eigen::Vector3f corner[3], int body_id, const Vec4& o, const Vec4& d,
+                        __m128 lanes, __m128* t_max, int body[4], Eigen::Vector3f normal[4]) {
   Vec4 c[3];
   for (int k = 0; k < 3; ++k) {
     c[k] = {_mm_set1_ps(corner[k].x()), _mm_set1_ps(corner[k].y()), _mm_set1_ps(corner[k].z())};
   }
   Vec4 n;
-  const __m128 ties = _mm_castsi128_ps(
-      _mm_cmpgt_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(body)),
-                      _mm_set1_epi32(body_id)));
+  const __m128 ties = _mm_castsi128_ps(_mm_cmpgt_epi32(
+      _mm_loadu_si128(reinterpret_cast<const __m128i*>(body)), _mm_set1_epi32(body_id)));
   const int mask = _mm_movemask_ps(HitLanes4(c, o, d, lanes, ties, t_max, &n));
   if (mask == 0) return;
   alignas(16) float nx[4], ny[4], nz[4];
@@ -128,7 +173,7 @@ SANDBOX_KERNEL_TARGET inline void HitCorners4(const Eigen::Vector3f corner[3], i
 // every hit. Boxes are in the object's frame, the rays taken there; each
 // box is grown by the object's margin (the rounding of that change of frame),
 // so a ray's box test never drops a triangle its Bullet-frame test would hit.
-SANDBOX_KERNEL_TARGET void WalkWide4(const Target& target, Packet* packet) {
+void WalkWide4(const Target& target, Packet* packet) {
   const scene::TriangleBvh& bvh = *target.bvh;
   if (bvh.root == scene::TriangleBvh::kEmpty) return;
   const Eigen::Matrix3f& R = target.R_LB;
@@ -229,12 +274,26 @@ SANDBOX_KERNEL_TARGET void WalkWide4(const Target& target, Packet* packet) {
   packet->t_max = t_max;
 }
 
-// The pairs of a grid band (GridBand::Pairs: a triangle and a ray each), four
-// at a time, a pair a lane; then none are left. A ray that ends before the
+// Lanes whose rays enter an axis-aligned box (Bullet frame) before their t_max.
+inline int PacketMeetsBox(const Packet& packet, const __m128 inverse[3],
+                          const Eigen::Vector3f& box_min, const Eigen::Vector3f& box_max) {
+  const __m128 o[3] = {packet.ox, packet.oy, packet.oz};
+  __m128 t_enter = _mm_setzero_ps(), t_exit = packet.t_max;
+  for (int k = 0; k < 3; ++k) {
+    const __m128 t1 = Mul(Sub(_mm_set1_ps(box_min[k]), o[k]), inverse[k]);
+    const __m128 t2 = Mul(Sub(_mm_set1_ps(box_max[k]), o[k]), inverse[k]);
+    t_enter = _mm_max_ps(t_enter, _mm_min_ps(t1, t2));
+    t_exit = _mm_min_ps(t_exit, _mm_max_ps(t1, t2));
+  }
+  return _mm_movemask_ps(_mm_and_ps(packet.active, _mm_cmple_ps(t_enter, t_exit)));
+}
+}  // namespace
+
+// Four pairs at a time. A ray that ends before the
 // pair's `near` (its triangle's nearest depth) is left out. Where two lanes
 // hold the same ray, the nearer hit stays (on a tie, the lower body's, then
 // the earlier pair's): the same result as the pairs taken one by one.
-SANDBOX_KERNEL_TARGET void HitPairs(GridBand* band) {
+void HitPairs(GridBand* band) {
   GridBand::Pairs& pairs = band->pairs;
   const Vec4 d{band->dx, band->dy, band->dz};
   const __m128i lane_index = _mm_setr_epi32(0, 1, 2, 3);
@@ -261,13 +320,13 @@ SANDBOX_KERNEL_TARGET void HitPairs(GridBand* band) {
               _mm_load_ps(&pairs.corner[3 * j + 2][k])};
     }
     Vec4 n;
-    const __m128 ties = _mm_castsi128_ps(_mm_cmpgt_epi32(
-        _mm_setr_epi32(band->body[cell[0]], band->body[cell[1]], band->body[cell[2]],
-                       band->body[cell[3]]),
-        _mm_setr_epi32(pairs.body[k + std::min(0, in_packet - 1)],
-                       pairs.body[k + std::min(1, in_packet - 1)],
-                       pairs.body[k + std::min(2, in_packet - 1)],
-                       pairs.body[k + std::min(3, in_packet - 1)])));
+    const __m128 ties = _mm_castsi128_ps(
+        _mm_cmpgt_epi32(_mm_setr_epi32(band->body[cell[0]], band->body[cell[1]],
+                                       band->body[cell[2]], band->body[cell[3]]),
+                        _mm_setr_epi32(pairs.body[k + std::min(0, in_packet - 1)],
+                                       pairs.body[k + std::min(1, in_packet - 1)],
+                                       pairs.body[k + std::min(2, in_packet - 1)],
+                                       pairs.body[k + std::min(3, in_packet - 1)])));
     const int mask = _mm_movemask_ps(HitLanes4(c, o, d, lanes, ties, &t_max, &n));
     if (mask == 0) continue;
     alignas(16) float t_hit[4], nx[4], ny[4], nz[4];
@@ -275,8 +334,8 @@ SANDBOX_KERNEL_TARGET void HitPairs(GridBand* band) {
     _mm_store_ps(nx, n.x), _mm_store_ps(ny, n.y), _mm_store_ps(nz, n.z);
     for (int lane = 0; lane < in_packet; ++lane) {
       const auto i = std::size_t(cell[lane]);
-      const bool nearer = t_hit[lane] < t[i] ||
-                          (t_hit[lane] == t[i] && pairs.body[k + lane] < band->body[i]);
+      const bool nearer =
+          t_hit[lane] < t[i] || (t_hit[lane] == t[i] && pairs.body[k + lane] < band->body[i]);
       if (!(mask & (1 << lane)) || !nearer) continue;
       t[i] = t_hit[lane];
       band->body[i] = pairs.body[k + lane];
@@ -285,3 +344,55 @@ SANDBOX_KERNEL_TARGET void HitPairs(GridBand* band) {
   }
   pairs.count = 0;
 }
+
+void CastRays(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t first,
+              std::size_t end, const Target* const* targets, std::size_t num_targets,
+              RayHits* hits) {
+  for (std::size_t i = first; i < end; i += 4) {
+    alignas(16) float lane[7][4];
+    alignas(16) std::uint32_t active[4];
+    for (int l = 0; l < 4; ++l) {
+      const std::size_t r = std::min(i + std::size_t(l), end - 1);
+      const Eigen::Vector3f o = origin_B + rays.start[r];
+      lane[0][l] = o.x(), lane[1][l] = o.y(), lane[2][l] = o.z();
+      lane[3][l] = rays.direction[r].x(), lane[4][l] = rays.direction[r].y();
+      lane[5][l] = rays.direction[r].z(), lane[6][l] = rays.length_m[r];
+      active[l] = i + std::size_t(l) < end ? 0xFFFFFFFFu : 0u;
+    }
+    Packet packet;
+    packet.ox = _mm_load_ps(lane[0]), packet.oy = _mm_load_ps(lane[1]);
+    packet.oz = _mm_load_ps(lane[2]), packet.dx = _mm_load_ps(lane[3]);
+    packet.dy = _mm_load_ps(lane[4]), packet.dz = _mm_load_ps(lane[5]);
+    packet.t_max = _mm_load_ps(lane[6]);
+    packet.active = _mm_load_ps(reinterpret_cast<const float*>(active));
+    const __m128 inverse[3] = {_mm_div_ps(_mm_set1_ps(1.0f), AwayFromZero(packet.dx)),
+                               _mm_div_ps(_mm_set1_ps(1.0f), AwayFromZero(packet.dy)),
+                               _mm_div_ps(_mm_set1_ps(1.0f), AwayFromZero(packet.dz))};
+    for (int l = 0; l < 4; ++l) packet.body[l] = RayHits::kNoHit;
+    for (std::size_t t = 0; t < num_targets;) {
+      // A run of one body's objects (a robot's pieces): skipped whole when
+      // the packet misses the box around them.
+      std::size_t run_end = t + 1;
+      while (run_end < num_targets && targets[run_end]->body == targets[t]->body) ++run_end;
+      if (run_end - t > 2 &&
+          PacketMeetsBox(packet, inverse, targets[t]->body_min, targets[t]->body_max) == 0) {
+        t = run_end;
+        continue;
+      }
+      for (; t < run_end; ++t) {
+        const Target& target = *targets[t];
+        if (PacketMeetsBox(packet, inverse, target.aabb_min, target.aabb_max) != 0) {
+          WalkWide4(target, &packet);
+        }
+      }
+    }
+    alignas(16) float t_max[4];
+    _mm_store_ps(t_max, packet.t_max);
+    for (int l = 0; l < 4 && i + std::size_t(l) < end; ++l) {
+      const std::size_t r = i + std::size_t(l);
+      WriteHit(r, t_max[l], packet.body[l], packet.normal[l], rays.direction[r], hits);
+    }
+  }
+}
+
+}  // namespace sandbox::sensors::SANDBOX_ISA

@@ -1,10 +1,21 @@
-// The deferred shading kernel: deferred_shading.cc includes this three
-// times, in a namespace of its own each, compiled for AVX-512 (SANDBOX_SIMD
-// 512: 16 pixels at a time), AVX2 + FMA (256: 8) and any x86-64 (0: 8, in
-// SSE2 halves). Each line mirrors a line of the forward shaders (shaders.h:
+// The deferred shading kernel (deferred_kernel.h), written once for vectors
+// of kLanes pixels in GCC's vector extensions and built per instruction set:
+// avx512 (16 pixels at a time), avx2 (8, with FMA) and sse2 (8, in SSE2
+// halves). Each line mirrors a line of the forward shaders (shaders.h:
 // kShading, the scene and sky programs).
 
-#if SANDBOX_SIMD == 512
+#include "sensors/render/deferred_kernel.h"
+
+#include <immintrin.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace sandbox::render::SANDBOX_ISA {
+namespace {
+
+#if defined(__AVX512F__)
 constexpr int kLanes = 16;
 #else
 constexpr int kLanes = 8;
@@ -26,10 +37,10 @@ INLINE vf Clamp01(vf a) { return Min(Max(a, Splat(0.f)), Splat(1.f)); }
 INLINE vf Abs(vf a) { return __builtin_bit_cast(vf, __builtin_bit_cast(vi, a) & 0x7fffffff); }
 INLINE vf Mix(vf a, vf b, vf t) { return a + (b - a) * t; }
 INLINE bool Any(vi mask) {
-#if SANDBOX_SIMD == 512
+#if defined(__AVX512F__)
   const __m512i m = reinterpret_cast<__m512i>(mask);
   return _mm512_test_epi32_mask(m, m) != 0;
-#elif SANDBOX_SIMD == 256
+#elif defined(__AVX2__)
   return _mm256_movemask_ps(reinterpret_cast<__m256>(mask)) != 0;
 #else
   for (int k = 0; k < kLanes; ++k) {
@@ -44,9 +55,9 @@ INLINE vf Floor(vf x) {
   return t - Select(t > x, Splat(1.f), Splat(0.f));
 }
 INLINE vf Sqrt(vf x) {
-#if SANDBOX_SIMD == 512
+#if defined(__AVX512F__)
   return reinterpret_cast<vf>(_mm512_maskz_sqrt_ps(0xffff, reinterpret_cast<__m512>(x)));
-#elif SANDBOX_SIMD == 256
+#elif defined(__AVX2__)
   return reinterpret_cast<vf>(_mm256_sqrt_ps(reinterpret_cast<__m256>(x)));
 #else
   vf r;
@@ -55,10 +66,10 @@ INLINE vf Sqrt(vf x) {
 #endif
 }
 INLINE vf Gather(const float* base, vi index) {
-#if SANDBOX_SIMD == 512
+#if defined(__AVX512F__)
   return reinterpret_cast<vf>(_mm512_mask_i32gather_ps(_mm512_setzero_ps(), 0xffff,
                                                        reinterpret_cast<__m512i>(index), base, 4));
-#elif SANDBOX_SIMD == 256
+#elif defined(__AVX2__)
   return reinterpret_cast<vf>(_mm256_i32gather_ps(base, reinterpret_cast<__m256i>(index), 4));
 #else
   vf r;
@@ -67,10 +78,10 @@ INLINE vf Gather(const float* base, vi index) {
 #endif
 }
 INLINE vi Gather(const std::int32_t* base, vi index) {
-#if SANDBOX_SIMD == 512
+#if defined(__AVX512F__)
   return reinterpret_cast<vi>(_mm512_mask_i32gather_epi32(
       _mm512_setzero_si512(), 0xffff, reinterpret_cast<__m512i>(index), base, 4));
-#elif SANDBOX_SIMD == 256
+#elif defined(__AVX2__)
   return reinterpret_cast<vi>(_mm256_i32gather_epi32(base, reinterpret_cast<__m256i>(index), 4));
 #else
   vi r;
@@ -86,14 +97,14 @@ INLINE vi LaneIndex() {
 }
 // Each lane's 2 x 2 quad's left and right column's value (even x on the left).
 INLINE vf QuadLeft(vf v) {
-#if SANDBOX_SIMD == 512
+#if defined(__AVX512F__)
   return __builtin_shufflevector(v, v, 0, 0, 2, 2, 4, 4, 6, 6, 8, 8, 10, 10, 12, 12, 14, 14);
 #else
   return __builtin_shufflevector(v, v, 0, 0, 2, 2, 4, 4, 6, 6);
 #endif
 }
 INLINE vf QuadRight(vf v) {
-#if SANDBOX_SIMD == 512
+#if defined(__AVX512F__)
   return __builtin_shufflevector(v, v, 1, 1, 3, 3, 5, 5, 7, 7, 9, 9, 11, 11, 13, 13, 15, 15);
 #else
   return __builtin_shufflevector(v, v, 1, 1, 3, 3, 5, 5, 7, 7);
@@ -185,17 +196,8 @@ INLINE vf Noise(vf px, vf py) {
              Mix(Hash(ix, iy + 1), Hash(ix + 1, iy + 1), sx), sy);
 }
 
-// What the kernel reads besides the layers.
-struct Constants {
-  const LightingFrame* frame;
-  const DetailTextures* detail;
-  const std::int32_t* srgb;  // kSrgbSteps + 1 entries: display byte of a linear value
-  const float* shadow;       // the cascades' maps, one after the other
-  int width, height;
-};
-
 // The display byte of linear values (clamped to 0..1).
-INLINE vi Out(const Constants& k, vf c) {
+INLINE vi Out(const ShadeConstants& k, vf c) {
   return Gather(k.srgb, ToI(Clamp01(c) * float(kSrgbSteps) + 0.5f));
 }
 
@@ -250,7 +252,7 @@ INLINE vf Pcf(const float* depth, int px, vi base, vf s, vf t, vf ref) {
 
 // The point p pushed off the surface along n, more where the sun grazes it
 // and by the levels of detail's allowance, then into `m`'s clip space.
-INLINE Vec3 ToMap(const Constants& k, const ShadowMapView& m, const Vec3& n, const Vec3& p,
+INLINE Vec3 ToMap(const ShadeConstants& k, const ShadowMapView& m, const Vec3& n, const Vec3& p,
                   vf grazing, vf distance_m) {
   const vf offset = (0.4f + 1.5f * grazing) * m.texel_m + k.frame->lod_offset_per_m * distance_m;
   const vf x = p.x + n.x * offset, y = p.y + n.y * offset, z = p.z + n.z * offset;
@@ -262,7 +264,7 @@ INLINE Vec3 ToMap(const Constants& k, const ShadowMapView& m, const Vec3& n, con
 
 // The sun's light reaching p (shaders.h's Shadow): the still casters'
 // cascade for p's depth along the view, times the moving casters' map.
-INLINE vf Shadow(const Constants& k, const Vec3& n, const Vec3& p, vf distance_m) {
+INLINE vf Shadow(const ShadeConstants& k, const Vec3& n, const Vec3& p, vf distance_m) {
   const std::vector<ShadowMapView>& cascades = k.frame->cascades;
   if (cascades.empty()) return Splat(1.f);
   const Eigen::Vector3f& sun = k.frame->sun;
@@ -300,7 +302,7 @@ INLINE vf Shadow(const Constants& k, const Vec3& n, const Vec3& p, vf distance_m
 
 // The ground's albedo (shaders.h's GroundAlbedo); d*_x, d*_y: the screen
 // derivatives of the world x, y.
-INLINE Vec3 GroundAlbedo(const Constants& k, const Vec3& base, vi imagery, const Vec3& n,
+INLINE Vec3 GroundAlbedo(const ShadeConstants& k, const Vec3& base, vi imagery, const Vec3& n,
                          const Vec3& p, vf distance_m, vf dx_x, vf dy_x, vf dx_y, vf dy_y) {
   const LightingFrame& f = *k.frame;
   const vf st_x = p.x + f.camera_xy.x(), st_y = p.y + f.camera_xy.y();
@@ -345,8 +347,8 @@ INLINE Vec3 GroundAlbedo(const Constants& k, const Vec3& base, vi imagery, const
 }
 
 // Sun (with its shadow) and sky light, and with materials the highlight (shaders.h's Lit).
-INLINE Vec3 Lit(const Constants& k, const Vec3& albedo, const Vec3& n, const Vec3& p, vf distance_m,
-                vf metal, vf rough) {
+INLINE Vec3 Lit(const ShadeConstants& k, const Vec3& albedo, const Vec3& n, const Vec3& p,
+                vf distance_m, vf metal, vf rough) {
   const LightingFrame& f = *k.frame;
   const Vec3 sun = Splat(f.sun);
   const vf sun_light = Max(Dot(n, sun), Splat(0.f)) * Shadow(k, n, p, distance_m);
@@ -378,8 +380,8 @@ struct Shaded {
 };
 
 // Points of one kind code each: their linear colour (shaders.h's scene program).
-INLINE Shaded ShadeSurface(const Constants& k, const Vec3& p, const Vec3& n, Vec3 albedo, vi code,
-                           vf rough, vf distance_m, vf haze, const vf derivatives[4]) {
+INLINE Shaded ShadeSurface(const ShadeConstants& k, const Vec3& p, const Vec3& n, Vec3 albedo,
+                           vi code, vf rough, vf distance_m, vf haze, const vf derivatives[4]) {
   const LightingFrame& f = *k.frame;
   const vi kind = code & 7;
   const vf metal = ToF(code >> 3) * (1.f / 31.f);
@@ -450,9 +452,9 @@ INLINE V Load(const std::vector<T>& data, int width, int row, int x) {
   return v;
 }
 
-// Rows [row_begin, row_end) (even row_begin) of `rgba` from the layers, and
-// their luma (0..1) into `luma` when given.
-void ShadeRows(const Constants& k, const SurfaceLayer& opaque, const SurfaceLayer* translucent,
+}  // namespace
+
+void ShadeRows(const ShadeConstants& k, const SurfaceLayer& opaque, const SurfaceLayer* translucent,
                int row_begin, int row_end, std::uint32_t* rgba, float* luma) {
   const LightingFrame& f = *k.frame;
   const Eigen::Matrix4f& M = f.clip_to_world;
@@ -562,11 +564,8 @@ void ShadeRows(const Constants& k, const SurfaceLayer& opaque, const SurfaceLaye
   }
 }
 
-// Calls edge(x) for each pixel x of row `row` that the edge filter changes:
-// where its luma and its four diagonal neighbours' (clamped at the image's
-// edges) differ by at least max(1/32, their highest / 8).
-template <typename Edge>
-void ForEachEdge(const float* luma, int w, int h, int row, Edge&& edge) {
+int EdgesOfRow(const float* luma, int w, int h, int row, int* columns) {
+  int count = 0;
   const float* above = luma + std::size_t(std::max(row - 1, 0)) * std::size_t(w);
   const float* here = luma + std::size_t(row) * std::size_t(w);
   const float* below = luma + std::size_t(std::min(row + 1, h - 1)) * std::size_t(w);
@@ -589,9 +588,10 @@ void ForEachEdge(const float* luma, int w, int h, int row, Edge&& edge) {
     const vi edges = hi - lo >= Max(Splat(1.f / 32.f), hi * (1.f / 8.f));
     if (!Any(edges)) continue;
     for (int i = 0; i < kLanes && x + i < w; ++i) {
-      if (edges[i]) edge(x + i);
+      if (edges[i]) columns[count++] = x + i;
     }
   }
+  return count;
 }
 
-#undef INLINE
+}  // namespace sandbox::render::SANDBOX_ISA

@@ -1,0 +1,119 @@
+#pragma once
+// The ray caster's kernels: the code that tests rays against triangles, once
+// per instruction set. Internal to the caster (ray_caster.cc calls them).
+//
+// Each packet kernel is a source file built once per instruction set by
+// CMake's sandbox_isa_kernel, in a namespace named after the set:
+//   packet_walk4.cc   four rays a packet: sse2 (any x86-64; fused
+//                     multiply-adds emulated where rounding could turn a
+//                     decision) and fma (fused throughout, as Embree's);
+//   packet_walk16.cc  sixteen rays a packet: avx512 (fused, as fma).
+// All give the same hits (docs/reference/sensors.md). RayCaster::kernel()
+// names the one in use; SANDBOX_RAY_KERNEL picks another.
+
+#include <immintrin.h>
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "sensors/ray_caster.h"
+#include "sensors/ray_targets.h"
+
+namespace sandbox::sensors {
+
+// Whether the ray, up to t, meets the triangle's own bounding box (with two
+// ulps of slack on the distances). A hit the edge test admits within its
+// rounding tolerance but that lies outside the triangle's box is no hit: a ray
+// passing a hair outside an outer edge misses, as a watertight caster's box
+// test has it. A direction component of exactly 0 counts as an
+// infinitesimally positive one (Embree's convention): a ray running along the
+// box's upper bound on that axis leaves the box at once, along its lower bound
+// stays in it; of two surfaces that abut there without sharing an edge, the
+// ray meets exactly one.
+constexpr float kHuge = 1e30f;
+
+// Ray r's result: its distance, the body hit and, when asked for, the unit
+// normal facing the ray (zero without a hit).
+static inline void WriteHit(std::size_t r, float t, int body, const Eigen::Vector3f& normal,
+                            const Eigen::Vector3f& direction, RayHits* hits) {
+  hits->distance_m[r] = t;
+  hits->body[r] = body;
+  if (!hits->with_normals) return;
+  if (body == RayHits::kNoHit) {
+    hits->normal_W[r].setZero();
+    return;
+  }
+  const Eigen::Vector3f unit = normal.normalized();
+  hits->normal_W[r] = unit.dot(direction) > 0.0f ? -unit : unit;
+}
+
+// The rays of a band of rows of one grid block (RayGrid), as the structured
+// kernel reads them: origins in the Bullet frame and results, indexed by cell
+// (a band's ray from its first).
+struct GridBand {
+  __m128 dx, dy, dz;                      // the block's direction
+  __m128 ox, oy, oz;                      // the batch origin (a ray starts at it plus its start)
+  const Eigen::Vector3f* start{nullptr};  // the cells' rays' starts
+  float* t_max{nullptr};                  // their entries of RayHits::distance_m
+  std::int32_t* body{nullptr};            // of RayHits::body
+  Eigen::Vector3f* normal{nullptr};       // unnormalised, or null: none asked for
+  std::vector<Eigen::Vector3f> normals;   // their storage
+  // Triangle-ray pairs waiting for a test (HitPairs), in lanes' order.
+  struct Pairs {
+    static constexpr int kCapacity = 64;
+    int count{0};
+    alignas(16) float corner[9][kCapacity];  // x, y, z of corner 0, 1, 2
+    alignas(16) float near[kCapacity];
+    int cell[kCapacity], body[kCapacity];
+  } pairs;
+
+  // Queues the triangle with these corners against ray `cell`; tests the
+  // queue when full (test: HitPairs of the kernel in use).
+  template <typename Test>
+  void Add(const Eigen::Vector3f corner[3], int body_id, int cell_index, float near_depth,
+           Test test) {
+    const int k = pairs.count++;
+    for (int j = 0; j < 3; ++j) {
+      for (int a = 0; a < 3; ++a) pairs.corner[3 * j + a][k] = corner[j][a];
+    }
+    pairs.near[k] = near_depth;
+    pairs.cell[k] = cell_index;
+    pairs.body[k] = body_id;
+    if (pairs.count == Pairs::kCapacity) test(this);
+  }
+};
+
+// Cast()'s rays [first, end) of `rays` (ray r starts at origin_B + start[r],
+// Bullet frame) against `targets` (a body's objects next to each other),
+// into `hits`.
+using CastRaysKernel = void (*)(const RayBatch& rays, const Eigen::Vector3f& origin_B,
+                                std::size_t first, std::size_t end, const Target* const* targets,
+                                std::size_t num_targets, RayHits* hits);
+
+// The pairs queued in a grid band (GridBand::Pairs: a triangle and a ray
+// each), tested, a pair a lane; then none are left.
+using HitPairsKernel = void (*)(GridBand* band);
+
+namespace sse2 {
+void CastRays(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t first,
+              std::size_t end, const Target* const* targets, std::size_t num_targets,
+              RayHits* hits);
+void HitPairs(GridBand* band);
+}  // namespace sse2
+
+namespace fma {
+void CastRays(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t first,
+              std::size_t end, const Target* const* targets, std::size_t num_targets,
+              RayHits* hits);
+void HitPairs(GridBand* band);
+}  // namespace fma
+
+namespace avx512 {
+void CastRays(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t first,
+              std::size_t end, const Target* const* targets, std::size_t num_targets,
+              RayHits* hits);
+void HitPairs(GridBand* band);
+}  // namespace avx512
+
+}  // namespace sandbox::sensors

@@ -1,0 +1,53 @@
+#pragma once
+// The world's objects as the ray caster's kernels read them: internal to the
+// caster (ray_caster.cc, ray_targets.cc and the kernels of ray_kernels.h).
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include <LinearMath/btTransform.h>
+
+#include "scene/collision_world.h"
+#include "scene/triangle_bvh.h"
+#include "sensors/ray_caster.h"
+
+namespace sandbox::sensors {
+
+constexpr int kStackInPlace = RayCaster::kStackInPlace;
+
+// One Bullet object as a ray sees it: where it is and its own hierarchy.
+struct Target {
+  int body{-1};
+  std::uint32_t group{0};  // the object's collision group (scene::kWorldStatic, ...)
+  // The box around this object and the other objects of its body next to it
+  // in the list (a robot's pieces): a packet that misses it skips them all.
+  Eigen::Vector3f body_min{Eigen::Vector3f::Zero()}, body_max{Eigen::Vector3f::Zero()};
+  Eigen::Vector3f aabb_min, aabb_max;  // in the Bullet frame (world minus origin)
+  Eigen::Matrix3f R_LB;                // local from Bullet frame
+  Eigen::Vector3f p_LB;
+  btTransform X_BL;      // Bullet frame from local: where triangles are tested
+  bool identity{false};  // X_BL is exactly the identity
+  // The object's own hierarchy (local frame), and how far its boxes are grown
+  // for the rounding of rays taken into that frame.
+  const scene::TriangleBvh* bvh{nullptr};
+  float box_margin{0.f};
+  // The merged static objects' target (scene::MergedStatic) has a body per
+  // leaf part (BodyOf); any other, its one body.
+  const std::int32_t* body_of_part{nullptr};
+  int BodyOf(int part) const { return body_of_part != nullptr ? body_of_part[part] : body; }
+};
+
+inline Eigen::Vector3f ToEigen(const btVector3& v) {
+  return {float(v.x()), float(v.y()), float(v.z())};
+}
+
+// Every object of the world, in the world's order (a body's objects next to
+// each other), with the boxes around each run of one body's objects.
+std::vector<Target> CollectTargets(const scene::CollisionWorld& world);
+
+// The target of the world's merged static objects (scene::MergedStatic),
+// placed for the world's origin now.
+Target MergedTarget(const scene::CollisionWorld& world);
+
+}  // namespace sandbox::sensors
