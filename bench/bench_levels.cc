@@ -52,8 +52,13 @@ std::string Machine() {
     if (start != std::string::npos) model = line.substr(start);
     break;
   }
+  // The instruction sets the kernels are built for (sandbox_isa_kernel) that it runs.
+  std::string sets = "sse2";
+  if (__builtin_cpu_supports("fma")) sets += " fma";
+  if (__builtin_cpu_supports("avx2")) sets += " avx2";
+  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq")) sets += " avx512";
   return "machine: " + model + ", " + std::to_string(std::thread::hardware_concurrency()) +
-         " logical CPUs";
+         " logical CPUs, " + sets;
 }
 
 }  // namespace sandbox::bench

@@ -33,15 +33,6 @@ inline __m512 Abs(__m512 x) {
   return _mm512_castsi512_ps(
       _mm512_maskz_andnot_epi32(0xFFFF, _mm512_castps_si512(Set(-0.0f)), _mm512_castps_si512(x)));
 }
-inline __m512 L1(const V16& a) { return Add(Add(Abs(a.x), Abs(a.y)), Abs(a.z)); }
-// The least of the sixteen lanes.
-inline float ReduceMin(__m512 x) {
-  x = Min(x, _mm512_maskz_shuffle_f32x4(0xFFFF, x, x, _MM_SHUFFLE(1, 0, 3, 2)));
-  x = Min(x, _mm512_maskz_shuffle_f32x4(0xFFFF, x, x, _MM_SHUFFLE(2, 3, 0, 1)));
-  x = Min(x, _mm512_maskz_permute_ps(0xFFFF, x, _MM_SHUFFLE(1, 0, 3, 2)));
-  x = Min(x, _mm512_maskz_permute_ps(0xFFFF, x, _MM_SHUFFLE(2, 3, 0, 1)));
-  return _mm512_cvtss_f32(x);
-}
 // a where the mask is set, b elsewhere.
 inline __m512 Select(__mmask16 mask, __m512 a, __m512 b) {
   return _mm512_mask_blend_ps(mask, b, a);

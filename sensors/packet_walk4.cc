@@ -23,13 +23,12 @@ inline __m128 FusedMulAdd(__m128 a, __m128 b, __m128 c, bool subtract) {
 }
 constexpr bool kPlainFirst = false;
 #else
-// Plain arithmetic first, fused (emulated) where rounding could turn a
-// decision: the same results as the fused kernel but for the emulation's rare
-// double rounding.
-// a b + c (or a b - c) rounded once: the product of two floats is exact in
-// double, so only the sum rounds, to double and then to float (a double
-// rounding that differs from a single one needs a tie at float precision
-// after rounding to double: about once in 2^29 operations).
+// Plain arithmetic first, fused where rounding could turn a decision, the
+// fused a b + c (or a b - c) emulated: the product of two floats is exact in
+// double, so only the sum rounds, to double and then to float. The same
+// results as the fma build but for that double rounding, which differs from
+// a single one only at a tie at float precision after rounding to double:
+// about once in 2^29 operations.
 inline __m128 FusedMulAdd(__m128 a, __m128 b, __m128 c, bool subtract) {
   const __m128d a_lo = _mm_cvtps_pd(a), b_lo = _mm_cvtps_pd(b), c_lo = _mm_cvtps_pd(c);
   const __m128d a_hi = _mm_cvtps_pd(_mm_movehl_ps(a, a)), b_hi = _mm_cvtps_pd(_mm_movehl_ps(b, b));

@@ -146,9 +146,6 @@ INLINE Vec3 Normalize(const Vec3& a) {
   const vf s = 1.f / Sqrt(Max(Dot(a, a), Splat(1e-30f)));
   return {a.x * s, a.y * s, a.z * s};
 }
-INLINE Vec3 Mix(const Vec3& a, const Vec3& b, vf t) {
-  return {Mix(a.x, b.x, t), Mix(a.y, b.y, t), Mix(a.z, b.z, t)};
-}
 INLINE Vec3 Mix(const Vec3& a, const Eigen::Vector3f& b, vf t) {
   return {Mix(a.x, Splat(b.x()), t), Mix(a.y, Splat(b.y()), t), Mix(a.z, Splat(b.z()), t)};
 }

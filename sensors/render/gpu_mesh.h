@@ -7,8 +7,10 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
+#include "scene/mesh.h"
 #include "sensors/render/gl.h"
 #include "sensors/render/hidden_faces.h"
 #include "sensors/render/mesh_lods.h"
@@ -31,7 +33,7 @@ struct GpuMesh {
   mutable std::size_t level{0};
   HiddenBackFaces hidden;  // where its back faces cannot be seen, in its own frame
   int material{-1};
-  int surface{-1};  // a scene::Surface over the material's, -1: the material's
+  std::optional<scene::Surface> surface;  // over the material's; none: the material's
   std::uint32_t segment_base{0};
   GLuint triangle_segments{0}, triangle_segment_buffer{0};  // a buffer texture, 0: none
 };

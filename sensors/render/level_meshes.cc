@@ -8,16 +8,16 @@
 
 namespace sandbox::render {
 
-bool DrawnWhole(const scene::Level& level, int material, int surface) {
-  if (surface == int(scene::Surface::kWater)) return false;
+bool DrawnWhole(const scene::Level& level, int material, std::optional<scene::Surface> surface) {
+  if (surface == scene::Surface::kWater) return false;
   if (material < 0 || material >= int(level.materials.size())) return true;
   const scene::Material& m = level.materials[std::size_t(material)];
   return m.surface != scene::Surface::kWater && m.alpha_mode != scene::AlphaMode::kMask &&
          m.base_color.w() >= 0.999f;
 }
 
-bool IsTranslucent(const scene::Level& level, int material, int surface) {
-  if (surface == int(scene::Surface::kWater)) return true;
+bool IsTranslucent(const scene::Level& level, int material, std::optional<scene::Surface> surface) {
+  if (surface == scene::Surface::kWater) return true;
   if (material < 0 || material >= int(level.materials.size())) return false;
   const scene::Material& m = level.materials[std::size_t(material)];
   return m.surface == scene::Surface::kWater ||
@@ -33,7 +33,7 @@ std::vector<StaticChunk> MergeStaticActors(const scene::Level& level, const Eige
                                            const SegmentationLegend& legend) {
   // By material, surface, ground cell and which back faces may go
   // (-1: none, 0: those of solids, k + 1: those of height field k).
-  using Key = std::tuple<int, int, long, long, int>;
+  using Key = std::tuple<int, std::optional<scene::Surface>, long, long, int>;
   std::map<Key, StaticChunk> chunks;
   // Whether any mesh in a chunk had uvs, lightmap uvs, colours.
   std::map<Key, std::array<bool, 3>> any;
@@ -41,7 +41,7 @@ std::vector<StaticChunk> MergeStaticActors(const scene::Level& level, const Eige
   for (std::size_t a = 0; a < level.actors.size(); ++a) {
     const scene::Actor& actor = level.actors[a];
     if (actor.movable) continue;
-    const int surface = actor.surface ? int(*actor.surface) : -1;
+    const std::optional<scene::Surface> surface = actor.surface;
     const Eigen::Matrix3d R = actor.X_WA.linear();
     for (const scene::Mesh& mesh : actor.meshes) {
       // This mesh's vertices already copied into each chunk.
@@ -141,7 +141,7 @@ MovableMeshes UploadMovableActors(const scene::Level& level, const SegmentationL
       GpuMesh gpu = Upload({&mesh.positions_A, &mesh.normals_A, &mesh.uvs, &mesh.lightmap_uvs,
                             &mesh.colors, nullptr, nullptr, &lods},
                            mesh.material, GL_STATIC_DRAW);
-      gpu.surface = level.actors[a].surface ? int(*level.actors[a].surface) : -1;
+      gpu.surface = level.actors[a].surface;
       gpu.segment_base = legend.actor(int(a));
       gpu.moving = true;
       if (DrawnWhole(level, mesh.material, gpu.surface)) {

@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -17,18 +18,18 @@
 
 namespace sandbox::render {
 
-// Whether meshes of this material and surface (-1: the material's) are
+// Whether meshes of this material and surface (none: the material's) are
 // drawn opaque and whole (not water, not cut out, not see-through): their
 // back faces hide behind their front faces.
-bool DrawnWhole(const scene::Level& level, int material, int surface);
+bool DrawnWhole(const scene::Level& level, int material, std::optional<scene::Surface> surface);
 // Whether they are drawn after the opaque ones, blended (water, alpha below 1).
-bool IsTranslucent(const scene::Level& level, int material, int surface);
+bool IsTranslucent(const scene::Level& level, int material, std::optional<scene::Surface> surface);
 
 // Static geometry, merged. Positions are relative to the level's centre
 // (double) so that floats keep their precision in large levels.
 struct StaticChunk {
   int material{-1};
-  int surface{-1};
+  std::optional<scene::Surface> surface;
   std::vector<Eigen::Vector3f> positions, normals;
   std::vector<Eigen::Vector2f> uvs, lightmap_uvs;  // empty when no mesh in it had them
   std::vector<Eigen::Vector4f> colors;             // empty when no mesh in it had them

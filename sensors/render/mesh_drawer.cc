@@ -50,7 +50,7 @@ void MeshDrawer::Draw(const GpuMesh& mesh, const Eigen::Matrix4f& model) {
     return;
   }
   if (state_.look & kTranslucent) state_.translucent_drawn = true;
-  GlProgram& p = UseProgram(mesh.surface >= 0 ? scene::Surface(mesh.surface) : m.surface, features);
+  GlProgram& p = UseProgram(mesh.surface.value_or(m.surface), features);
   glUniformMatrix4fv(p.Uniform("model"), 1, GL_FALSE, model.data());
   const Eigen::Vector3f base = Shading(m.base_color.head<3>(), m.linear_color, state_.gamma);
   glUniform4f(p.Uniform("base_color"), base.x(), base.y(), base.z(), m.base_color.w());
@@ -106,8 +106,7 @@ void MeshDrawer::DrawPlain(const GpuMesh& mesh, const Eigen::Matrix4f& model,
   } else {
     const bool textured = texture != 0 && mesh.uvs != 0;
     GlProgram& p =
-        UseProgram(mesh.surface >= 0 ? scene::Surface(mesh.surface) : scene::Surface::kPlain,
-                   textured ? kTexture : 0);
+        UseProgram(mesh.surface.value_or(scene::Surface::kPlain), textured ? kTexture : 0);
     glUniformMatrix4fv(p.Uniform("model"), 1, GL_FALSE, model.data());
     const Eigen::Vector3f base = Shading(color.head<3>(), false, state_.gamma);
     glUniform4f(p.Uniform("base_color"), base.x(), base.y(), base.z(), color.w());

@@ -45,7 +45,7 @@ void RobotMeshes::Pose(const std::vector<const scene::RobotState*>& robots) {
         const int r = RobotIndex(model);
         meshes.back().moving = true;
         // (Closed as made; its volume as first posed.)
-        if (DrawnWhole(level_, bind.material, -1)) {
+        if (DrawnWhole(level_, bind.material, std::nullopt)) {
           meshes.back().hidden = HiddenBackFaces::Of(state->positions_B(int(m)), bind.indices);
         }
         meshes.back().segment_base = r >= 0 ? legend_.bone(r, 0) : 0xffffu;

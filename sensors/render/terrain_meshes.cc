@@ -113,7 +113,7 @@ void TerrainTiles::Update(const scene::TileList& tiles, std::uint32_t segment) {
     gpu.mesh =
         Upload({&tile->positions, &tile->normals, &tile->uvs, nullptr, nullptr, nullptr, &indices},
                -1, GL_STATIC_DRAW);
-    gpu.mesh.surface = int(scene::Surface::kTerrain);
+    gpu.mesh.surface = scene::Surface::kTerrain;
     gpu.mesh.segment_base = segment;
     if (!tile->texture_rgba.empty()) {
       gpu.texture = UploadTexture({tile->texture_width, tile->texture_height, tile->texture_rgba},
