@@ -359,24 +359,12 @@ void CastRays(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t
                                _mm512_div_ps(Set(1.0f), AwayFromZero16(packet.d.z))};
     packet.box_inverse = CornerBoxInverse(packet.d, inverse);
     for (int l = 0; l < 16; ++l) packet.body[l] = RayHits::kNoHit;
-    for (std::size_t t = 0; t < num_targets;) {
-      // A run of one body's objects (a robot's pieces): skipped whole when
-      // the packet misses the box around them.
-      std::size_t run_end = t + 1;
-      while (run_end < num_targets && targets[run_end]->body == targets[t]->body) ++run_end;
-      if (run_end - t > 2 &&
-          MeetsBox16(packet, inverse, targets[t]->body_min, targets[t]->body_max) == 0) {
-        t = run_end;
-        continue;
-      }
-      for (; t < run_end; ++t) {
-        const Target& target = *targets[t];
-        // (Every object the scene makes has its hierarchy: CollectTargets.)
-        if (MeetsBox16(packet, inverse, target.aabb_min, target.aabb_max) != 0) {
-          WalkWide16(target, inverse, &packet);
-        }
-      }
-    }
+    WalkTargetsMet(
+        targets, num_targets,
+        [&](const Eigen::Vector3f& lo, const Eigen::Vector3f& hi) {
+          return MeetsBox16(packet, inverse, lo, hi);
+        },
+        [&](const Target& target) { WalkWide16(target, inverse, &packet); });
     if (full && !hits->with_normals) {  // WriteHit's two stores, sixteen at once
       _mm512_storeu_ps(&hits->distance_m[i], packet.t_max);
       _mm512_storeu_si512(&hits->body[i], _mm512_load_si512(packet.body));
@@ -457,5 +445,7 @@ void HitPairs(GridBand* band) {
   }
   pairs.count = 0;
 }
+
+const RayKernel kKernel{SANDBOX_ISA_NAME, CastRays, HitPairs};
 
 }  // namespace sandbox::sensors::SANDBOX_ISA

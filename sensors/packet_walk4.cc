@@ -368,23 +368,12 @@ void CastRays(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t
                                _mm_div_ps(_mm_set1_ps(1.0f), AwayFromZero(packet.dy)),
                                _mm_div_ps(_mm_set1_ps(1.0f), AwayFromZero(packet.dz))};
     for (int l = 0; l < 4; ++l) packet.body[l] = RayHits::kNoHit;
-    for (std::size_t t = 0; t < num_targets;) {
-      // A run of one body's objects (a robot's pieces): skipped whole when
-      // the packet misses the box around them.
-      std::size_t run_end = t + 1;
-      while (run_end < num_targets && targets[run_end]->body == targets[t]->body) ++run_end;
-      if (run_end - t > 2 &&
-          PacketMeetsBox(packet, inverse, targets[t]->body_min, targets[t]->body_max) == 0) {
-        t = run_end;
-        continue;
-      }
-      for (; t < run_end; ++t) {
-        const Target& target = *targets[t];
-        if (PacketMeetsBox(packet, inverse, target.aabb_min, target.aabb_max) != 0) {
-          WalkWide4(target, &packet);
-        }
-      }
-    }
+    WalkTargetsMet(
+        targets, num_targets,
+        [&](const Eigen::Vector3f& lo, const Eigen::Vector3f& hi) {
+          return PacketMeetsBox(packet, inverse, lo, hi);
+        },
+        [&](const Target& target) { WalkWide4(target, &packet); });
     alignas(16) float t_max[4];
     _mm_store_ps(t_max, packet.t_max);
     for (int l = 0; l < 4 && i + std::size_t(l) < end; ++l) {
@@ -393,5 +382,7 @@ void CastRays(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t
     }
   }
 }
+
+const RayKernel kKernel{SANDBOX_ISA_NAME, CastRays, HitPairs};
 
 }  // namespace sandbox::sensors::SANDBOX_ISA

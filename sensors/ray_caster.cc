@@ -20,27 +20,18 @@ namespace {
 
 constexpr int kRaysPerChunk = 256;
 
-// A packet kernel (sensors/ray_kernels.h).
-struct Kernel {
-  const char* name;
-  CastRaysKernel cast_rays;
-  HitPairsKernel hit_pairs;
-};
-
 // The widest kernel the CPU runs, or the one SANDBOX_RAY_KERNEL names (tests
 // run each; the results are the same). A name the CPU cannot run, or no
 // kernel's, is said on stderr and the widest taken.
-const Kernel& ChosenKernel() {
-  static const Kernel chosen = [] {
+const RayKernel& ChosenKernel() {
+  static const RayKernel chosen = [] {
     const bool fma = __builtin_cpu_supports("fma");
     const bool avx512 =
         fma && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
     const struct {
-      Kernel kernel;
+      const RayKernel& kernel;
       bool runs;
-    } kernels[] = {{{"avx512", avx512::CastRays, avx512::HitPairs}, avx512},
-                   {{"fma", fma::CastRays, fma::HitPairs}, fma},
-                   {{"sse2", sse2::CastRays, sse2::HitPairs}, true}};
+    } kernels[] = {{avx512::kKernel, avx512}, {fma::kKernel, fma}, {sse2::kKernel, true}};
     const char* asked = std::getenv("SANDBOX_RAY_KERNEL");
     if (asked != nullptr && *asked != '\0') {
       for (const auto& k : kernels) {
@@ -336,7 +327,7 @@ BandArea AreaOf(const BandJob& band, const Eigen::Vector3d& world_origin) {
 // Queues the triangle with these corners (Bullet frame) against each ray of
 // the band whose cell its shadow on the grid covers.
 void QueueTriangle(const Eigen::Vector3f corners[3], int body, const BandArea& area,
-                   HitPairsKernel hit_pairs, GridBand* band) {
+                   void (*hit_pairs)(GridBand*), GridBand* band) {
   const BandFrame& frame = area.frame;
   const int cols = area.cols;
   // Columns u, rows v and depths s of the corners (SSE, a lane each).
@@ -392,7 +383,7 @@ void QueueTriangle(const Eigen::Vector3f corners[3], int body, const BandArea& a
 // `hit_pairs`, into `hits`.
 void CastBand(const BandJob& this_band, const RayBatch& rays, const Eigen::Vector3f& origin_B,
               const Eigen::Vector3d& world_origin, const std::vector<Target>& targets,
-              const Visible& wanted, HitPairsKernel hit_pairs, RayHits* hits) {
+              const Visible& wanted, void (*hit_pairs)(GridBand*), RayHits* hits) {
   const RayGrid& grid = *this_band.grid;
   const BandArea area = AreaOf(this_band, world_origin);
   const std::size_t first = grid.first + std::size_t(this_band.row_begin) * std::size_t(grid.cols);
@@ -442,8 +433,8 @@ void CastBand(const BandJob& this_band, const RayBatch& rays, const Eigen::Vecto
 // (`costs`): a block gets as many bands as it took threads' shares of the
 // total (rounded up), and the costliest bands are taken first, so that the
 // threads end together.
-std::vector<BandJob> PlanBands(const std::vector<RayGrid>& grids, const std::vector<BlockCost>& costs,
-                            int threads) {
+std::vector<BandJob> PlanBands(const std::vector<RayGrid>& grids,
+                               const std::vector<BlockCost>& costs, int threads) {
   std::vector<BandJob> bands;
   bool known = threads > 1 && costs.size() == grids.size();
   double total = 0.0;
@@ -567,7 +558,7 @@ void RayCaster::Cast(const scene::CollisionWorld& world, const RayBatch& rays,
     seen.push_back(&target);
   }
   constexpr int kFewBodies = 8;
-  const CastRaysKernel cast_rays = ChosenKernel().cast_rays;
+  const auto cast_rays = ChosenKernel().cast_rays;
   RunParallel(static_cast<int>((n + kRaysPerChunk - 1) / kRaysPerChunk), [&](int chunk) {
     const std::size_t first = std::size_t(chunk) * kRaysPerChunk;
     const std::size_t end = std::min(n, first + kRaysPerChunk);
@@ -592,7 +583,7 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
   const Eigen::Vector3f origin_B = (rays.origin_W - world.origin()).cast<float>();
   const std::vector<Target>& targets = TargetsOf(world).For(filter);
   const Visible wanted{filter, world.internals().num_actors};
-  const HitPairsKernel hit_pairs = ChosenKernel().hit_pairs;
+  const auto hit_pairs = ChosenKernel().hit_pairs;
   const std::vector<BandJob> bands = PlanBands(grids, grid_costs_, threads());
   std::vector<double> band_seconds(bands.size(), 0.0);
   RunParallel(static_cast<int>(bands.size()), [&](int b) {

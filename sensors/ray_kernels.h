@@ -84,36 +84,50 @@ struct GridBand {
   }
 };
 
-// Cast()'s rays [first, end) of `rays` (ray r starts at origin_B + start[r],
-// Bullet frame) against `targets` (a body's objects next to each other),
-// into `hits`.
-using CastRaysKernel = void (*)(const RayBatch& rays, const Eigen::Vector3f& origin_B,
-                                std::size_t first, std::size_t end, const Target* const* targets,
-                                std::size_t num_targets, RayHits* hits);
+// Calls walk(target) for each of `targets` whose box the packet meets
+// (meets(min, max): a mask of the lanes that enter the box, 0 for none). A
+// run of one body's objects (a robot's pieces) is skipped whole when the
+// packet misses the box around them. (Internal linkage: each kernel's copy
+// is built for its set.)
+template <typename Meets, typename Walk>
+static inline void WalkTargetsMet(const Target* const* targets, std::size_t num_targets,
+                                  Meets&& meets, Walk&& walk) {
+  for (std::size_t t = 0; t < num_targets;) {
+    std::size_t run_end = t + 1;
+    while (run_end < num_targets && targets[run_end]->body == targets[t]->body) ++run_end;
+    if (run_end - t > 2 && meets(targets[t]->body_min, targets[t]->body_max) == 0) {
+      t = run_end;
+      continue;
+    }
+    for (; t < run_end; ++t) {
+      if (meets(targets[t]->aabb_min, targets[t]->aabb_max) != 0) walk(*targets[t]);
+    }
+  }
+}
 
-// The pairs queued in a grid band (GridBand::Pairs: a triangle and a ray
-// each), tested, a pair a lane; then none are left.
-using HitPairsKernel = void (*)(GridBand* band);
+// One build of a packet kernel: its name and its two entry points.
+struct RayKernel {
+  const char* name;
+  // Cast()'s rays [first, end) of `rays` (ray r starts at origin_B +
+  // start[r], Bullet frame) against `targets` (a body's objects next to each
+  // other), into `hits`.
+  void (*cast_rays)(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t first,
+                    std::size_t end, const Target* const* targets, std::size_t num_targets,
+                    RayHits* hits);
+  // The pairs queued in a grid band (GridBand::Pairs: a triangle and a ray
+  // each), tested, a pair a lane; then none are left.
+  void (*hit_pairs)(GridBand* band);
+};
 
+// Each build's, defined in its namespace by the source built for it.
 namespace sse2 {
-void CastRays(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t first,
-              std::size_t end, const Target* const* targets, std::size_t num_targets,
-              RayHits* hits);
-void HitPairs(GridBand* band);
-}  // namespace sse2
-
+extern const RayKernel kKernel;
+}
 namespace fma {
-void CastRays(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t first,
-              std::size_t end, const Target* const* targets, std::size_t num_targets,
-              RayHits* hits);
-void HitPairs(GridBand* band);
-}  // namespace fma
-
+extern const RayKernel kKernel;
+}
 namespace avx512 {
-void CastRays(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t first,
-              std::size_t end, const Target* const* targets, std::size_t num_targets,
-              RayHits* hits);
-void HitPairs(GridBand* band);
-}  // namespace avx512
+extern const RayKernel kKernel;
+}
 
 }  // namespace sandbox::sensors
