@@ -1,3 +1,4 @@
+// Over 600 lines: the caster and its structured grid kernel (bands, their area, the triangles queued), which share its targets and worker pool.
 #include "sensors/ray_caster.h"
 
 #include <Eigen/Geometry>
