@@ -268,12 +268,7 @@ void WalkWide16(const Target& target, const __m512 inverse_B[3], Packet16* packe
       const scene::TriangleBvh::Leaves& leaf = bvh.leaves[std::size_t(-1 - entry.ref())];
       for (int i = 0; i < leaf.count; ++i) {
         Eigen::Vector3f corner[3];
-        for (int k = 0; k < 3; ++k) {
-          const Eigen::Vector3f p(leaf.corner[3 * k][i], leaf.corner[3 * k + 1][i],
-                                  leaf.corner[3 * k + 2][i]);
-          // In the Bullet frame as Bullet places it (Corners()).
-          corner[k] = target.identity ? p : ToEigen(target.X_BL * btVector3(p.x(), p.y(), p.z()));
-        }
+        LeafCorners(target, leaf, i, corner);
         HitCorners16(corner, target.BodyOf(leaf.part[i]), packet, lanes, &t_max);
       }
       continue;

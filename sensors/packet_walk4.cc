@@ -213,12 +213,7 @@ void WalkWide4(const Target& target, Packet* packet) {
       const scene::TriangleBvh::Leaves& leaf = bvh.leaves[std::size_t(-1 - entry.ref())];
       for (int i = 0; i < leaf.count; ++i) {
         Eigen::Vector3f corner[3];
-        for (int k = 0; k < 3; ++k) {
-          const Eigen::Vector3f p(leaf.corner[3 * k][i], leaf.corner[3 * k + 1][i],
-                                  leaf.corner[3 * k + 2][i]);
-          // In the Bullet frame as Bullet places it (Corners()).
-          corner[k] = target.identity ? p : ToEigen(target.X_BL * btVector3(p.x(), p.y(), p.z()));
-        }
+        LeafCorners(target, leaf, i, corner);
         HitCorners4(corner, target.BodyOf(leaf.part[i]), o_B, d_B, lanes, &t_max, packet->body,
                     packet->normal);
       }

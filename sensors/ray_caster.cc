@@ -1,4 +1,5 @@
-// Over 600 lines: the caster and its structured grid kernel (bands, their area, the triangles queued), which share its targets and worker pool.
+// Over 600 lines: the caster and its structured grid kernel (bands, their area,
+// the triangles queued), which share its targets and worker pool.
 #include "sensors/ray_caster.h"
 
 #include <Eigen/Geometry>
@@ -245,11 +246,7 @@ void ForEachTriangleOverGridWide(const Target& target, const GridCull& cull, Vis
       const scene::TriangleBvh::Leaves& leaf = bvh.leaves[std::size_t(-1 - ref)];
       for (int i = 0; i < leaf.count; ++i) {
         Eigen::Vector3f corners[3];
-        for (int k = 0; k < 3; ++k) {
-          const Eigen::Vector3f p(leaf.corner[3 * k][i], leaf.corner[3 * k + 1][i],
-                                  leaf.corner[3 * k + 2][i]);
-          corners[k] = target.identity ? p : ToEigen(target.X_BL * btVector3(p.x(), p.y(), p.z()));
-        }
+        LeafCorners(target, leaf, i, corners);
         visit(corners, target.BodyOf(leaf.part[i]));
       }
       continue;

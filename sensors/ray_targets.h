@@ -2,11 +2,11 @@
 // The world's objects as the ray caster's kernels read them: internal to the
 // caster (ray_caster.cc, ray_targets.cc and the kernels of ray_kernels.h).
 
+#include <LinearMath/btTransform.h>
+
 #include <Eigen/Core>
 #include <cstdint>
 #include <vector>
-
-#include <LinearMath/btTransform.h>
 
 #include "scene/collision_world.h"
 #include "scene/triangle_bvh.h"
@@ -40,6 +40,18 @@ struct Target {
 
 inline Eigen::Vector3f ToEigen(const btVector3& v) {
   return {float(v.x()), float(v.y()), float(v.z())};
+}
+
+// The corners of triangle i of a leaf of the target's own hierarchy, in the
+// Bullet frame as Bullet places them. (Internal linkage: each kernel's copy
+// is built for its set.)
+static inline void LeafCorners(const Target& target, const scene::TriangleBvh::Leaves& leaf, int i,
+                               Eigen::Vector3f corner[3]) {
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3f p(leaf.corner[3 * k][i], leaf.corner[3 * k + 1][i],
+                            leaf.corner[3 * k + 2][i]);
+    corner[k] = target.identity ? p : ToEigen(target.X_BL * btVector3(p.x(), p.y(), p.z()));
+  }
 }
 
 // Every object of the world, in the world's order (a body's objects next to
