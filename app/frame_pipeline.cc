@@ -15,7 +15,7 @@
 
 #include "app/command_line.h"
 #include "app/images.h"
-#include "sensors/render/segmentation.h"
+#include "scene/surface_ids.h"
 
 namespace sandbox::app {
 namespace {
@@ -235,7 +235,7 @@ void FramePipeline::Write(const Encoded& item) {
     if (kinds & render::kSegmentationImage) {
       if (!legend_written_) {  // the legend depends on the level alone
         std::ofstream legend(dir / "segmentation.csv");
-        legend << render::SegmentationLegend(level_).Csv();
+        legend << scene::SurfaceIds(level_).Csv();
         if (!legend.good())
           throw std::runtime_error("cannot write " + (dir / "segmentation.csv").string());
         legend_written_ = true;

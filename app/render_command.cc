@@ -16,7 +16,7 @@
 #include "scene/level.h"
 #include "sensors/render/cameras.h"
 #include "sensors/render/debug_overlay.h"
-#include "sensors/render/segmentation.h"
+#include "scene/surface_ids.h"
 #include "sensors/sensor.h"
 
 namespace sandbox::app {
@@ -209,7 +209,7 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
       WriteSegmentation(frame, ids.string());
       std::filesystem::path legend = file;
       legend.replace_filename(file.stem().string() + "_seg.csv");
-      std::ofstream(legend) << render::SegmentationLegend(level).Csv();
+      std::ofstream(legend) << scene::SurfaceIds(level).Csv();
       said << ", segmentation -> " << ids.string() << " (legend " << legend.string() << ")";
     }
     if (settings.images & render::kNormalsImage) {

@@ -205,8 +205,9 @@ void SandboxLoop::Tick(double wall_s, double drain_budget_s, TickRecord* record)
   if (options_.sensors) RunDueSensors(t, now);  // 3, and 4: their outputs
   if (options_.publish) PublishStates(now);     // 4
   WriteDueScans(t);
-  DirectCameras(t, record);                          // 5
-  if (options_.publish) PublishStatusIfDue(t, now);  // 4
+  DirectCameras(t, record);                            // 5
+  if (options_.publish) PublishStatusIfDue(t, now);    // 4
+  if (options_.publish) PublishSurfacesIfDue(t, now);  // 4
   ReportRecordingFailure();
   if (hooks_.end_of_tick) hooks_.end_of_tick(tick_);
   record->rays = caster_.rays_cast() + side_rays_ - rays_before;
@@ -387,6 +388,15 @@ void SandboxLoop::PublishStatusIfDue(double t, std::int64_t now_utime) {
     robot.outputs->PublishStatus(rate_now, tick_, stats_.overruns(),
                                  robot.feed->Channels(now_utime), now_utime);
   }
+}
+
+void SandboxLoop::PublishSurfacesIfDue(double t, std::int64_t now_utime) {
+  const std::uint64_t revision = world_.surface_revision();
+  if (t < next_surfaces_s_ && revision == surfaces_sent_revision_) return;
+  next_surfaces_s_ = t + 1.0;
+  surfaces_sent_revision_ = revision;
+  const std::vector<scene::SurfaceEntry> table = world_.SurfaceTable();
+  for (RobotRun& robot : robots_) robot.outputs->PublishSurfaces(table, revision, now_utime);
 }
 
 void SandboxLoop::KeepOriginNearRobot() {

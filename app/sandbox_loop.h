@@ -102,6 +102,9 @@ class SandboxLoop {
   void WriteDueScans(double t);
   void DirectCameras(double t, TickRecord* record);
   void PublishStatusIfDue(double t, std::int64_t now_utime);
+  // The surface table on each robot's WORLD channel: at the first tick, when
+  // terrain tiles come or go, and once a second.
+  void PublishSurfacesIfDue(double t, std::int64_t now_utime);
   // Between ticks: the floating origin to the first robot when it is far from it.
   void KeepOriginNearRobot();
   // Says once that the recording (--record) could not be written.
@@ -142,7 +145,8 @@ class SandboxLoop {
   CameraDirector::Shot shot_;
   bool recording_failure_reported_{false};
   InputClock input_clock_;  // lock-step time
-  double next_status_s_{0.0}, next_progress_s_{0.0};
+  double next_status_s_{0.0}, next_progress_s_{0.0}, next_surfaces_s_{0.0};
+  std::uint64_t surfaces_sent_revision_{0};
   std::int64_t origin_moves_{0};
   double longest_origin_move_ms_{0.0};
   RateSchedule scan_file_schedule_{options_.scans_every_s > 0.0 ? 1.0 / options_.scans_every_s

@@ -235,7 +235,7 @@ bool DisagreeWhenMoved(const scene::CollisionWorld& world, const EmbreeScene& em
   embree.Cast(EmbreeMode::kOne, moved, (moved.origin_W - world.origin()).cast<float>(), 0, 2,
               &distance, &hit);
   for (int k = 0; k < 2; ++k) {
-    if ((ours.body[std::size_t(k)] != sensors::RayHits::kNoHit) != bool(hit[std::size_t(k)]))
+    if ((ours.surface[std::size_t(k)] != sensors::RayHits::kNoHit) != bool(hit[std::size_t(k)]))
       return true;
   }
   return false;
@@ -300,7 +300,7 @@ Agreement Agree(const scene::CollisionWorld& world, const EmbreeScene& watertigh
                   &distance, &hit);
   Agreement agreement;
   for (std::size_t i = 0; i < n; ++i) {
-    const bool ours_hit = ours.body[i] != sensors::RayHits::kNoHit;
+    const bool ours_hit = ours.surface[i] != sensors::RayHits::kNoHit;
     const double diff_mm = 1e3 * std::abs(double(ours.distance_m[i]) - distance[i]);
     if (ours_hit != bool(hit[i]) || (ours_hit && diff_mm > 1.0)) {
       if (agreement.mismatches < show) {

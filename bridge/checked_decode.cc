@@ -14,6 +14,7 @@
 #include "sandbox_msgs/scan_face_compact_t.hpp"
 #include "sandbox_msgs/scan_face_t.hpp"
 #include "sandbox_msgs/status_t.hpp"
+#include "sandbox_msgs/surface_table_t.hpp"
 #include "sandbox_msgs/wrench_t.hpp"
 
 namespace sandbox::bridge {
@@ -125,6 +126,8 @@ void Layout(const camera_command_t*, WireReader& r) {
 void Layout(const ground_map_t*, WireReader& r) {
   r.Fixed(8 * 4 + 4 + 8 + 8 * 2 + 8, "the header");
   r.Array(r.Count("num_points"), 4, "height");
+  r.Array(r.Count("num_surface"), 4, "surface");
+  r.Array(r.Count("num_normal"), 4, "normal");
 }
 
 void Layout(const lidar_scan_t*, WireReader& r) {
@@ -136,6 +139,8 @@ void Layout(const lidar_scan_t*, WireReader& r) {
   r.Array(beams, 1, "hit");
   r.Array(r.Count("num_xyz"), 4, "xyz");
   r.Array(steps, 4, "time_s");
+  r.Array(r.Count("num_surface"), 4, "surface");
+  r.Array(r.Count("num_normal"), 4, "normal");
 }
 
 void Layout(const range_t*, WireReader& r) {
@@ -154,12 +159,17 @@ void Layout(const scan_face_t*, WireReader& r) {
   r.Fixed(8 * 5 + 1 + 4 + 8 * 10, "the header");
   r.Array(r.Count("num_points"), 1, "occupancy");
   r.Array(r.Count("num_xyz"), 4, "xyz");
+  r.Array(r.Count("num_surface"), 4, "surface");
+  r.Array(r.Count("num_normal"), 4, "normal");
 }
 
 void Layout(const scan_face_compact_t*, WireReader& r) {
   r.Fixed(8 * 5 + 1 + 4 + 8 * 13 + 1, "the header");
   r.Array(r.Count("num_mm"), 2, "distance_mm");
   r.Array(r.Count("num_m"), 4, "distance_m");
+  const std::int64_t runs = r.Count("num_runs");
+  r.Array(runs, 4, "run_surface");
+  r.Array(runs, 4, "run_length");
 }
 
 void Layout(const status_t*, WireReader& r) {
@@ -168,6 +178,17 @@ void Layout(const status_t*, WireReader& r) {
   r.Strings(channels, "channels");
   r.Array(channels, 8 * 3 + 1, "the counters");
   r.Strings(channels, "last_reject_reason");
+}
+
+void Layout(const surface_table_t*, WireReader& r) {
+  r.Fixed(8 * 3, "the header");
+  const std::int64_t surfaces = r.Count("num_surfaces");
+  r.Array(surfaces, 4, "id");
+  r.Strings(surfaces, "kind");
+  r.Strings(surfaces, "name");
+  r.Array(surfaces, 4, "actor");
+  r.Strings(surfaces, "robot");
+  r.Strings(surfaces, "bone");
 }
 
 void Layout(const wrench_t*, WireReader& r) {
@@ -213,6 +234,7 @@ SANDBOX_CHECKED_DECODE(robot_state_t)
 SANDBOX_CHECKED_DECODE(scan_face_t)
 SANDBOX_CHECKED_DECODE(scan_face_compact_t)
 SANDBOX_CHECKED_DECODE(status_t)
+SANDBOX_CHECKED_DECODE(surface_table_t)
 SANDBOX_CHECKED_DECODE(wrench_t)
 
 #undef SANDBOX_CHECKED_DECODE

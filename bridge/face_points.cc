@@ -26,6 +26,18 @@ void EncodeCompactFace(const sensors::FaceScan& scan, int f,
   Quaternion(face.X_WS.linear(), message->sensor_orientation);
   Quaternion(face.X_WB.linear(), message->box_orientation);
   const std::size_t cells = face.distance_m.size();
+  message->num_runs = 0;
+  message->run_surface.clear(), message->run_length.clear();
+  if (scan.surface_ids) {
+    for (std::size_t k = 0; k < cells;) {
+      std::size_t end = k + 1;
+      while (end < cells && face.surface[end] == face.surface[k]) ++end;
+      message->run_surface.push_back(face.surface[k]);
+      message->run_length.push_back(std::int32_t(end - k));
+      k = end;
+    }
+    message->num_runs = std::int32_t(message->run_surface.size());
+  }
   message->num_mm = 0, message->num_m = 0;
   message->distance_mm.clear(), message->distance_m.clear();
   if (scan.encoding == sensors::FaceEncoding::kFloat) {
@@ -79,6 +91,19 @@ void CheckCompactFace(const sandbox_msgs::scan_face_compact_t& message) {
   if (std::abs(expected_n - message.n) > 0.5)
     fail("n = " + std::to_string(message.n) +
          " does not match 2 half_extent_m / resolution_m + 1 = " + std::to_string(expected_n));
+  if (message.num_runs < 0 || std::size_t(message.num_runs) != message.run_surface.size() ||
+      std::size_t(message.num_runs) != message.run_length.size())
+    fail("num_runs = " + std::to_string(message.num_runs) + " but the id plane holds " +
+         std::to_string(message.run_surface.size()) + " ids and " +
+         std::to_string(message.run_length.size()) + " lengths");
+  std::int64_t covered = 0;
+  for (const std::int32_t length : message.run_length) {
+    if (length < 1) fail("run_length " + std::to_string(length) + " is not positive");
+    covered += length;
+  }
+  if (message.num_runs > 0 && covered != sent)
+    fail("the id plane's runs cover " + std::to_string(covered) +
+         " samples, not n^2 = " + std::to_string(sent));
 }
 
 FacePoints DecodeCompactFace(const sandbox_msgs::scan_face_compact_t& message) {
@@ -101,6 +126,10 @@ FacePoints DecodeCompactFace(const sandbox_msgs::scan_face_compact_t& message) {
   FacePoints out;
   out.points_W.assign(cells, Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
   out.occupancy.assign(cells, sensors::kUnvisited);
+  for (int j = 0; j < message.num_runs; ++j) {
+    out.surface.insert(out.surface.end(), std::size_t(message.run_length[std::size_t(j)]),
+                       message.run_surface[std::size_t(j)]);
+  }
   for (int r = 0; r < n; ++r) {
     for (int c = 0; c < n; ++c) {
       const std::size_t k = std::size_t(r) * std::size_t(n) + std::size_t(c);

@@ -109,7 +109,8 @@ bool LogWriter::Close() {
 
 LcmLink::LcmLink(const std::string& url)
     : url_(WithReceiveBuffer(url)), impl_(std::make_unique<Impl>(url_)) {
-  if (!impl_->lcm.good()) throw std::runtime_error("LcmLink::LcmLink(): cannot open LCM URL '" + url_ + "'");
+  if (!impl_->lcm.good())
+    throw std::runtime_error("LcmLink::LcmLink(): cannot open LCM URL '" + url_ + "'");
 }
 
 LcmLink::~LcmLink() = default;
@@ -256,7 +257,8 @@ LatestInput::LatestInput(LcmLink& link, std::string channel, MessageCheck check,
     : link_(link), channel_(std::move(channel)), check_(std::move(check)), max_bytes_(max_bytes) {
   lcm::Subscription* subscription = link_.impl().lcm.subscribeFunction(channel_, &Deliver, this);
   if (subscription == nullptr) {
-    throw std::runtime_error("LatestInput::LatestInput(): cannot subscribe to '" + Printable(channel_) + "'");
+    throw std::runtime_error("LatestInput::LatestInput(): cannot subscribe to '" +
+                             Printable(channel_) + "'");
   }
   subscription->setQueueCapacity(kQueueCapacity);
   subscription_ = subscription;

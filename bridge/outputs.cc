@@ -11,6 +11,7 @@
 #include "sandbox_msgs/scan_face_compact_t.hpp"
 #include "sandbox_msgs/scan_face_t.hpp"
 #include "sandbox_msgs/status_t.hpp"
+#include "sandbox_msgs/surface_table_t.hpp"
 
 namespace sandbox::bridge {
 
@@ -39,6 +40,24 @@ void Offsets(const std::vector<Eigen::Vector3d>& points_W, const Eigen::Vector3d
   for (std::size_t i = 0; i < points_W.size(); ++i) {
     const Eigen::Vector3d offset = points_W[i] - origin;
     for (int k = 0; k < 3; ++k) (*xyz)[3 * i + std::size_t(k)] = float(offset[k]);
+  }
+}
+
+// What each sample hit: its surface id (when published) and normal (when
+// kept), into the message's surface and normal arrays.
+template <typename Message>
+void SurfaceFields(bool ids, const std::vector<std::int32_t>& surface,
+                   const std::vector<Eigen::Vector3f>& normal_W, Message* message) {
+  message->num_surface = ids ? int(surface.size()) : 0;
+  if (ids) {
+    message->surface = surface;
+  } else {
+    message->surface.clear();
+  }
+  message->num_normal = int(3 * normal_W.size());
+  message->normal.resize(3 * normal_W.size());
+  for (std::size_t i = 0; i < normal_W.size(); ++i) {
+    for (int k = 0; k < 3; ++k) message->normal[3 * i + std::size_t(k)] = normal_W[i][k];
   }
 }
 
@@ -112,6 +131,7 @@ void PublishOutput(const sensors::FaceScan& scan, const Header& header, Send&& s
     message.occupancy = face.occupancy;
     message.num_xyz = int(3 * n);
     Offsets(scan.PointsW(f), p, &message.xyz);
+    SurfaceFields(scan.surface_ids, face.surface, face.normal_W, &message);
     send(message);
   }
 }
@@ -126,6 +146,7 @@ void PublishOutput(const sensors::HeightMap& map, const Header& header, Send&& s
   message.origin_z = 0.0;
   message.num_points = int(map.height_m.size());
   message.height.assign(map.height_m.begin(), map.height_m.end());
+  SurfaceFields(map.surface_ids, map.surface, map.normal_W, &message);
   send(message);
 }
 
@@ -147,6 +168,7 @@ void PublishOutput(const sensors::LidarScan& scan, const Header& header, Send&& 
   message.num_xyz = int(3 * n);
   Offsets(scan.points_W, origin, &message.xyz);
   message.time_s.assign(scan.time_s.begin(), scan.time_s.end());
+  SurfaceFields(scan.surface_ids, scan.surface, scan.normal_W, &message);
   send(message);
 }
 
@@ -164,7 +186,7 @@ void PublishOutput(const sensors::RangeReading& reading, const Header& header, S
   }
   message.hit = reading.hit ? 1 : 0;
   message.range_m = reading.range_m;
-  message.body = reading.body;
+  message.surface = reading.surface;
   send(message);
 }
 
@@ -220,6 +242,23 @@ void RobotOutputs::PublishStatus(double loop_rate_hz, std::int64_t ticks, std::i
     message.last_reject_reason.push_back(c.last_reject_reason);
   }
   Send("STATUS", message);
+}
+
+void RobotOutputs::PublishSurfaces(const std::vector<scene::SurfaceEntry>& table,
+                                   std::uint64_t revision, std::int64_t now_utime) {
+  sandbox_msgs::surface_table_t message{};
+  message.utime = now_utime;
+  message.revision = std::int64_t(revision);
+  message.num_surfaces = int(table.size());
+  for (const scene::SurfaceEntry& entry : table) {
+    message.id.push_back(entry.id);
+    message.kind.push_back(entry.kind);
+    message.name.push_back(entry.name);
+    message.actor.push_back(entry.actor);
+    message.robot.push_back(entry.robot_name);
+    message.bone.push_back(entry.bone_name);
+  }
+  Send("WORLD", message);
 }
 
 }  // namespace sandbox::bridge

@@ -1,6 +1,6 @@
 #pragma once
 // What the sandbox publishes for a robot: <ROBOT>/SCAN_FACE, /GROUND, /LIDAR, /RANGE,
-// /STATE and /STATUS, each numbered on its own channel (seq 0, 1, 2, ...) and
+// /STATE, /STATUS and /WORLD, each numbered on its own channel (seq 0, 1, 2, ...) and
 // tagged with the sequence number and time of the pose input it was computed
 // from. Threads: the loop thread.
 
@@ -13,6 +13,7 @@
 #include "bridge/lcm_link.h"
 #include "bridge/translation.h"
 #include "scene/robot_state.h"
+#include "scene/surface_ids.h"
 #include "sensors/face_scanner.h"
 #include "sensors/sensor.h"
 
@@ -61,6 +62,10 @@ class RobotOutputs {
                     const FaceFrames* X_WF = nullptr);
   void PublishStatus(double loop_rate_hz, std::int64_t ticks, std::int64_t overruns,
                      const std::vector<ChannelStatus>& channels, std::int64_t now_utime);
+  // The world's surface table (scene::CollisionWorld::SurfaceTable()) on
+  // <prefix>/WORLD: what the samples' surface ids name.
+  void PublishSurfaces(const std::vector<scene::SurfaceEntry>& table, std::uint64_t revision,
+                       std::int64_t now_utime);
 
   const std::string& prefix() const { return prefix_; }
   std::int64_t published() const { return published_; }

@@ -26,8 +26,8 @@ UdpLatest::UdpLatest(const std::string& address, int port, MessageCheck check)
       ::fcntl(socket_, F_SETFL, O_NONBLOCK) != 0) {
     const std::string reason = std::strerror(errno);
     if (socket_ >= 0) ::close(socket_);
-    throw std::runtime_error("UdpLatest::UdpLatest(): cannot bind " + address + ":" + std::to_string(port) +
-                             ": " + reason);
+    throw std::runtime_error("UdpLatest::UdpLatest(): cannot bind " + address + ":" +
+                             std::to_string(port) + ": " + reason);
   }
 }
 

@@ -24,7 +24,8 @@ UnknownRobots::UnknownRobots(LcmLink& link, const std::vector<std::string>& pref
   reason_ = "a pose for a robot this level does not have; its robots are " + robots;
   // LCM matches the whole channel name against the expression.
   lcm::Subscription* subscription = link_.impl().lcm.subscribeFunction(".*/POSE", &Deliver, this);
-  if (subscription == nullptr) throw std::runtime_error("UnknownRobots::UnknownRobots(): cannot subscribe");
+  if (subscription == nullptr)
+    throw std::runtime_error("UnknownRobots::UnknownRobots(): cannot subscribe");
   subscription->setQueueCapacity(LatestInput::kQueueCapacity);
   subscription_ = subscription;
 }

@@ -37,6 +37,7 @@ CollisionWorld::CollisionWorld(const Level& level) : impl_(std::make_unique<Impl
   w.broadphase.m_deferedcollide = true;  // no overlap search when objects are added
   w.num_actors = static_cast<int>(level.actors.size());
   w.terrain_actor = level.terrain_actor;
+  w.surface_ids = std::make_unique<SurfaceIds>(level);
   w.objects_of_body.resize(level.actors.size() + level.robots.size());
   for (std::size_t a = 0; a < level.actors.size(); ++a) {
     const Actor& actor = level.actors[a];
@@ -46,7 +47,7 @@ CollisionWorld::CollisionWorld(const Level& level) : impl_(std::make_unique<Impl
     if (!actor.collision) continue;
     std::vector<MeshArrays> meshes;
     for (const Mesh& mesh : actor.meshes) meshes.push_back({&mesh.positions_A, &mesh.indices});
-    w.AddBody(static_cast<int>(a), meshes,
+    w.AddBody(static_cast<int>(a), w.surface_ids->actor(static_cast<int>(a)), meshes,
               static_cast<int>(actor.movable ? kWorldMovable : kWorldStatic));
     w.Place(static_cast<int>(a), p_WO_);
   }
@@ -77,8 +78,11 @@ CollisionWorld::CollisionWorld(const Level& level) : impl_(std::make_unique<Impl
       }
     }
     const int body = w.num_actors + static_cast<int>(r);
+    const std::vector<int> bone_of_node = BoneGroupOfNodes(model);
     for (auto& [node, piece] : pieces) {
-      w.AddBody(body, {{&piece->positions, &piece->indices}}, static_cast<int>(kRobot),
+      const int bone = node >= 0 ? bone_of_node[static_cast<std::size_t>(node)] : 0;
+      w.AddBody(body, w.surface_ids->bone(static_cast<int>(r), bone),
+                {{&piece->positions, &piece->indices}}, static_cast<int>(kRobot),
                 RigidPart(rest.node_poses_B()[static_cast<std::size_t>(node)]));
       w.robot_pieces[r].push_back(std::move(piece));
     }
@@ -109,7 +113,8 @@ void CollisionWorld::Impl::MergeStatic(const Eigen::Vector3d& p_WO) {
     const IndexedMeshArray& parts = object->mesh_interface->getIndexedMeshArray();
     for (int k = 0; k < parts.size(); ++k) {
       const btIndexedMesh& part = parts[k];
-      std::vector<Eigen::Vector3f>& placed = positions.emplace_back(std::size_t(part.m_numVertices));
+      std::vector<Eigen::Vector3f>& placed =
+          positions.emplace_back(std::size_t(part.m_numVertices));
       const auto* in = reinterpret_cast<const Eigen::Vector3f*>(part.m_vertexBase);
       for (std::size_t v = 0; v < placed.size(); ++v) {
         const btVector3 p = X * btVector3(in[v].x(), in[v].y(), in[v].z());
@@ -118,7 +123,7 @@ void CollisionWorld::Impl::MergeStatic(const Eigen::Vector3d& p_WO) {
       soups.push_back({placed.data(), placed.size(),
                        reinterpret_cast<const std::uint32_t*>(part.m_triangleIndexBase),
                        std::size_t(part.m_numTriangles)});
-      merged_static.body_of_part.push_back(body);
+      merged_static.surface_of_part.push_back(object->surface);
     }
     merged_static.holds_actor[std::size_t(body)] = true;
     object->merged = true;
@@ -146,6 +151,7 @@ std::optional<RayHit> CollisionWorld::CastRay(const Eigen::Vector3d& from_W,
   hit.distance_m = fraction * (to_W - from_W).norm();
   hit.normal_W = FromBullet(callback.m_hitNormalWorld).normalized();
   if (hit.normal_W.dot(to_W - from_W) > 0.0) hit.normal_W = -hit.normal_W;
+  hit.surface = callback.m_collisionObject->getUserIndex2();
   const int body = callback.m_collisionObject->getUserIndex();
   if (body < impl_->num_actors) {
     hit.actor = body;
@@ -224,21 +230,49 @@ void CollisionWorld::AddTile(std::shared_ptr<PreparedTile> tile) {
     throw std::logic_error("CollisionWorld::AddTile(): the level has no terrain");
   const std::uint64_t key = tile->tile->id.key();
   RemoveTile(key);
+  auto [known, is_new] = w.tile_surface.try_emplace(key + 1, 0);
+  if (is_new) {
+    known->second = w.surface_ids->first_tile() + std::int32_t(w.tile_surface.size()) - 1;
+  }
   for (MeshObject& object : tile->objects) {
     object.object->setUserIndex(w.terrain_actor);
+    object.object->setUserIndex2(known->second);
+    object.surface = known->second;
     w.Add(std::move(object), static_cast<int>(kWorldStatic));
   }
   w.tiles[key + 1] = tile->tile;
   w.Place(w.terrain_actor, p_WO_);
   ++revision_;
+  ++w.surface_revision;
 }
 
 bool CollisionWorld::RemoveTile(std::uint64_t key) {
   if (!impl_->RemoveTile(key + 1)) return false;
   impl_->tiles.erase(key + 1);
   ++revision_;
+  ++impl_->surface_revision;
   return true;
 }
+
+const SurfaceIds& CollisionWorld::surface_ids() const { return *impl_->surface_ids; }
+
+std::vector<SurfaceEntry> CollisionWorld::SurfaceTable() const {
+  const Impl& w = *impl_;
+  std::vector<SurfaceEntry> table = w.surface_ids->entries();
+  for (const auto& [key_1, tile] : w.tiles) {
+    const TileId& id = tile->id;
+    SurfaceEntry entry;
+    entry.id = w.tile_surface.at(key_1);
+    entry.kind = "tile";
+    entry.name = "terrain/" + std::to_string(id.file) + "/" + std::to_string(id.tx) + "," +
+                 std::to_string(id.ty);
+    entry.actor = w.terrain_actor;
+    table.push_back(std::move(entry));
+  }
+  return table;
+}
+
+std::uint64_t CollisionWorld::surface_revision() const { return impl_->surface_revision; }
 
 int CollisionWorld::num_tiles() const { return static_cast<int>(impl_->tiles.size()); }
 

@@ -21,6 +21,7 @@
 
 #include "scene/level.h"
 #include "scene/robot_state.h"
+#include "scene/surface_ids.h"
 
 namespace sandbox::scene {
 
@@ -40,6 +41,7 @@ struct RayHit {
   double distance_m{0.0};    // from the ray's start
   int actor{-1};             // index into Level::actors, or -1 when a robot was hit
   int robot{-1};             // index into Level::robots, or -1 when an actor was hit
+  std::int32_t surface{0};   // its surface id (scene/surface_ids.h)
 };
 
 class CollisionWorld {
@@ -91,6 +93,14 @@ class CollisionWorld {
   void AddTile(std::shared_ptr<PreparedTile> tile);
   bool RemoveTile(std::uint64_t key);  // false when no such tile is in
   int num_tiles() const;
+
+  // What rays report they hit (scene/surface_ids.h): the level's ids, and the
+  // table of every surface in the world now, the level's and then the terrain
+  // tiles in (a tile keeps the id it first came in with). The table changes
+  // when tiles come or go, and surface_revision() with it.
+  const SurfaceIds& surface_ids() const;
+  std::vector<SurfaceEntry> SurfaceTable() const;
+  std::uint64_t surface_revision() const;
 
   int num_collision_objects() const;
   int num_parts() const;  // Bullet mesh parts over all shapes

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "scene/collision_world.h"
+#include "scene/surface_ids.h"
 #include "scene/terrain_tile.h"
 #include "scene/triangle_bvh.h"
 
@@ -50,8 +51,9 @@ struct MeshObject {
   std::unique_ptr<btCollisionObject> object;
   std::shared_ptr<const TriangleBvh> bvh;
   Eigen::Isometry3d X_BO{Eigen::Isometry3d::Identity()};  // in its body's frame
-  std::uint64_t tile{0};  // a terrain tile's key (TileId::key() + 1), 0 for the rest
-  bool merged{false};     // its triangles are in CollisionWorld::Impl::merged_static too
+  std::uint64_t tile{0};    // a terrain tile's key (TileId::key() + 1), 0 for the rest
+  std::int32_t surface{0};  // its surface id (scene/surface_ids.h; also Bullet's user index 2)
+  bool merged{false};       // its triangles are in CollisionWorld::Impl::merged_static too
 };
 
 // One hierarchy over the triangles of the static actors' objects (not the
@@ -59,10 +61,10 @@ struct MeshObject {
 // p_WO: a ray walks one tree instead of one per object, nearest first across
 // them all (the objects of a game level overlap: those of the Quake 3 map of
 // ../shared/assets, 61, cover each other's boxes). Leaf lanes name their
-// triangle's part, body_of_part its body (an actor).
+// triangle's part, surface_of_part its surface id (an actor's).
 struct MergedStatic {
   std::shared_ptr<const TriangleBvh> bvh;
-  std::vector<std::int32_t> body_of_part;
+  std::vector<std::int32_t> surface_of_part;
   std::vector<bool> holds_actor;  // by actor
   Eigen::Vector3d p_WO{Eigen::Vector3d::Zero()};
 };
@@ -102,6 +104,11 @@ struct CollisionWorld::Impl {
   int num_parts{0};
   int terrain_actor{-1};  // the body of the terrain tiles (Level::terrain_actor)
   std::map<std::uint64_t, std::shared_ptr<const TerrainTile>> tiles;  // by key + 1
+  // Surface ids: the level's, and each tile's from the first time it came in
+  // (by key + 1; kept when the tile leaves, so it comes back with its id).
+  std::unique_ptr<SurfaceIds> surface_ids;
+  std::map<std::uint64_t, std::int32_t> tile_surface;
+  std::uint64_t surface_revision{0};
   // Robots: their models and rigid pieces (Bullet reads the pieces' arrays).
   std::vector<const RobotModel*> robot_models;
   std::vector<std::vector<std::unique_ptr<RobotPiece>>> robot_pieces;
@@ -113,10 +120,14 @@ struct CollisionWorld::Impl {
 
   // Creates the objects of one body over `meshes` (split to Bullet's limits),
   // placed at X_BO in the body's frame; returns their indices in `objects`.
-  std::vector<int> AddBody(int body, const std::vector<MeshArrays>& meshes, int group,
+  // Their surface id is `surface`.
+  std::vector<int> AddBody(int body, std::int32_t surface, const std::vector<MeshArrays>& meshes,
+                           int group,
                            const Eigen::Isometry3d& X_BO = Eigen::Isometry3d::Identity()) {
     std::vector<int> added;
     for (MeshObject& object : MakeObjects(body, meshes, X_BO)) {
+      object.surface = surface;
+      object.object->setUserIndex2(surface);
       added.push_back(Add(std::move(object), group));
     }
     return added;

@@ -76,10 +76,15 @@ FaceScan FaceScanner::EmptyScan() const {
   scan.resolution_m = config_.resolution_m;
   scan.half_extent_m = config_.half_extent_m;
   scan.encoding = config_.encoding;
+  scan.surface_ids = config_.surface_ids;
+  scan.normals = config_.normals;
   const Eigen::Vector3d nan = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   for (ScanFace& face : scan.faces) {
     face.occupancy.assign(std::size_t(n_) * std::size_t(n_), kUnvisited);
     face.distance_m.assign(std::size_t(n_) * std::size_t(n_), nan.x());
+    face.surface.assign(std::size_t(n_) * std::size_t(n_), RayHits::kNoHit);
+    if (config_.normals)
+      face.normal_W.assign(std::size_t(n_) * std::size_t(n_), Eigen::Vector3f::Zero());
   }
   return scan;
 }
@@ -187,7 +192,7 @@ void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
   // The rays and hits keep their memory from scan to scan (no allocation a tick).
   thread_local RayBatch rays;
   thread_local RayHits hits;
-  hits.with_normals = false;
+  hits.with_normals = config_.normals;
   thread_local std::vector<RayGrid> grids;
   // The rays of GridRays, made in pieces of rows on the caster's threads:
   // their starts only (the structured kernel takes the direction and the
@@ -228,11 +233,15 @@ void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
     const std::size_t count = std::size_t(part.row_end - part.row_begin) * std::size_t(n_);
     const std::size_t i0 = blocks[std::size_t(p)].first;  // the part's first ray
     for (std::size_t j = 0; j < count; ++j) {
-      face.occupancy[k0 + j] = cast.body[i0 + j] == RayHits::kNoHit ? kFree : kOccupied;
+      face.occupancy[k0 + j] = cast.surface[i0 + j] == RayHits::kNoHit ? kFree : kOccupied;
     }
-    std::copy(cast.distance_m.begin() + std::ptrdiff_t(i0),
-              cast.distance_m.begin() + std::ptrdiff_t(i0 + count),
-              face.distance_m.begin() + std::ptrdiff_t(k0));
+    auto copy = [&](const auto& from, auto& to) {
+      std::copy(from.begin() + std::ptrdiff_t(i0), from.begin() + std::ptrdiff_t(i0 + count),
+                to.begin() + std::ptrdiff_t(k0));
+    };
+    copy(cast.distance_m, face.distance_m);
+    copy(cast.surface, face.surface);
+    if (config_.normals) copy(cast.normal_W, face.normal_W);
   });
 }
 
@@ -281,6 +290,13 @@ FaceScannerConfig FaceScannerConfig::Read(scene::SettingsReader& read) {
     face.encoding = FaceEncoding::kFloat;
   } else {
     read.Fail("encoding", "'encoding' must be points, mm or float, got '" + encoding + "'");
+  }
+  face.surface_ids = read.Flag("surface_ids", face.surface_ids);
+  face.normals = read.Flag("normals", face.normals);
+  if (face.normals && face.encoding != FaceEncoding::kPoints) {
+    read.Fail("normals",
+              "'normals' needs encoding = \"points\" (the compact encodings carry "
+              "a distance and an id a sample)");
   }
   return face;
 }

@@ -51,6 +51,12 @@ struct FaceScannerConfig {
   // about 0.9 GB (docs/reference/sensors.md).
   static constexpr double kMaxSampleBudget = 2e7;
   FaceEncoding encoding{FaceEncoding::kPoints};
+  // What a sample says besides its distance (docs/reference/sensors.md, "What
+  // a sample hit"): the surface id of what it hit (ScanFace::surface; always
+  // kept, published unless off) and its normal (kept and published only when
+  // on: a square root and a division a sample, and 12 bytes on the wire).
+  bool surface_ids{true};
+  bool normals{false};
 
   // Throws std::invalid_argument naming the field and its value: a resolution
   // or half extent that is not positive and finite, a half extent that is not
@@ -73,6 +79,10 @@ struct ScanFace {
   Eigen::Isometry3d X_WB{Eigen::Isometry3d::Identity()};  // the box of that scan (BoxFrame)
   std::vector<std::int8_t> occupancy;                     // n * n, Occupancy
   std::vector<float> distance_m;  // n * n: from the ray's start along the face axis; NaN unvisited
+  std::vector<std::int32_t> surface;  // n * n: surface id of the hit; 0 free or unvisited
+  // n * n with FaceScannerConfig::normals (else empty): the unit normal at
+  // the hit facing the ray, world frame; zero free or unvisited.
+  std::vector<Eigen::Vector3f> normal_W;
 };
 
 struct FaceScan {
@@ -81,6 +91,7 @@ struct FaceScan {
   // The grid and how it is to be published (the scanner's config).
   double resolution_m{1.0}, half_extent_m{25.0};
   FaceEncoding encoding{FaceEncoding::kPoints};
+  bool surface_ids{true}, normals{false};
 
   // Sample k of face f in the world, from its distance and its box: the hit,
   // or the ray's end when free; NaN when unvisited. Computed on demand (a

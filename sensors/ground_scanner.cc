@@ -41,16 +41,23 @@ void GroundScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
       rays.length_m[i] = static_cast<float>(config_.depth_m);
     }
   }
-  RayHits hits;
-  hits.with_normals = false;
+  thread_local RayHits hits;
+  hits.with_normals = config_.normals;
   caster.Cast(world, rays, filter, &hits);
   map->n = n_;
   map->resolution_m = res;
   map->corner_W = p_WS.head<2>() - Eigen::Vector2d::Constant(E);
   map->height_m.resize(rays.size());
   for (std::size_t i = 0; i < rays.size(); ++i) {
-    map->height_m[i] = hits.body[i] == RayHits::kNoHit ? std::numeric_limits<double>::quiet_NaN()
-                                                       : p_WS.z() - double(hits.distance_m[i]);
+    map->height_m[i] = hits.surface[i] == RayHits::kNoHit ? std::numeric_limits<double>::quiet_NaN()
+                                                          : p_WS.z() - double(hits.distance_m[i]);
+  }
+  map->surface = hits.surface;
+  map->surface_ids = config_.surface_ids;
+  if (config_.normals) {
+    map->normal_W = hits.normal_W;
+  } else {
+    map->normal_W.clear();
   }
 }
 
@@ -59,6 +66,8 @@ GroundScannerConfig GroundScannerConfig::Read(scene::SettingsReader& read) {
   ground.resolution_m = read.Number("resolution_m", ground.resolution_m);
   ground.half_extent_m = read.Number("half_extent_m", ground.half_extent_m);
   ground.depth_m = read.Number("depth_m", ground.depth_m);
+  ground.surface_ids = read.Flag("surface_ids", ground.surface_ids);
+  ground.normals = read.Flag("normals", ground.normals);
   return ground;
 }
 

@@ -20,6 +20,8 @@ struct GroundScannerConfig {
   double resolution_m{1.0};
   double half_extent_m{25.0};
   double depth_m{100.0};         // how far below the sensor to look
+  bool surface_ids{true};        // publish each point's surface id (HeightMap::surface)
+  bool normals{false};           // keep and publish each point's normal (HeightMap::normal_W)
   void ValidateOrThrow() const;  // throws std::invalid_argument naming the field
 
   // The [[robot.sensor]] table's own keys (docs/reference/levels.md); throws scene::LevelError
@@ -33,6 +35,9 @@ struct HeightMap {
   double resolution_m{1.0};
   Eigen::Vector2d corner_W{Eigen::Vector2d::Zero()};  // x, y of row 0, column 0
   std::vector<double> height_m;                       // n * n, NaN without ground
+  std::vector<std::int32_t> surface;                  // n * n: surface id; 0 without ground
+  std::vector<Eigen::Vector3f> normal_W;  // n * n unit, world (GroundScannerConfig::normals)
+  bool surface_ids{true};                 // published (GroundScannerConfig::surface_ids)
 };
 
 class GroundScanner {

@@ -74,8 +74,8 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
     throw std::invalid_argument("Lidar::Sweep(): non-finite pose");
   }
   const RayBatch rays = Rays(X_WS_start, X_WS_end);
-  RayHits hits;
-  hits.with_normals = false;
+  thread_local RayHits hits;
+  hits.with_normals = config_.normals;
   caster.Cast(world, rays, filter, &hits);
   const std::size_t n = rays.size();
   scan->channels = config_.channels();
@@ -85,9 +85,16 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
   scan->hit.resize(n);
   scan->points_W.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    scan->hit[i] = hits.body[i] != RayHits::kNoHit;
+    scan->hit[i] = hits.surface[i] != RayHits::kNoHit;
     scan->points_W[i] =
         rays.origin_W + (rays.start[i] + hits.distance_m[i] * rays.direction[i]).cast<double>();
+  }
+  scan->surface = hits.surface;
+  scan->surface_ids = config_.surface_ids;
+  if (config_.normals) {
+    scan->normal_W = hits.normal_W;
+  } else {
+    scan->normal_W.clear();
   }
   scan->sweep_s = 1.0 / config_.rotation_hz;
   scan->X_WS_start = X_WS_start;
@@ -113,6 +120,8 @@ LidarConfig LidarConfig::Read(scene::SettingsReader& read) {
   lidar.azimuth_steps = read.Whole("azimuth_steps", 1024);
   lidar.range_m = read.Number("range_m", 100.0);
   lidar.rotation_hz = read.Number("rotation_hz", 10.0);
+  lidar.surface_ids = read.Flag("surface_ids", lidar.surface_ids);
+  lidar.normals = read.Flag("normals", lidar.normals);
   read.Removed("kernel",
                "every lidar is cast by the general caster, faster than the structured sweep "
                "kernel on every level measured (docs/decisions/001-no-structured-lidar-kernel.md); "

@@ -25,6 +25,8 @@ struct LidarConfig {
   int azimuth_steps{1024};
   double range_m{100.0};
   double rotation_hz{10.0};  // one sweep lasts 1 / rotation_hz
+  bool surface_ids{true};    // publish each beam's surface id (LidarScan::surface)
+  bool normals{false};       // publish each beam's normal (LidarScan::normal_W)
 
   // `channels` elevations evenly from min to max (degrees).
   static LidarConfig Uniform(int channels, double min_deg, double max_deg, int azimuth_steps,
@@ -43,10 +45,13 @@ struct LidarConfig {
 struct LidarScan {
   int channels{0};
   int azimuth_steps{0};
-  std::vector<float> range_m;                         // the hit distance, or range_m when nothing
-  std::vector<std::uint8_t> hit;                      // 1 when the beam hit something
-  std::vector<Eigen::Vector3d> points_W;              // the hit, or the beam's end
-  std::vector<double> time_s;                         // per azimuth step, from the sweep's start
+  std::vector<float> range_m;             // the hit distance, or range_m when nothing
+  std::vector<std::uint8_t> hit;          // 1 when the beam hit something
+  std::vector<Eigen::Vector3d> points_W;  // the hit, or the beam's end
+  std::vector<std::int32_t> surface;      // surface id of the hit; 0 without
+  std::vector<Eigen::Vector3f> normal_W;  // unit, world, facing the beam (LidarConfig::normals)
+  bool surface_ids{true};                 // published (LidarConfig::surface_ids)
+  std::vector<double> time_s;             // per azimuth step, from the sweep's start
   Eigen::Vector3d origin_W{Eigen::Vector3d::Zero()};  // the sensor at the sweep's start
   double sweep_s{0.0};                                // 1 / rotation_hz
   Eigen::Isometry3d X_WS_start{Eigen::Isometry3d::Identity()};

@@ -122,23 +122,23 @@ struct Packet16 {
   V16 box_inverse;  // CornerBoxInverse(d)
   __m512 t_max;
   __mmask16 active;  // lanes that hold a ray
-  // Each lane's nearest hit so far: its body and normal (Bullet frame, unnormalised).
-  alignas(64) std::int32_t body[16];
+  // Each lane's nearest hit so far: its surface and normal (Bullet frame, unnormalised).
+  alignas(64) std::int32_t surface[16];
   alignas(64) float normal[3][16];
 };
 
 // HitLanes16 for the packet's lanes against one triangle (corners in the Bullet frame).
-inline void HitCorners16(const Eigen::Vector3f corner[3], int body_id, Packet16* packet,
+inline void HitCorners16(const Eigen::Vector3f corner[3], int surface_id, Packet16* packet,
                          __mmask16 lanes, __m512* t_max) {
   V16 c[3];
   for (int k = 0; k < 3; ++k) c[k] = {Set(corner[k].x()), Set(corner[k].y()), Set(corner[k].z())};
   V16 n;
   const __mmask16 ties =
-      _mm512_cmpgt_epi32_mask(_mm512_load_si512(packet->body), _mm512_set1_epi32(body_id));
+      _mm512_cmpgt_epi32_mask(_mm512_load_si512(packet->surface), _mm512_set1_epi32(surface_id));
   const __mmask16 hit =
       HitLanes16(c, packet->o, packet->d, packet->box_inverse, lanes, ties, t_max, &n);
   if (hit == 0) return;
-  _mm512_mask_store_epi32(packet->body, hit, _mm512_set1_epi32(body_id));
+  _mm512_mask_store_epi32(packet->surface, hit, _mm512_set1_epi32(surface_id));
   _mm512_mask_store_ps(packet->normal[0], hit, n.x);
   _mm512_mask_store_ps(packet->normal[1], hit, n.y);
   _mm512_mask_store_ps(packet->normal[2], hit, n.z);
@@ -269,7 +269,7 @@ void WalkWide16(const Target& target, const __m512 inverse_B[3], Packet16* packe
       for (int i = 0; i < leaf.count; ++i) {
         Eigen::Vector3f corner[3];
         LeafCorners(target, leaf, i, corner);
-        HitCorners16(corner, target.BodyOf(leaf.part[i]), packet, lanes, &t_max);
+        HitCorners16(corner, target.SurfaceOf(leaf.part[i]), packet, lanes, &t_max);
       }
       continue;
     }
@@ -353,7 +353,7 @@ void CastRays(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t
                                _mm512_div_ps(Set(1.0f), AwayFromZero16(packet.d.y)),
                                _mm512_div_ps(Set(1.0f), AwayFromZero16(packet.d.z))};
     packet.box_inverse = CornerBoxInverse(packet.d, inverse);
-    for (int l = 0; l < 16; ++l) packet.body[l] = RayHits::kNoHit;
+    for (int l = 0; l < 16; ++l) packet.surface[l] = RayHits::kNoHit;
     WalkTargetsMet(
         targets, num_targets,
         [&](const Eigen::Vector3f& lo, const Eigen::Vector3f& hi) {
@@ -362,7 +362,7 @@ void CastRays(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t
         [&](const Target& target) { WalkWide16(target, inverse, &packet); });
     if (full && !hits->with_normals) {  // WriteHit's two stores, sixteen at once
       _mm512_storeu_ps(&hits->distance_m[i], packet.t_max);
-      _mm512_storeu_si512(&hits->body[i], _mm512_load_si512(packet.body));
+      _mm512_storeu_si512(&hits->surface[i], _mm512_load_si512(packet.surface));
       continue;
     }
     alignas(64) float t_max[16];
@@ -370,7 +370,7 @@ void CastRays(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t
     for (int l = 0; l < 16 && i + std::size_t(l) < end; ++l) {
       const std::size_t r = i + std::size_t(l);
       const Eigen::Vector3f normal(packet.normal[0][l], packet.normal[1][l], packet.normal[2][l]);
-      WriteHit(r, t_max[l], packet.body[l], normal, rays.direction[r], hits);
+      WriteHit(r, t_max[l], packet.surface[l], normal, rays.direction[r], hits);
     }
   }
 }
@@ -391,7 +391,7 @@ inline V16 Gather(const float* base, __mmask16 lanes, __m512i xyz) {
 void HitPairs(GridBand* band) {
   GridBand::Pairs& pairs = band->pairs;
   float* t = band->t_max;
-  std::int32_t* body = band->body;
+  std::int32_t* surface = band->surface;
   const float* start = band->start[0].data();
   const V16 origin{Set(_mm_cvtss_f32(band->ox)), Set(_mm_cvtss_f32(band->oy)),
                    Set(_mm_cvtss_f32(band->oz))};
@@ -413,10 +413,10 @@ void HitPairs(GridBand* band) {
               _mm512_loadu_ps(&pairs.corner[3 * j + 1][k]),
               _mm512_loadu_ps(&pairs.corner[3 * j + 2][k])};
     }
-    const __m512i pair_body = _mm512_maskz_loadu_epi32(in_packet, &pairs.body[k]);
-    const __m512i ray_body =
-        _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), lanes, cell, body, 4);
-    const __mmask16 ties = _mm512_cmpgt_epi32_mask(ray_body, pair_body);
+    const __m512i pair_surface = _mm512_maskz_loadu_epi32(in_packet, &pairs.surface[k]);
+    const __m512i ray_surface =
+        _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), lanes, cell, surface, 4);
+    const __mmask16 ties = _mm512_cmpgt_epi32_mask(ray_surface, pair_surface);
     V16 n;
     const __mmask16 hit = HitLanes16(c, o, d, box_inverse, lanes, ties, &t_max, &n);
     if (hit == 0) continue;
@@ -431,10 +431,10 @@ void HitPairs(GridBand* band) {
     for (unsigned rest = hit; rest != 0; rest &= rest - 1) {
       const int lane = __builtin_ctz(rest);
       const auto i = std::size_t(cells[lane]);
-      const int pair_body_id = pairs.body[k + lane];
-      if (!(t_hit[lane] < t[i] || (t_hit[lane] == t[i] && pair_body_id < body[i]))) continue;
+      const int pair_surface_id = pairs.surface[k + lane];
+      if (!(t_hit[lane] < t[i] || (t_hit[lane] == t[i] && pair_surface_id < surface[i]))) continue;
       t[i] = t_hit[lane];
-      body[i] = pair_body_id;
+      surface[i] = pair_surface_id;
       if (band->normal != nullptr) band->normal[i] = Eigen::Vector3f(nx[lane], ny[lane], nz[lane]);
     }
   }

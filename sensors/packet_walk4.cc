@@ -49,7 +49,7 @@ struct Packet {
   __m128 ox, oy, oz, dx, dy, dz;  // Bullet frame
   __m128 t_max;                   // per lane
   __m128 active;                  // all bits set in lanes that hold a ray
-  int body[4];
+  int surface[4];
   Eigen::Vector3f normal[4];  // in the Bullet frame, unnormalised
 };
 
@@ -85,8 +85,8 @@ inline Vec4 StableNormal4(const Vec4& a, const Vec4& b, const Vec4& c) {
 // HitTriangle (the rules of docs/reference/sensors.md) for four rays against four
 // triangles, a ray and a triangle a lane (corners c[k], in the Bullet frame):
 // the lanes hit closer than their t_max (or at it, in `ties`: lanes whose
-// hit so far is a higher body's), which take the distance; the (unnormalised)
-// normals in *normal. So a tie between bodies goes to the lower body, in
+// hit so far is a higher surface's), which take the distance; the (unnormalised)
+// normals in *normal. So a tie between bodies goes to the lower surface, in
 // whatever order a kernel meets the triangles.
 inline __m128 HitLanes4(const Vec4 c[3], const Vec4& o, const Vec4& d, __m128 lanes, __m128 ties,
                         __m128* t_max, Vec4* normal) {
@@ -144,23 +144,24 @@ inline __m128 HitLanes4(const Vec4 c[3], const Vec4& o, const Vec4& d, __m128 la
 }
 
 // HitLanes4 for four rays against one triangle: the lanes it hits take its
-// distance, `body_id` and its (unnormalised) normal.
-inline void HitCorners4(const Eigen::Vector3f corner[3], int body_id, const Vec4& o, const Vec4& d,
-                        __m128 lanes, __m128* t_max, int body[4], Eigen::Vector3f normal[4]) {
+// distance, `surface_id` and its (unnormalised) normal.
+inline void HitCorners4(const Eigen::Vector3f corner[3], int surface_id, const Vec4& o,
+                        const Vec4& d, __m128 lanes, __m128* t_max, int surface[4],
+                        Eigen::Vector3f normal[4]) {
   Vec4 c[3];
   for (int k = 0; k < 3; ++k) {
     c[k] = {_mm_set1_ps(corner[k].x()), _mm_set1_ps(corner[k].y()), _mm_set1_ps(corner[k].z())};
   }
   Vec4 n;
   const __m128 ties = _mm_castsi128_ps(_mm_cmpgt_epi32(
-      _mm_loadu_si128(reinterpret_cast<const __m128i*>(body)), _mm_set1_epi32(body_id)));
+      _mm_loadu_si128(reinterpret_cast<const __m128i*>(surface)), _mm_set1_epi32(surface_id)));
   const int mask = _mm_movemask_ps(HitLanes4(c, o, d, lanes, ties, t_max, &n));
   if (mask == 0) return;
   alignas(16) float nx[4], ny[4], nz[4];
   _mm_store_ps(nx, n.x), _mm_store_ps(ny, n.y), _mm_store_ps(nz, n.z);
   for (int lane = 0; lane < 4; ++lane) {
     if (mask & (1 << lane)) {
-      body[lane] = body_id;
+      surface[lane] = surface_id;
       normal[lane] = Eigen::Vector3f(nx[lane], ny[lane], nz[lane]);
     }
   }
@@ -214,8 +215,8 @@ void WalkWide4(const Target& target, Packet* packet) {
       for (int i = 0; i < leaf.count; ++i) {
         Eigen::Vector3f corner[3];
         LeafCorners(target, leaf, i, corner);
-        HitCorners4(corner, target.BodyOf(leaf.part[i]), o_B, d_B, lanes, &t_max, packet->body,
-                    packet->normal);
+        HitCorners4(corner, target.SurfaceOf(leaf.part[i]), o_B, d_B, lanes, &t_max,
+                    packet->surface, packet->normal);
       }
       continue;
     }
@@ -285,7 +286,7 @@ inline int PacketMeetsBox(const Packet& packet, const __m128 inverse[3],
 
 // Four pairs at a time. A ray that ends before the
 // pair's `near` (its triangle's nearest depth) is left out. Where two lanes
-// hold the same ray, the nearer hit stays (on a tie, the lower body's, then
+// hold the same ray, the nearer hit stays (on a tie, the lower surface's, then
 // the earlier pair's): the same result as the pairs taken one by one.
 void HitPairs(GridBand* band) {
   GridBand::Pairs& pairs = band->pairs;
@@ -315,12 +316,12 @@ void HitPairs(GridBand* band) {
     }
     Vec4 n;
     const __m128 ties = _mm_castsi128_ps(
-        _mm_cmpgt_epi32(_mm_setr_epi32(band->body[cell[0]], band->body[cell[1]],
-                                       band->body[cell[2]], band->body[cell[3]]),
-                        _mm_setr_epi32(pairs.body[k + std::min(0, in_packet - 1)],
-                                       pairs.body[k + std::min(1, in_packet - 1)],
-                                       pairs.body[k + std::min(2, in_packet - 1)],
-                                       pairs.body[k + std::min(3, in_packet - 1)])));
+        _mm_cmpgt_epi32(_mm_setr_epi32(band->surface[cell[0]], band->surface[cell[1]],
+                                       band->surface[cell[2]], band->surface[cell[3]]),
+                        _mm_setr_epi32(pairs.surface[k + std::min(0, in_packet - 1)],
+                                       pairs.surface[k + std::min(1, in_packet - 1)],
+                                       pairs.surface[k + std::min(2, in_packet - 1)],
+                                       pairs.surface[k + std::min(3, in_packet - 1)])));
     const int mask = _mm_movemask_ps(HitLanes4(c, o, d, lanes, ties, &t_max, &n));
     if (mask == 0) continue;
     alignas(16) float t_hit[4], nx[4], ny[4], nz[4];
@@ -329,10 +330,10 @@ void HitPairs(GridBand* band) {
     for (int lane = 0; lane < in_packet; ++lane) {
       const auto i = std::size_t(cell[lane]);
       const bool nearer =
-          t_hit[lane] < t[i] || (t_hit[lane] == t[i] && pairs.body[k + lane] < band->body[i]);
+          t_hit[lane] < t[i] || (t_hit[lane] == t[i] && pairs.surface[k + lane] < band->surface[i]);
       if (!(mask & (1 << lane)) || !nearer) continue;
       t[i] = t_hit[lane];
-      band->body[i] = pairs.body[k + lane];
+      band->surface[i] = pairs.surface[k + lane];
       if (band->normal != nullptr) band->normal[i] = Eigen::Vector3f(nx[lane], ny[lane], nz[lane]);
     }
   }
@@ -362,7 +363,7 @@ void CastRays(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t
     const __m128 inverse[3] = {_mm_div_ps(_mm_set1_ps(1.0f), AwayFromZero(packet.dx)),
                                _mm_div_ps(_mm_set1_ps(1.0f), AwayFromZero(packet.dy)),
                                _mm_div_ps(_mm_set1_ps(1.0f), AwayFromZero(packet.dz))};
-    for (int l = 0; l < 4; ++l) packet.body[l] = RayHits::kNoHit;
+    for (int l = 0; l < 4; ++l) packet.surface[l] = RayHits::kNoHit;
     WalkTargetsMet(
         targets, num_targets,
         [&](const Eigen::Vector3f& lo, const Eigen::Vector3f& hi) {
@@ -373,7 +374,7 @@ void CastRays(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t
     _mm_store_ps(t_max, packet.t_max);
     for (int l = 0; l < 4 && i + std::size_t(l) < end; ++l) {
       const std::size_t r = i + std::size_t(l);
-      WriteHit(r, t_max[l], packet.body[l], packet.normal[l], rays.direction[r], hits);
+      WriteHit(r, t_max[l], packet.surface[l], packet.normal[l], rays.direction[r], hits);
     }
   }
 }

@@ -31,11 +31,11 @@ RangeReading MeasureRange(const RangeSensorConfig& config, const scene::Collisio
   RangeReading reading;
   reading.origin_W = ray.origin_W;
   reading.direction_W = X_WS.linear() * config.direction_S;
-  reading.hit = hits.body[0] != RayHits::kNoHit;
+  reading.hit = hits.surface[0] != RayHits::kNoHit;
   reading.range_m = hits.distance_m[0];
   reading.point_W = ray.origin_W + double(hits.distance_m[0]) * ray.direction[0].cast<double>();
   reading.normal_W = hits.normal_W[0].cast<double>();
-  reading.body = hits.body[0];
+  reading.surface = hits.surface[0];
   return reading;
 }
 

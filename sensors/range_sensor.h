@@ -29,7 +29,7 @@ struct RangeReading {
   double range_m{0.0};  // to the hit, or range_m when nothing
   Eigen::Vector3d point_W{Eigen::Vector3d::Zero()};
   Eigen::Vector3d normal_W{Eigen::Vector3d::Zero()};
-  int body{RayHits::kNoHit};
+  std::int32_t surface{RayHits::kNoHit};  // surface id of the hit (scene/surface_ids.h)
 };
 
 // One ray from sensor pose X_WS.

@@ -59,7 +59,7 @@ const RayKernel& ChosenKernel() {
 void SizeHits(std::size_t n, RayHits* hits) {
   hits->distance_m.resize(n);
   hits->normal_W.resize(hits->with_normals ? n : 0);
-  hits->body.resize(n);
+  hits->surface.resize(n);
 }
 
 // Whether a filter lets rays see an object.
@@ -232,7 +232,7 @@ inline bool ChildMeetsGrid(const scene::TriangleBvh::Node& node, int c, const Gr
   return _mm_movemask_ps(_mm_cmpge_ps(Select(cull.integral, whole, high), low)) == 0xF;
 }
 
-// Calls visit(corners, body) (the Bullet frame, as Corners() places them) for
+// Calls visit(corners, surface) (the Bullet frame, as Corners() places them) for
 // each triangle of `target` in a leaf of its own hierarchy whose box meets the grid.
 template <typename Visit>
 void ForEachTriangleOverGridWide(const Target& target, const GridCull& cull, Visit&& visit) {
@@ -247,7 +247,7 @@ void ForEachTriangleOverGridWide(const Target& target, const GridCull& cull, Vis
       for (int i = 0; i < leaf.count; ++i) {
         Eigen::Vector3f corners[3];
         LeafCorners(target, leaf, i, corners);
-        visit(corners, target.BodyOf(leaf.part[i]));
+        visit(corners, target.SurfaceOf(leaf.part[i]));
       }
       continue;
     }
@@ -324,7 +324,7 @@ BandArea AreaOf(const BandJob& band, const Eigen::Vector3d& world_origin) {
 
 // Queues the triangle with these corners (Bullet frame) against each ray of
 // the band whose cell its shadow on the grid covers.
-void QueueTriangle(const Eigen::Vector3f corners[3], int body, const BandArea& area,
+void QueueTriangle(const Eigen::Vector3f corners[3], int surface, const BandArea& area,
                    void (*hit_pairs)(GridBand*), GridBand* band) {
   const BandFrame& frame = area.frame;
   const int cols = area.cols;
@@ -358,7 +358,7 @@ void QueueTriangle(const Eigen::Vector3f corners[3], int body, const BandArea& a
   _mm_store_si128(reinterpret_cast<__m128i*>(lasts), last);
   const int c0 = firsts[0], r0 = firsts[1], c1 = lasts[0], r1 = lasts[1];
   const float near = _mm_cvtss_f32(_mm_movehl_ps(low, low));
-  auto add = [&](int r, int c) { band->Add(corners, body, r * cols + c, near, hit_pairs); };
+  auto add = [&](int r, int c) { band->Add(corners, surface, r * cols + c, near, hit_pairs); };
   if ((r1 - r0 + 1) * (c1 - c0 + 1) <= 4) {  // the box's few cells
     for (int r = r0; r <= r1; ++r) {
       for (int c = c0; c <= c1; ++c) add(r, c);
@@ -394,9 +394,9 @@ void CastBand(const BandJob& this_band, const RayBatch& rays, const Eigen::Vecto
   band.oz = _mm_set1_ps(origin_B.z());
   band.start = rays.start.data() + first;
   band.t_max = hits->distance_m.data() + first;
-  band.body = hits->body.data() + first;
+  band.surface = hits->surface.data() + first;
   std::fill(band.t_max, band.t_max + count, length);
-  std::fill(band.body, band.body + count, RayHits::kNoHit);
+  std::fill(band.surface, band.surface + count, RayHits::kNoHit);
   band.normal = nullptr;
   if (hits->with_normals) {
     band.normals.resize(count);
@@ -412,14 +412,14 @@ void CastBand(const BandJob& this_band, const RayBatch& rays, const Eigen::Vecto
     const double limit[3] = {double(area.cols - 1), double(area.rows - 1), double(length)};
     const double margins[3] = {area.margin_columns, area.margin_rows, area.margin};
     const GridCull cull = CullForWide(target, area.corner, axes, 3, limit, margins, true);
-    ForEachTriangleOverGridWide(target, cull, [&](const Eigen::Vector3f* corners, int body) {
-      QueueTriangle(corners, body, area, hit_pairs, &band);
+    ForEachTriangleOverGridWide(target, cull, [&](const Eigen::Vector3f* corners, int surface) {
+      QueueTriangle(corners, surface, area, hit_pairs, &band);
     });
   }
   hit_pairs(&band);
   if (band.normal != nullptr) {
     for (std::size_t i = 0; i < count; ++i) {
-      WriteHit(first + i, band.t_max[i], band.body[i], band.normal[i], d, hits);
+      WriteHit(first + i, band.t_max[i], band.surface[i], band.normal[i], d, hits);
     }
   }
 }

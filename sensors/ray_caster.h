@@ -64,19 +64,20 @@ struct RayFilter {
   int ignore_robot{-1};  // a robot's own sensors set this to the robot
 };
 
-// One entry per ray. A ray that hits nothing has distance_m = length_m and
-// body = -1 (kNoHit). A ray that meets surfaces of two bodies at one distance
-// reports the lower body, in every kernel.
+// One entry per ray: its distance and the surface id of what it hit
+// (scene/surface_ids.h: the world's SurfaceTable() names it). A ray that hits
+// nothing has distance_m = length_m and surface = 0 (kNoHit). A ray that meets
+// two surfaces at one distance reports the lower id, in every kernel.
 struct RayHits {
-  static constexpr int kNoHit = -1;
+  static constexpr std::int32_t kNoHit = scene::SurfaceIds::kNothing;
   std::vector<float> distance_m;
   std::vector<Eigen::Vector3f> normal_W;  // unit, facing the ray; zero without a hit
-  std::vector<std::int32_t> body;         // actor index, or num_actors + robot index
+  std::vector<std::int32_t> surface;
   // False: normal_W is left empty (a caller that needs no normals, such as
   // the face scanner, saves a square root and a division a hit).
   bool with_normals{true};
 
-  std::size_t size() const { return body.size(); }
+  std::size_t size() const { return surface.size(); }
 };
 
 // What one block of a CastGrids() call took, its rows and seconds.

@@ -33,14 +33,14 @@ namespace sandbox::sensors {
 // ray meets exactly one.
 constexpr float kHuge = 1e30f;
 
-// Ray r's result: its distance, the body hit and, when asked for, the unit
-// normal facing the ray (zero without a hit).
-static inline void WriteHit(std::size_t r, float t, int body, const Eigen::Vector3f& normal,
+// Ray r's result: its distance, the surface hit and, when asked for, the
+// unit normal facing the ray (zero without a hit).
+static inline void WriteHit(std::size_t r, float t, int surface, const Eigen::Vector3f& normal,
                             const Eigen::Vector3f& direction, RayHits* hits) {
   hits->distance_m[r] = t;
-  hits->body[r] = body;
+  hits->surface[r] = surface;
   if (!hits->with_normals) return;
-  if (body == RayHits::kNoHit) {
+  if (surface == RayHits::kNoHit) {
     hits->normal_W[r].setZero();
     return;
   }
@@ -56,7 +56,7 @@ struct GridBand {
   __m128 ox, oy, oz;                      // the batch origin (a ray starts at it plus its start)
   const Eigen::Vector3f* start{nullptr};  // the cells' rays' starts
   float* t_max{nullptr};                  // their entries of RayHits::distance_m
-  std::int32_t* body{nullptr};            // of RayHits::body
+  std::int32_t* surface{nullptr};         // of RayHits::surface
   Eigen::Vector3f* normal{nullptr};       // unnormalised, or null: none asked for
   std::vector<Eigen::Vector3f> normals;   // their storage
   // Triangle-ray pairs waiting for a test (HitPairs), in lanes' order.
@@ -65,13 +65,13 @@ struct GridBand {
     int count{0};
     alignas(16) float corner[9][kCapacity];  // x, y, z of corner 0, 1, 2
     alignas(16) float near[kCapacity];
-    int cell[kCapacity], body[kCapacity];
+    int cell[kCapacity], surface[kCapacity];
   } pairs;
 
   // Queues the triangle with these corners against ray `cell`; tests the
   // queue when full (test: HitPairs of the kernel in use).
   template <typename Test>
-  void Add(const Eigen::Vector3f corner[3], int body_id, int cell_index, float near_depth,
+  void Add(const Eigen::Vector3f corner[3], int surface_id, int cell_index, float near_depth,
            Test test) {
     const int k = pairs.count++;
     for (int j = 0; j < 3; ++j) {
@@ -79,7 +79,7 @@ struct GridBand {
     }
     pairs.near[k] = near_depth;
     pairs.cell[k] = cell_index;
-    pairs.body[k] = body_id;
+    pairs.surface[k] = surface_id;
     if (pairs.count == Pairs::kCapacity) test(this);
   }
 };

@@ -24,10 +24,10 @@ float BoxMargin(const scene::TriangleBvh& bvh, const Eigen::Vector3f& p_LB,
 Target MergedTarget(const scene::CollisionWorld& world) {
   const scene::MergedStatic& merged = world.internals().merged_static;
   Target t;
-  t.body = -2;  // none: each lane's is BodyOf its part
+  t.body = -2;  // none: each lane's surface is SurfaceOf its part
   t.group = scene::kWorldStatic;
   t.bvh = merged.bvh.get();
-  t.body_of_part = merged.body_of_part.data();
+  t.surface_of_part = merged.surface_of_part.data();
   const btVector3 offset = scene::ToBullet(merged.p_WO - world.origin());
   t.X_BL.setIdentity();
   t.X_BL.setOrigin(offset);
@@ -48,6 +48,7 @@ std::vector<Target> CollectTargets(const scene::CollisionWorld& world) {
     const btCollisionObject& o = *object.object;
     Target t;
     t.body = o.getUserIndex();
+    t.surface = object.surface;
     t.group = static_cast<std::uint32_t>(o.getBroadphaseHandle()->m_collisionFilterGroup);
     t.aabb_min = ToEigen(o.getBroadphaseHandle()->m_aabbMin);
     t.aabb_max = ToEigen(o.getBroadphaseHandle()->m_aabbMax);
@@ -59,7 +60,8 @@ std::vector<Target> CollectTargets(const scene::CollisionWorld& world) {
     t.identity = X.getBasis() == btMatrix3x3::getIdentity() && X.getOrigin() == btVector3(0, 0, 0);
     t.p_LB = -(t.R_LB * ToEigen(X.getOrigin()));
     t.bvh = object.bvh.get();
-    if (t.bvh == nullptr) throw std::logic_error("CollectTargets(): an object without its hierarchy");
+    if (t.bvh == nullptr)
+      throw std::logic_error("CollectTargets(): an object without its hierarchy");
     t.box_margin = BoxMargin(*t.bvh, t.p_LB, ToEigen(X.getOrigin()));
     targets.push_back(std::move(t));
   }

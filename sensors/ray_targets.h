@@ -18,7 +18,7 @@ constexpr int kStackInPlace = RayCaster::kStackInPlace;
 
 // One Bullet object as a ray sees it: where it is and its own hierarchy.
 struct Target {
-  int body{-1};
+  int body{-1};            // the actor, or num_actors + the robot (what RayFilter names)
   std::uint32_t group{0};  // the object's collision group (scene::kWorldStatic, ...)
   // The box around this object and the other objects of its body next to it
   // in the list (a robot's pieces): a packet that misses it skips them all.
@@ -32,10 +32,14 @@ struct Target {
   // for the rounding of rays taken into that frame.
   const scene::TriangleBvh* bvh{nullptr};
   float box_margin{0.f};
-  // The merged static objects' target (scene::MergedStatic) has a body per
-  // leaf part (BodyOf); any other, its one body.
-  const std::int32_t* body_of_part{nullptr};
-  int BodyOf(int part) const { return body_of_part != nullptr ? body_of_part[part] : body; }
+  // What a hit on it reports (scene/surface_ids.h): the merged static
+  // objects' target (scene::MergedStatic) has a surface per leaf part
+  // (SurfaceOf); any other, its one surface.
+  std::int32_t surface{0};
+  const std::int32_t* surface_of_part{nullptr};
+  int SurfaceOf(int part) const {
+    return surface_of_part != nullptr ? surface_of_part[part] : surface;
+  }
 };
 
 inline Eigen::Vector3f ToEigen(const btVector3& v) {

@@ -63,8 +63,8 @@ class WalkStack {
  private:
   void Grow() {
     capacity_ *= 2;
-    data_ = static_cast<T*>(heap_.Grow(data_, sizeof(T) * std::size_t(size_),
-                                       sizeof(T) * std::size_t(capacity_)));
+    data_ = static_cast<T*>(
+        heap_.Grow(data_, sizeof(T) * std::size_t(size_), sizeof(T) * std::size_t(capacity_)));
   }
 
   T in_place_[kInPlace];

@@ -65,7 +65,8 @@ GlProgram::GlProgram(std::string name, const std::string& vertex, const std::str
   if (!ok) {
     char log[4096];
     glGetProgramInfoLog(id_, sizeof(log), nullptr, log);
-    throw std::runtime_error("GlProgram::GlProgram(): the " + name_ + " program does not link: " + log);
+    throw std::runtime_error("GlProgram::GlProgram(): the " + name_ +
+                             " program does not link: " + log);
   }
   declared_ = DeclaredUniforms(vertex);
   declared_.merge(DeclaredUniforms(fragment));
@@ -75,8 +76,8 @@ GLint GlProgram::Uniform(const std::string& name) {
   const auto found = locations_.find(name);
   if (found != locations_.end()) return found->second;
   if (!declared_.count(name.substr(0, name.find('[')))) {
-    throw std::logic_error("GlProgram::Uniform(): the " + name_ + " program declares no uniform '" + name +
-                           "'");
+    throw std::logic_error("GlProgram::Uniform(): the " + name_ + " program declares no uniform '" +
+                           name + "'");
   }
   return locations_[name] = glGetUniformLocation(id_, name.c_str());
 }

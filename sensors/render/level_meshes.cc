@@ -30,7 +30,7 @@ Eigen::Vector3d ChunkOrigin(const scene::Level& level) {
 }
 
 std::vector<StaticChunk> MergeStaticActors(const scene::Level& level, const Eigen::Vector3d& origin,
-                                           const SegmentationLegend& legend) {
+                                           const scene::SurfaceIds& legend) {
   // By material, surface, ground cell and which back faces may go
   // (-1: none, 0: those of solids, k + 1: those of height field k).
   using Key = std::tuple<int, std::optional<scene::Surface>, long, long, int>;
@@ -128,7 +128,7 @@ std::vector<std::pair<Eigen::AlignedBox3f, GpuMesh>> UploadChunks(
   return uploaded;
 }
 
-MovableMeshes UploadMovableActors(const scene::Level& level, const SegmentationLegend& legend) {
+MovableMeshes UploadMovableActors(const scene::Level& level, const scene::SurfaceIds& legend) {
   MovableMeshes out;
   for (std::size_t a = 0; a < level.actors.size(); ++a) {
     if (!level.actors[a].movable) continue;  // merged into chunks

@@ -12,9 +12,9 @@
 #include <vector>
 
 #include "scene/level.h"
+#include "scene/surface_ids.h"
 #include "sensors/render/gpu_mesh.h"
 #include "sensors/render/hidden_faces.h"
-#include "sensors/render/segmentation.h"
 
 namespace sandbox::render {
 
@@ -45,7 +45,7 @@ Eigen::Vector3d ChunkOrigin(const scene::Level& level);
 // The static actors' meshes in the frame at `origin`, grouped by material,
 // surface, ground cell and which back faces may go; no GL.
 std::vector<StaticChunk> MergeStaticActors(const scene::Level& level, const Eigen::Vector3d& origin,
-                                           const SegmentationLegend& legend);
+                                           const scene::SurfaceIds& legend);
 
 // Chunks with their levels of detail, uploaded, with their bounds.
 std::vector<std::pair<Eigen::AlignedBox3f, GpuMesh>> UploadChunks(
@@ -57,6 +57,6 @@ struct MovableMeshes {
   std::vector<std::pair<int, GpuMesh>> meshes;
   std::map<int, Eigen::AlignedBox3d> bounds_A;
 };
-MovableMeshes UploadMovableActors(const scene::Level& level, const SegmentationLegend& legend);
+MovableMeshes UploadMovableActors(const scene::Level& level, const scene::SurfaceIds& legend);
 
 }  // namespace sandbox::render

@@ -78,7 +78,8 @@ std::optional<RenderSettings::Problem> RenderSettings::FindProblem() const {
 
 void RenderSettings::ValidateOrThrow() const {
   if (const auto problem = FindProblem()) {
-    throw std::invalid_argument("RenderSettings::ValidateOrThrow(): '" + problem->field + "' " + problem->why);
+    throw std::invalid_argument("RenderSettings::ValidateOrThrow(): '" + problem->field + "' " +
+                                problem->why);
   }
 }
 

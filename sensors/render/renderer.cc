@@ -18,6 +18,7 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "scene/surface_ids.h"
 #include "sensors/render/deferred_shading.h"
 #include "sensors/render/detail_textures.h"
 #include "sensors/render/frame_targets.h"
@@ -31,7 +32,6 @@
 #include "sensors/render/robot_meshes.h"
 #include "sensors/render/scene_programs.h"
 #include "sensors/render/screen_passes.h"
-#include "sensors/render/segmentation.h"
 #include "sensors/render/shadow_cascades.h"
 #include "sensors/render/shadow_maps.h"
 #include "sensors/render/terrain_meshes.h"
@@ -100,7 +100,7 @@ class OsMesaRenderer : public Renderer {
     level_ = &level;
     drawer_.SetLevel(level);
     shadow_maps_.Forget();
-    legend_ = std::make_unique<SegmentationLegend>(level);
+    legend_ = std::make_unique<scene::SurfaceIds>(level);
     water_level_ = -1e9f;
     for (const scene::Actor& actor : level.actors) {
       if (actor.surface == scene::Surface::kWater && !actor.bounds_W.isEmpty()) {
@@ -132,12 +132,14 @@ class OsMesaRenderer : public Renderer {
     view.ValidateOrThrow();
     if (overlay != nullptr && (overlay->point_rgb.size() != overlay->points_W.size() ||
                                overlay->line_rgb.size() * 2 != overlay->lines_W.size())) {
-      throw std::invalid_argument("Renderer::Render(): an overlay needs one colour per point and per line");
+      throw std::invalid_argument(
+          "Renderer::Render(): an overlay needs one colour per point and per line");
     }
     settings.ValidateOrThrow();
     if (settings.anisotropy > max_anisotropy_) {
-      throw std::invalid_argument("Renderer::Render(): anisotropy " + std::to_string(settings.anisotropy) +
-                                  " is beyond this GL's " + std::to_string(int(max_anisotropy_)));
+      throw std::invalid_argument("Renderer::Render(): anisotropy " +
+                                  std::to_string(settings.anisotropy) + " is beyond this GL's " +
+                                  std::to_string(int(max_anisotropy_)));
     }
     const FramePlan plan = Plan(settings, overlay);
     targets_.Resize(view.width, view.height, plan.samples);
@@ -574,7 +576,7 @@ class OsMesaRenderer : public Renderer {
 
   // The level.
   const scene::Level* level_{nullptr};
-  std::unique_ptr<SegmentationLegend> legend_;
+  std::unique_ptr<scene::SurfaceIds> legend_;
   float water_level_{-1e9f};
   Eigen::Vector3d origin_{Eigen::Vector3d::Zero()};  // of the static chunks
   std::vector<std::pair<Eigen::AlignedBox3f, GpuMesh>> static_meshes_;

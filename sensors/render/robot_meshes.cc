@@ -7,13 +7,13 @@
 
 namespace sandbox::render {
 
-RobotMeshes::RobotMeshes(const scene::Level& level, const SegmentationLegend& legend)
+RobotMeshes::RobotMeshes(const scene::Level& level, const scene::SurfaceIds& legend)
     : level_(level), legend_(legend) {
   // The robots' bone groups, per triangle, for segmentation.
   for (std::size_t r = 0; r < level.robots.size(); ++r) {
     std::vector<std::vector<std::uint32_t>>& groups = groups_[&level.robots[r]];
     for (std::size_t m = 0; m < level.robots[r].meshes.size(); ++m) {
-      groups.push_back(BoneGroupPerTriangle(level.robots[r], int(m)));
+      groups.push_back(scene::BoneGroupPerTriangle(level.robots[r], int(m)));
     }
   }
 }

@@ -11,15 +11,15 @@
 
 #include "scene/level.h"
 #include "scene/robot_state.h"
+#include "scene/surface_ids.h"
 #include "sensors/render/gpu_mesh.h"
-#include "sensors/render/segmentation.h"
 
 namespace sandbox::render {
 
 class RobotMeshes {
  public:
   // `level` and `legend` outlive this.
-  RobotMeshes(const scene::Level& level, const SegmentationLegend& legend);
+  RobotMeshes(const scene::Level& level, const scene::SurfaceIds& legend);
 
   // This frame's robots, uploaded (first sight) or updated.
   void Pose(const std::vector<const scene::RobotState*>& robots);
@@ -35,7 +35,7 @@ class RobotMeshes {
   int RobotIndex(const scene::RobotModel& model) const;
 
   const scene::Level& level_;
-  const SegmentationLegend& legend_;
+  const scene::SurfaceIds& legend_;
   std::map<const scene::RobotModel*, std::vector<GpuMesh>> meshes_;
   std::map<const scene::RobotModel*, std::vector<std::vector<std::uint32_t>>> groups_;
   std::vector<Posed> posed_;

@@ -35,7 +35,7 @@ struct CameraView {
 enum ImageKind : unsigned {
   kColorImage = 1u,
   kDepthImage = 2u,
-  kSegmentationImage = 4u,  // an id per actor, horizon and robot bone group (segmentation.h)
+  kSegmentationImage = 4u,  // an id per actor, horizon and robot bone group (scene/surface_ids.h)
   kNormalsImage = 8u,       // unit surface normals in the camera frame
 };
 using ImageKinds = unsigned;

@@ -24,6 +24,7 @@
 #include "sandbox_msgs/scan_face_compact_t.hpp"
 #include "sandbox_msgs/scan_face_t.hpp"
 #include "sandbox_msgs/status_t.hpp"
+#include "sandbox_msgs/surface_table_t.hpp"
 #include "sandbox_msgs/wrench_t.hpp"
 
 namespace sandbox::bridge {
@@ -80,11 +81,14 @@ struct Samples {
     }
     ground_map_t ground{};
     ground.n = 3, ground.num_points = 9, ground.height.assign(9, 1.0f);
+    ground.num_surface = 9, ground.surface.assign(9, 4);
     Add("ground_map_t", ground);
     lidar_scan_t lidar{};
     lidar.channels = 2, lidar.steps = 3, lidar.num_beams = 6;
     lidar.range_m.assign(6, 10.0f), lidar.hit.assign(6, 1);
     lidar.num_xyz = 18, lidar.xyz.assign(18, 0.5f), lidar.time_s.assign(3, 0.01f);
+    lidar.num_surface = 6, lidar.surface.assign(6, 2);
+    lidar.num_normal = 18, lidar.normal.assign(18, 0.5f);
     Add("lidar_scan_t", lidar);
     range_t range{};
     range.sensor = "altimeter", range.range_m = 12.0;
@@ -95,9 +99,12 @@ struct Samples {
     scan_face_t face{};
     face.n = 2, face.num_points = 4, face.occupancy = {-1, 0, 1, 1};
     face.num_xyz = 12, face.xyz.assign(12, 2.0f);
+    face.num_surface = 4, face.surface = {0, 0, 3, 5};
+    face.num_normal = 12, face.normal.assign(12, 0.25f);
     Add("scan_face_t", face);
     scan_face_compact_t compact{};
     compact.n = 2, compact.encoding = 1, compact.num_mm = 4, compact.distance_mm = {1, -1, -2, 7};
+    compact.num_runs = 2, compact.run_surface = {0, 3}, compact.run_length = {2, 2};
     Add("scan_face_compact_t", compact);
     status_t status{};
     status.num_channels = 2;
@@ -105,6 +112,11 @@ struct Samples {
     status.received = {10, 20}, status.superseded = {1, 2}, status.rejected = {0, 3};
     status.stale = {0, 1}, status.last_reject_reason = {"", "non-finite bone value"};
     Add("status_t", status);
+    surface_table_t table{};
+    table.num_surfaces = 2, table.id = {1, 5}, table.kind = {"actor", "bone"};
+    table.name = {"terrain", "ELAHA/wing_left"}, table.actor = {0, -1};
+    table.robot = {"", "ELAHA"}, table.bone = {"", "wing_left"};
+    Add("surface_table_t", table);
     wrench_t wrench{};
     wrench.frame = "world";
     Add("wrench_t", wrench);
@@ -146,6 +158,7 @@ Decoded Decode(const std::string& type, const std::uint8_t* data, std::size_t si
       {"scan_face_t", DecodeAs<scan_face_t>},
       {"scan_face_compact_t", DecodeAs<scan_face_compact_t>},
       {"status_t", DecodeAs<status_t>},
+      {"surface_table_t", DecodeAs<surface_table_t>},
       {"wrench_t", DecodeAs<wrench_t>}};
   return decoders.at(type)(data, size);
 }

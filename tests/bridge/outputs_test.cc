@@ -56,7 +56,7 @@ TEST(RobotOutputsTest, RangeReadingArrivesOnItsChannelWithItsSensorAndInput) {
   EXPECT_EQ(message.input_seq, 42);
   EXPECT_EQ(message.input_utime, 4200);
   EXPECT_EQ(message.hit, 1);
-  EXPECT_EQ(message.body, reading.body);
+  EXPECT_EQ(message.surface, reading.surface);
   // The ray as mounted, and the point where it stopped on it.
   EXPECT_DOUBLE_EQ(message.origin[0], 3.0);
   EXPECT_DOUBLE_EQ(message.origin[1], -4.0);

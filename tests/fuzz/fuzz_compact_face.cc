@@ -15,6 +15,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     const sandbox::bridge::FacePoints points = sandbox::bridge::DecodeCompactFace(message);
     if (points.occupancy.size() != points.points_W.size()) __builtin_trap();
+    if (!points.surface.empty() && points.surface.size() != points.points_W.size())
+      __builtin_trap();
   } catch (const std::invalid_argument&) {
   }
   return 0;

@@ -22,6 +22,7 @@
 #include "sandbox_msgs/robot_state_t.hpp"
 #include "sandbox_msgs/scan_face_t.hpp"
 #include "sandbox_msgs/status_t.hpp"
+#include "sandbox_msgs/surface_table_t.hpp"
 #include "sandbox_msgs/wrench_t.hpp"
 
 namespace {
@@ -70,6 +71,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   DecodeExactly<robot_state_t>(data, size);
   DecodeExactly<scan_face_t>(data, size);
   DecodeExactly<status_t>(data, size);
+  DecodeExactly<surface_table_t>(data, size);
   DecodeExactly<wrench_t>(data, size);
 
   World& w = TheWorld();

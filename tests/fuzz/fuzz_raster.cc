@@ -32,8 +32,7 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const char* name = "/vsimem/fuzz.tif";
-  VSILFILE* file =
-      VSIFileFromMemBuffer(name, const_cast<GByte*>(data), vsi_l_offset(size), FALSE);
+  VSILFILE* file = VSIFileFromMemBuffer(name, const_cast<GByte*>(data), vsi_l_offset(size), FALSE);
   if (file == nullptr) return 0;
   VSIFCloseL(file);
   TerrainSpec spec;

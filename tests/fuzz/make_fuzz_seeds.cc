@@ -30,6 +30,7 @@
 #include "sandbox_msgs/robot_pose_t.hpp"
 #include "sandbox_msgs/scan_face_compact_t.hpp"
 #include "sandbox_msgs/status_t.hpp"
+#include "sandbox_msgs/surface_table_t.hpp"
 #include "scene/terrain_cache.h"
 #include "scene/terrain_source.h"
 #include "tests/test_rasters.h"
@@ -82,6 +83,10 @@ void LcmSeeds(const fs::path& dir) {
   status.superseded = {0}, status.rejected = {1}, status.stale = {0};
   status.last_reject_reason = {"non-finite pose"};
   Write(dir / "status", Encode(status));
+  sandbox_msgs::surface_table_t table{};
+  table.num_surfaces = 1, table.id = {7}, table.kind = {"bone"}, table.name = {"ELAHA/wing"};
+  table.actor = {-1}, table.robot = {"ELAHA"}, table.bone = {"wing"};
+  Write(dir / "surfaces", Encode(table));
 }
 
 void UdpSeeds(const fs::path& dir) {
@@ -282,6 +287,7 @@ void CompactFaceSeeds(const fs::path& dir) {
     } else {
       face.num_m = 25;
       for (int k = 0; k < 25; ++k) face.distance_m.push_back(k % 3 ? 0.25f * float(k) : INFINITY);
+      face.num_runs = 3, face.run_surface = {0, 4, 9}, face.run_length = {5, 12, 8};  // an id plane
     }
     Write(dir / ("face_" + std::to_string(encoding)), Encode(face));
   }

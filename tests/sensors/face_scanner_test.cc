@@ -218,7 +218,11 @@ TEST(FaceScannerTest, SixStageScansOneFaceATickInOrder) {
 TEST(FaceScannerTest, OwnRobotAndCollisionOffActorsAreNeverSeen) {
   const scene::Level level = scene::LoadLevel(testing::SampleLevel());
   const scene::CollisionWorld world(level);
-  const int robot_body = int(level.actors.size());  // ELAHA, robot 0
+  // ELAHA, robot 0: any of its bone groups' ids.
+  auto on_robot = [&world](std::int32_t surface) {
+    const scene::SurfaceEntry* entry = world.surface_ids().Find(surface);
+    return entry != nullptr && entry->robot == 0;
+  };
   FaceScannerConfig config;
   config.refresh = Refresh::kFull;
   const FaceScanner scanner(config);
@@ -237,8 +241,8 @@ TEST(FaceScannerTest, OwnRobotAndCollisionOffActorsAreNeverSeen) {
   caster.Cast(world, rays, own, &without_robot);
   int robot_hits = 0;
   for (std::size_t i = 0; i < rays.size(); ++i) {
-    robot_hits += with_robot.body[i] == robot_body;
-    ASSERT_NE(without_robot.body[i], robot_body);
+    robot_hits += on_robot(with_robot.surface[i]);
+    ASSERT_FALSE(on_robot(without_robot.surface[i]));
   }
   EXPECT_GT(robot_hits, 20);
   // Over the lake the water (collision off) is never hit: the -Z face reaches the bed.

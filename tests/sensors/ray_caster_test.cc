@@ -74,7 +74,7 @@ TEST_F(RayCasterTest, AgreesWithBulletsRayTest) {
     const Vector3d from = rays.origin_W + rays.start[i].cast<double>();
     const Vector3d to = from + double(rays.length_m[i]) * rays.direction[i].cast<double>();
     const auto expected = world_->CastRay(from, to);
-    if (expected.has_value() != (hits.body[i] != RayHits::kNoHit)) {
+    if (expected.has_value() != (hits.surface[i] != RayHits::kNoHit)) {
       ++mismatches;  // grazing an edge or a silhouette can go either way
       continue;
     }
@@ -84,12 +84,14 @@ TEST_F(RayCasterTest, AgreesWithBulletsRayTest) {
     }
     ++hits_count;
     EXPECT_NEAR(hits.distance_m[i], expected->distance_m, 1e-3)
-        << "ray " << i << " body " << hits.body[i] << " bullet actor " << expected->actor
+        << "ray " << i << " surface " << hits.surface[i] << " bullet actor " << expected->actor
         << " robot " << expected->robot << " from " << from.transpose() << " dir "
         << rays.direction[i].transpose();
-    const int expected_body =
-        expected->actor >= 0 ? expected->actor : int(level_->actors.size()) + expected->robot;
-    EXPECT_EQ(hits.body[i], expected_body) << "ray " << i;
+    // The id names what Bullet says was hit (the level's table).
+    const scene::SurfaceEntry* entry = world_->surface_ids().Find(hits.surface[i]);
+    ASSERT_NE(entry, nullptr) << "ray " << i;
+    EXPECT_EQ(entry->actor, expected->actor) << "ray " << i;
+    EXPECT_EQ(entry->robot, expected->robot) << "ray " << i;
     EXPECT_GT(hits.normal_W[i].cast<double>().dot(expected->normal_W), 0.999) << "ray " << i;
   }
   EXPECT_GT(hits_count, 5000);
@@ -121,12 +123,12 @@ TEST_F(RayCasterTest, IgnoringAStaticActorAgreesWithBullet) {
   caster.Cast(*world_, rays, ignore, &ignored);
   int on_tower = 0, mismatches = 0;
   for (std::size_t i = 0; i < rays.size(); ++i) {
-    on_tower += seen.body[i] == tower;
-    ASSERT_NE(ignored.body[i], tower) << "ray " << i;
+    on_tower += seen.surface[i] == world_->surface_ids().actor(tower);
+    ASSERT_NE(ignored.surface[i], world_->surface_ids().actor(tower)) << "ray " << i;
     const Vector3d from = rays.origin_W + rays.start[i].cast<double>();
     const Vector3d to = from + 60.0 * rays.direction[i].cast<double>();
     const auto expected = world_->CastRay(from, to, scene::kAllGroups, tower);
-    if (expected.has_value() != (ignored.body[i] != RayHits::kNoHit)) {
+    if (expected.has_value() != (ignored.surface[i] != RayHits::kNoHit)) {
       ++mismatches;  // grazing an edge can go either way
       continue;
     }
@@ -160,7 +162,7 @@ TEST_F(RayCasterTest, VerticalRaysHitTheAnalyticTerrain) {
   const int terrain = level_->FindActor("terrain");
   int checked = 0;
   for (std::size_t i = 0; i < rays.size(); ++i) {
-    if (hits.body[i] != terrain) continue;  // a rock, the wall or the tower
+    if (hits.surface[i] != world_->surface_ids().actor(terrain)) continue;  // a rock, the wall, ...
     EXPECT_NEAR(200.0 - hits.distance_m[i], expected_z[i], 1e-3);
     ++checked;
   }
@@ -173,24 +175,27 @@ TEST_F(RayCasterTest, FiltersAndThreadCountsChangeNothingElse) {
   RayCaster single(1), pair(2);
   single.Cast(*world_, rays, {}, &one);
   pair.Cast(*world_, rays, {}, &two);
-  EXPECT_EQ(one.body, two.body);
+  EXPECT_EQ(one.surface, two.surface);
   EXPECT_EQ(one.distance_m, two.distance_m);
   // Water has collision off: never hit.
-  const int water = level_->FindActor("water");
-  for (const int body : one.body) EXPECT_NE(body, water);
+  const int water = world_->surface_ids().actor(level_->FindActor("water"));
+  for (const int surface : one.surface) EXPECT_NE(surface, water);
   // Ignoring the robot or keeping only static actors never shows them.
-  const int robot_body = int(level_->actors.size());
+  auto robot_body = [this](std::int32_t surface) {
+    const scene::SurfaceEntry* entry = world_->surface_ids().Find(surface);
+    return entry != nullptr && entry->robot == 0;
+  };
   RayFilter ignore;
   ignore.ignore_robot = 0;
   pair.Cast(*world_, rays, ignore, &no_robot);
   RayFilter statics;
   statics.group_mask = scene::kWorldStatic;
   pair.Cast(*world_, rays, statics, &static_only);
-  const int gate = level_->FindActor("gate");
+  const int gate = world_->surface_ids().actor(level_->FindActor("gate"));
   for (std::size_t i = 0; i < rays.size(); ++i) {
-    EXPECT_NE(no_robot.body[i], robot_body);
-    EXPECT_NE(static_only.body[i], robot_body);
-    EXPECT_NE(static_only.body[i], gate);
+    EXPECT_FALSE(robot_body(no_robot.surface[i]));
+    EXPECT_FALSE(robot_body(static_only.surface[i]));
+    EXPECT_NE(static_only.surface[i], gate);
   }
 }
 
@@ -220,11 +225,12 @@ TEST_F(RayCasterTest, OneCasterFollowsEveryChangeOfTheWorld) {
     changes[c]();
     kept.Cast(world, rays, {}, &after);
     RayCaster(2).Cast(world, rays, {}, &fresh);
-    EXPECT_EQ(after.body, fresh.body) << "change " << c;
+    EXPECT_EQ(after.surface, fresh.surface) << "change " << c;
     EXPECT_EQ(after.distance_m, fresh.distance_m) << "change " << c;
     int changed = 0;
     for (std::size_t i = 0; i < rays.size(); ++i) {
-      changed += after.body[i] != before.body[i] || after.distance_m[i] != before.distance_m[i];
+      changed +=
+          after.surface[i] != before.surface[i] || after.distance_m[i] != before.distance_m[i];
     }
     if (c < 2) {
       EXPECT_GT(changed, 0) << "change " << c << " moved nothing the rays see";
@@ -345,7 +351,7 @@ TEST(RayRulesTest, GrazingAndOriginRulesHoldInAnAxisAlignedRoom) {
       const Vector3d d = rays.direction[i].cast<double>();
       const double expected = ExpectedHit(o, d, rays.length_m[i]);
       const bool expect_hit = expected < rays.length_m[i];
-      const bool hit = hits.body[i] != RayHits::kNoHit;
+      const bool hit = hits.surface[i] != RayHits::kNoHit;
       if (hit != expect_hit || (hit && std::abs(hits.distance_m[i] - expected) > 1e-5)) {
         if (++mismatches <= 5) {
           ADD_FAILURE() << "ray from " << o.transpose() << " along " << d.transpose() << ": "

@@ -56,7 +56,7 @@ TEST(StructuredScanSharedAssetsTest, SameHitsAsTheGeneralCasterInEveryModel) {
         int differ = 0;
         double worst_m = 0.0;
         for (std::size_t i = 0; i < rays.size(); ++i) {
-          if (general.body[i] != structured.body[i]) {
+          if (general.surface[i] != structured.surface[i]) {
             ++differ;
           } else {
             worst_m = std::max(worst_m,
@@ -72,7 +72,7 @@ TEST(StructuredScanSharedAssetsTest, SameHitsAsTheGeneralCasterInEveryModel) {
       caster.Cast(world, rays, {}, &general);
       caster.CastGrids(world, rays, grids, {}, &structured);
       compare(rays, "face scan");
-      for (const std::int32_t body : general.body) hits += body != RayHits::kNoHit;
+      for (const std::int32_t surface : general.surface) hits += surface != RayHits::kNoHit;
     }
     EXPECT_GT(hits, 1000) << file;  // the scans see the model
   }

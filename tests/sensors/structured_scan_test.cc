@@ -23,7 +23,7 @@ using Eigen::Isometry3d;
 using Eigen::Vector3d;
 
 struct Difference {
-  int rays{0}, hits{0}, hit_differs{0}, body_differs{0}, normal_differs{0};
+  int rays{0}, hits{0}, hit_differs{0}, surface_differs{0}, normal_differs{0};
   double worst_m{0.0};
 };
 
@@ -32,13 +32,13 @@ Difference Differences(const RayHits& general, const RayHits& structured) {
   Difference difference;
   difference.rays = int(general.size());
   for (std::size_t i = 0; i < general.size(); ++i) {
-    const bool hit = general.body[i] != RayHits::kNoHit;
+    const bool hit = general.surface[i] != RayHits::kNoHit;
     difference.hits += hit;
-    if (hit != (structured.body[i] != RayHits::kNoHit)) {
+    if (hit != (structured.surface[i] != RayHits::kNoHit)) {
       ++difference.hit_differs;
       continue;
     }
-    difference.body_differs += general.body[i] != structured.body[i];
+    difference.surface_differs += general.surface[i] != structured.surface[i];
     difference.worst_m = std::max(
         difference.worst_m, std::abs(double(general.distance_m[i]) - structured.distance_m[i]));
   }
@@ -64,7 +64,7 @@ Difference CompareKernels(const scene::CollisionWorld& world, const FaceScannerC
   Difference difference = Differences(general, structured);
   const Difference second = Differences(general, again);
   difference.hit_differs += second.hit_differs;
-  difference.body_differs += second.body_differs;
+  difference.surface_differs += second.surface_differs;
   difference.normal_differs += second.normal_differs;
   difference.worst_m = std::max(difference.worst_m, second.worst_m);
   return difference;
@@ -75,7 +75,7 @@ Difference CompareKernels(const scene::CollisionWorld& world, const FaceScannerC
 // then differ, nothing else.
 void ExpectSame(const Difference& difference, const std::string& where, bool ties = false) {
   EXPECT_EQ(difference.hit_differs, 0) << where;
-  EXPECT_EQ(difference.body_differs, 0) << where;
+  EXPECT_EQ(difference.surface_differs, 0) << where;
   EXPECT_LE(difference.worst_m, 1e-5) << where;  // 0.01 mm
   if (!ties) {
     EXPECT_EQ(difference.normal_differs, 0) << where;
@@ -226,7 +226,10 @@ TEST(StructuredScanTest, ATieBetweenActorsGoesToTheFirstInEveryKernel) {
   RayHits hits;
   auto expect_first = [&](const char* kernel) {
     int on_floor = 0, second = 0;
-    for (const std::int32_t body : hits.body) on_floor += body >= 0, second += body == 1;
+    const std::int32_t second_id = world.surface_ids().actor(1);
+    for (const std::int32_t surface : hits.surface) {
+      on_floor += surface != RayHits::kNoHit, second += surface == second_id;
+    }
     EXPECT_GT(on_floor, 1000) << kernel;
     EXPECT_EQ(second, 0) << kernel;
   };

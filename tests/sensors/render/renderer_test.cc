@@ -139,7 +139,7 @@ TEST_F(RendererTest, DepthAgreesWithTheRayCaster) {
     const auto [column, row] = pixels[i];
     const float depth =
         frame.depth_m[std::size_t(row) * std::size_t(view.width) + std::size_t(column)];
-    if (hits.body[i] == sensors::RayHits::kNoHit) {
+    if (hits.surface[i] == sensors::RayHits::kNoHit) {
       EXPECT_TRUE(std::isinf(depth)) << column << ", " << row;
       continue;
     }
@@ -258,8 +258,7 @@ TEST_F(RendererTest, SegmentIdsMatchTheActorsTheRaysHit) {
     const auto [column, row] = pixels[i];
     const std::uint32_t id =
         frame.segment[std::size_t(row) * std::size_t(view.width) + std::size_t(column)];
-    const std::uint32_t expected =
-        hits.body[i] == sensors::RayHits::kNoHit ? 0u : std::uint32_t(1 + hits.body[i]);
+    const auto expected = std::uint32_t(hits.surface[i]);  // one vocabulary
     same += id == expected;
     tower += expected == 2u;
   }
