@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
@@ -37,17 +38,21 @@ const char* kUsage =
     "  --see-robots   rays see the level's robots too (default: world actors only)\n"
     "  --out          CSV (face: face,row,col,occupancy,x,y,z; lidar: "
     "channel,step,hit,x,y,z,range;\n"
-    "                 ground: row,col,valid,x,y,z; ray: hit,x,y,z,range) or PLY when it ends\n"
-    "                 in .ply (occupied points red, free points green); face scans also as a\n"
-    "                 sheet when it ends in .png (the six faces as distance images, unfolded\n"
-    "                 cube, colour bar); see docs/reference/sensors.md\n";
+    "                 ground: row,col,valid,x,y,z; ray: hit,x,y,z,range; then on every row\n"
+    "                 surface,nx,ny,nz: what the sample hit and its normal) or PLY when it\n"
+    "                 ends in .ply (occupied points red, free points green, with surface and\n"
+    "                 normal); the surface ids' table beside it in FILE_surfaces.csv; face\n"
+    "                 scans also as a sheet when it ends in .png (the six faces as distance\n"
+    "                 images, unfolded cube, colour bar); see docs/reference/sensors.md\n";
 
 // One sample for the writers.
 struct Sample {
   std::string key;  // the leading CSV columns, e.g. "0,12,7"
   bool occupied;
   Eigen::Vector3d point_W;
-  std::string extra;  // trailing CSV columns, e.g. ",37.2"
+  std::string extra;        // trailing CSV columns, e.g. ",37.2"
+  std::int32_t surface{0};  // what it hit (scene/surface_ids.h), 0: nothing
+  Eigen::Vector3f normal_W{Eigen::Vector3f::Zero()};
 };
 
 void WriteSamples(const std::string& file, const std::string& header,
@@ -60,20 +65,41 @@ void WriteSamples(const std::string& file, const std::string& header,
            "metres\nelement vertex "
         << samples.size()
         << "\nproperty double x\nproperty double y\nproperty double z\nproperty uchar red\n"
-           "property uchar green\nproperty uchar blue\nend_header\n";
+           "property uchar green\nproperty uchar blue\nproperty int surface\n"
+           "property float nx\nproperty float ny\nproperty float nz\nend_header\n";
     for (const Sample& s : samples) {
       out << s.point_W.x() << " " << s.point_W.y() << " " << s.point_W.z() << " "
-          << (s.occupied ? "255 0 0" : "0 255 0") << "\n";
+          << (s.occupied ? "255 0 0" : "0 255 0") << " " << s.surface << " " << s.normal_W.x()
+          << " " << s.normal_W.y() << " " << s.normal_W.z() << "\n";
     }
   } else {
-    out << header << "\n";
+    out << header << ",surface,nx,ny,nz\n";
     for (const Sample& s : samples) {
       out << s.key << s.point_W.x() << "," << s.point_W.y() << "," << s.point_W.z() << s.extra
-          << "\n";
+          << "," << s.surface << "," << s.normal_W.x() << "," << s.normal_W.y() << ","
+          << s.normal_W.z() << "\n";
     }
   }
   out.close();  // the last buffer's write errors show here
   if (!out) throw CommandError("cannot write " + file);
+}
+
+// The surface ids' table (scene::CollisionWorld::SurfaceTable()) as CSV.
+void WriteSurfaceTable(const std::string& file, const std::vector<scene::SurfaceEntry>& table) {
+  std::ofstream out(file);
+  out << "id,kind,name,actor,robot,bone\n";
+  for (const scene::SurfaceEntry& e : table) {
+    out << e.id << "," << e.kind << "," << e.name << "," << e.actor << "," << e.robot_name << ","
+        << e.bone_name << "\n";
+  }
+  out.close();
+  if (!out) throw CommandError("cannot write " + file);
+}
+
+// FILE.csv -> FILE_surfaces.csv
+std::string SurfaceTableFile(const std::string& out_file) {
+  std::filesystem::path path(out_file);
+  return (path.parent_path() / (path.stem().string() + "_surfaces.csv")).string();
 }
 
 double Positive(const std::string& text, const std::string& option) {
@@ -150,6 +176,7 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       config.refresh = sensors::Refresh::kFull;
       config.sample_budget = 1e7;  // a one-off scan may be finer than a sensor of the loop
       config.alignment = aligned == "body" ? sensors::Alignment::kBody : sensors::Alignment::kWorld;
+      config.normals = true;
       const sensors::FaceScanner scanner(config);
       sensors::FaceScan scan = scanner.EmptyScan();
       scanner.Scan(world, caster, filter, X_WS, 0, &scan);
@@ -165,17 +192,20 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       }
       header = "face,row,col,occupancy,x,y,z";
       for (int f = 0; f < 6; ++f) {
+        const sensors::ScanFace& face = scan.faces[std::size_t(f)];
         for (int k = 0; k < scan.n * scan.n; ++k) {
-          const int occupancy = scan.faces[std::size_t(f)].occupancy[std::size_t(k)];
+          const int occupancy = face.occupancy[std::size_t(k)];
           samples.push_back({std::to_string(f) + "," + std::to_string(k / scan.n) + "," +
                                  std::to_string(k % scan.n) + "," + std::to_string(occupancy) + ",",
-                             occupancy == sensors::kOccupied, scan.PointW(f, std::size_t(k)), ""});
+                             occupancy == sensors::kOccupied, scan.PointW(f, std::size_t(k)), "",
+                             face.surface[std::size_t(k)], face.normal_W[std::size_t(k)]});
         }
       }
     } else if (sensor == "ground") {
       sensors::GroundScannerConfig config;
       config.resolution_m = res;
       config.half_extent_m = extent;
+      config.normals = true;
       sensors::HeightMap map;
       sensors::GroundScanner(config).Scan(world, caster, filter, X_WS.translation(), &map);
       header = "row,col,valid,x,y,z";
@@ -188,10 +218,12 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
                                 valid ? h : X_WS.translation().z() - config.depth_m);
         samples.push_back(
             {std::to_string(r) + "," + std::to_string(c) + "," + std::to_string(int(valid)) + ",",
-             valid, p, ""});
+             valid, p, "", map.surface[std::size_t(k)], map.normal_W[std::size_t(k)]});
       }
     } else if (sensor == "lidar") {
-      const sensors::Lidar lidar(sensors::LidarConfig::Uniform(16, -15, 15, 1024, 100.0));
+      sensors::LidarConfig config = sensors::LidarConfig::Uniform(16, -15, 15, 1024, 100.0);
+      config.normals = true;
+      const sensors::Lidar lidar(config);
       sensors::LidarScan scan;
       lidar.Sweep(world, caster, filter, X_WS, X_WS, &scan);
       header = "channel,step,hit,x,y,z,range";
@@ -202,25 +234,28 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
         range << "," << scan.range_m[i];
         samples.push_back({std::to_string(c) + "," + std::to_string(k) + "," +
                                std::to_string(int(scan.hit[i])) + ",",
-                           scan.hit[i] != 0, scan.points_W[i], range.str()});
+                           scan.hit[i] != 0, scan.points_W[i], range.str(), scan.surface[i],
+                           scan.normal_W[i]});
       }
     } else {
       const sensors::RangeReading reading = sensors::MeasureRange({}, world, caster, filter, X_WS);
       header = "hit,x,y,z,range";
       std::ostringstream range;
       range << "," << reading.range_m;
-      samples.push_back(
-          {std::to_string(int(reading.hit)) + ",", reading.hit, reading.point_W, range.str()});
+      samples.push_back({std::to_string(int(reading.hit)) + ",", reading.hit, reading.point_W,
+                         range.str(), reading.surface, reading.normal_W.cast<float>()});
     }
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     if (!sheet) WriteSamples(out_file, header, samples);
+    WriteSurfaceTable(SurfaceTableFile(out_file), world.SurfaceTable());
     std::size_t occupied = 0;
     for (const Sample& s : samples) occupied += s.occupied ? 1 : 0;
     const Eigen::Vector3d p = X_WS.translation();
     out << sensor << " scan at (" << p.x() << ", " << p.y() << ", " << p.z()
         << "): " << samples.size() << " rays, " << occupied << " hit, " << std::fixed
-        << std::setprecision(2) << ms << " ms -> " << out_file << "\n";
+        << std::setprecision(2) << ms << " ms -> " << out_file << " (surfaces "
+        << SurfaceTableFile(out_file) << ")\n";
     return 0;
   } catch (const scene::LevelError& error) {
     err << "sandbox scan: " << error.what() << "\n";

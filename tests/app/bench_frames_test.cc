@@ -16,9 +16,10 @@ using sandbox::testing::RunSandbox;
 
 TEST(BenchFramesTest, RunsTheLookAndImagesAskedForAndWritesEveryFrame) {
   sandbox::testing::TempDir dir;
-  const auto run = RunSandbox("bench-frames --frames 3 --runs 1 --quality high --kind "
-                              "color,segmentation --out " +
-                              dir.path().string());
+  const auto run = RunSandbox(
+      "bench-frames --frames 3 --runs 1 --quality high --kind "
+      "color,segmentation --out " +
+      dir.path().string());
   ASSERT_EQ(run.exit_code, 0) << run.out;
   EXPECT_NE(run.out.find("high look, color,segmentation"), std::string::npos) << run.out;
   // 2 levels x 3 cases x 3 frames, after the header.

@@ -328,18 +328,21 @@ TEST(OutputContractTest, ScansTwoHundredKilometresOutAreAsPreciseAsAtTheOrigin) 
   ASSERT_EQ(scan.exit_code, 0) << scan.out;
   std::ifstream csv(one_shot);
   std::string line;
-  std::getline(csv, line);  // face,row,col,occupancy,x,y,z
+  std::getline(csv, line);  // face,row,col,occupancy,x,y,z,surface,nx,ny,nz
   int compared = 0;
   while (std::getline(csv, line)) {
-    int f, r, c, occupancy;
+    int f, r, c, occupancy, surface;
     double x, y, z;
-    ASSERT_EQ(
-        std::sscanf(line.c_str(), "%d,%d,%d,%d,%lf,%lf,%lf", &f, &r, &c, &occupancy, &x, &y, &z), 7)
+    ASSERT_EQ(std::sscanf(line.c_str(), "%d,%d,%d,%d,%lf,%lf,%lf,%d", &f, &r, &c, &occupancy, &x,
+                          &y, &z, &surface),
+              8)
         << line;
     const sandbox_msgs::scan_face_t& face = faces[faces.size() - 6 + std::size_t(f)];
     ASSERT_EQ(face.face, f);
     const int k = r * face.n + c;
     EXPECT_EQ(face.occupancy[k], occupancy) << line;
+    ASSERT_EQ(face.num_surface, face.num_points);  // surface ids are on by default
+    EXPECT_EQ(face.surface[k], surface) << line;
     const Eigen::Vector3d point =
         Eigen::Vector3d(face.origin[0], face.origin[1], face.origin[2]) +
         Eigen::Vector3d(face.xyz[3 * k], face.xyz[3 * k + 1], face.xyz[3 * k + 2]);

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -43,7 +44,13 @@ TEST(ScanCommandTest, FaceScanCsvMatchesTheTerrainBelow) {
   ASSERT_EQ(run.exit_code, 0) << run.out;
   const std::vector<std::string> lines = Lines(csv);
   ASSERT_EQ(lines.size(), 1u + 6u * 51u * 51u);
-  EXPECT_EQ(lines[0], "face,row,col,occupancy,x,y,z");
+  EXPECT_EQ(lines[0], "face,row,col,occupancy,x,y,z,surface,nx,ny,nz");
+  // The table beside it names the terrain's id.
+  int terrain = -1;
+  for (const std::string& row : Lines((dir.path() / "scan_surfaces.csv").string())) {
+    if (row.find(",actor,terrain,") != std::string::npos) terrain = std::stoi(row);
+  }
+  ASSERT_GT(terrain, 0);
   int checked = 0;
   for (std::size_t i = 1; i < lines.size(); ++i) {
     const std::vector<double> c = Cells(lines[i]);
@@ -52,6 +59,13 @@ TEST(ScanCommandTest, FaceScanCsvMatchesTheTerrainBelow) {
     EXPECT_DOUBLE_EQ(c[5], y - 25 + c[1]);
     // The terrain is piecewise flat between 2 m grid points: within 5 cm of the function.
     EXPECT_NEAR(c[6], sandbox::assets::sample::TerrainHeight(c[4], c[5]), 0.05);
+    EXPECT_EQ(c[7], terrain);
+    // The normal faces the ray (up): its slope is the terrain's, to the 2 m grid's steps.
+    const double dx = sandbox::assets::sample::TerrainHeight(c[4] + 0.5, c[5]) -
+                      sandbox::assets::sample::TerrainHeight(c[4] - 0.5, c[5]);
+    EXPECT_NEAR(std::hypot(c[8], c[9], c[10]), 1.0, 1e-5);
+    EXPECT_GT(c[10], 0.0);
+    EXPECT_NEAR(-c[8] / c[10], dx, 0.5);
     ++checked;
   }
   EXPECT_GT(checked, 2000);
@@ -63,7 +77,15 @@ TEST(ScanCommandTest, LidarCsvAndPlyColours) {
   ASSERT_EQ(RunSandbox("scan --at 0,0,30 --sensor lidar --out " + csv).exit_code, 0);
   const std::vector<std::string> lines = Lines(csv);
   ASSERT_EQ(lines.size(), 1u + 16u * 1024u);
-  EXPECT_EQ(lines[0], "channel,step,hit,x,y,z,range");
+  EXPECT_EQ(lines[0], "channel,step,hit,x,y,z,range,surface,nx,ny,nz");
+  for (std::size_t i = 1; i < lines.size(); ++i) {  // a hit has an id and a unit normal
+    const std::vector<double> c = Cells(lines[i]);
+    ASSERT_EQ(c.size(), 11u);
+    EXPECT_EQ(c[2] != 0, c[7] != 0) << lines[i];
+    if (c[2] != 0) {
+      EXPECT_NEAR(std::hypot(c[8], c[9], c[10]), 1.0, 1e-5) << lines[i];
+    }
+  }
   const std::string ply = (dir.path() / "face.ply").string();
   ASSERT_EQ(RunSandbox("scan --at 0,0,30 --out " + ply).exit_code, 0);
   const std::vector<std::string> points = Lines(ply);
@@ -71,8 +93,12 @@ TEST(ScanCommandTest, LidarCsvAndPlyColours) {
   EXPECT_EQ(points[0], "ply");
   int red = 0, green = 0;
   for (const std::string& line : points) {
-    red += line.size() > 8 && line.substr(line.size() - 8) == " 255 0 0";
-    green += line.size() > 8 && line.substr(line.size() - 8) == " 0 255 0";
+    std::istringstream in(line);
+    double x, y, z;
+    int r, g, b, surface;
+    if (!(in >> x >> y >> z >> r >> g >> b >> surface)) continue;  // the header
+    red += r == 255 && g == 0 && b == 0 && surface > 0;
+    green += r == 0 && g == 255 && b == 0 && surface == 0;
   }
   EXPECT_EQ(red + green, 6 * 51 * 51);
   EXPECT_GT(red, 51 * 51 - 100);  // nearly every down ray hits the valley
