@@ -187,7 +187,7 @@ void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
                        FaceScan* scan) const {
   if (!X_WS.matrix().allFinite())
     throw std::invalid_argument("FaceScanner::Scan(): non-finite pose");
-  if (scan->n != n_) *scan = EmptyScan();
+  if (scan->n != n_ || scan->normals != config_.normals) *scan = EmptyScan();
   const std::vector<Part> parts = DueAt(tick);
   // The rays and hits keep their memory from scan to scan (no allocation a tick).
   thread_local RayBatch rays;
@@ -311,7 +311,7 @@ std::string FaceScannerConfig::Summary() const {
 }
 
 void FaceScanner::Run(const SensorContext& at, FaceScan* scan) const {
-  if (scan->n != n_) *scan = EmptyScan();
+  if (scan->n != n_ || scan->normals != config_.normals) *scan = EmptyScan();
   Scan(at.world, at.caster, at.filter, at.X_WS, at.tick, scan);
 }
 

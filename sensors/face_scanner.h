@@ -124,7 +124,9 @@ class FaceScanner {
   Eigen::Isometry3d BoxFrame(const Eigen::Isometry3d& X_WS) const;
 
   // Scans what is due at `tick` (see Refresh) from sensor pose X_WS and
-  // writes it into `scan`; the rest of `scan` keeps its earlier values.
+  // writes it into `scan`; the rest of `scan` keeps its earlier values (a
+  // scan of another grid size, or kept with normals by a scanner without,
+  // or the other way round, starts again empty).
   void Scan(const scene::CollisionWorld& world, RayCaster& caster, const RayFilter& filter,
             const Eigen::Isometry3d& X_WS, std::int64_t tick, FaceScan* scan) const;
 

@@ -55,10 +55,12 @@ const RayKernel& ChosenKernel() {
   return chosen;
 }
 
-// Sizes `hits` for n rays (normals only when asked for).
+// Sizes `hits` for n rays (normals only when asked for: else they stay as
+// they were, so that casts with and without them on one RayHits do not clear
+// and refill megabytes in turn).
 void SizeHits(std::size_t n, RayHits* hits) {
   hits->distance_m.resize(n);
-  hits->normal_W.resize(hits->with_normals ? n : 0);
+  if (hits->with_normals) hits->normal_W.resize(n);
   hits->surface.resize(n);
 }
 
@@ -397,11 +399,7 @@ void CastBand(const BandJob& this_band, const RayBatch& rays, const Eigen::Vecto
   band.surface = hits->surface.data() + first;
   std::fill(band.t_max, band.t_max + count, length);
   std::fill(band.surface, band.surface + count, RayHits::kNoHit);
-  band.normal = nullptr;
-  if (hits->with_normals) {
-    band.normals.resize(count);
-    band.normal = band.normals.data();
-  }
+  band.normal = hits->with_normals ? hits->normal_W.data() + first : nullptr;
   band.pairs.count = 0;
   for (const Target& target : targets) {
     if (!wanted(target) || (target.aabb_min.array() > area.box_max.array()).any() ||
@@ -417,11 +415,7 @@ void CastBand(const BandJob& this_band, const RayBatch& rays, const Eigen::Vecto
     });
   }
   hit_pairs(&band);
-  if (band.normal != nullptr) {
-    for (std::size_t i = 0; i < count; ++i) {
-      WriteHit(first + i, band.t_max[i], band.surface[i], band.normal[i], d, hits);
-    }
-  }
+  if (band.normal != nullptr) FacingUnits(band.surface, count, d, band.normal);
 }
 
 // The bands of rows CastGrids() casts, each a chunk of work (each band walks

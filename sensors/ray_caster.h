@@ -73,8 +73,8 @@ struct RayHits {
   std::vector<float> distance_m;
   std::vector<Eigen::Vector3f> normal_W;  // unit, facing the ray; zero without a hit
   std::vector<std::int32_t> surface;
-  // False: normal_W is left empty (a caller that needs no normals, such as
-  // the face scanner, saves a square root and a division a hit).
+  // False: normal_W is left as it was, not read (a caller that needs no
+  // normals saves a square root and a division a hit, and 12 bytes a ray).
   bool with_normals{true};
 
   std::size_t size() const { return surface.size(); }
