@@ -1,7 +1,8 @@
 // What a sample carries beyond its distance, and what that costs: the face
 // scanner's and the lidar's time with normals against without (surface ids
-// are always written: the kernel keeps the id of the hit it found), in turns
-// in one process, the best of several rounds each; and the bytes of a compact
+// are always written: the kernel keeps the id of the hit it found), the
+// lidar's with intensity and with its seeded noise against without, call by
+// call in one process, the median of each; and the bytes of a compact
 // face with its id plane against without. Levels: the sample level and, where
 // ../shared/assets is, its Quake 3 map (many actors: many id runs).
 //
@@ -14,6 +15,7 @@
 #include <cstring>
 #include <filesystem>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "bench/bench_levels.h"
@@ -30,28 +32,22 @@ namespace fs = std::filesystem;
 using namespace sandbox;
 using Clock = std::chrono::steady_clock;
 
-template <typename Work>
-double SecondsPerCall(double seconds, Work work) {
-  work();  // warm up
-  int calls = 0;
-  const auto start = Clock::now();
-  double elapsed = 0.0;
-  do {
-    work();
-    ++calls;
-    elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-  } while (elapsed < seconds);
-  return elapsed / calls;
-}
-
-// Plain and with-normals runs in turns, five rounds: the best of each.
+// Runs without and with in turns, call by call, for `seconds`: the median
+// time of each (the machine's drift and its slow moments fall on both alike).
 template <typename Run>
 void Pair(const char* level, const char* what, int threads, double seconds, Run run) {
-  double plain = 1e30, with = 1e30;
-  for (int round = 0; round < 5; ++round) {
-    plain = std::min(plain, SecondsPerCall(seconds / 5, [&] { run(false); }));
-    with = std::min(with, SecondsPerCall(seconds / 5, [&] { run(true); }));
+  run(false), run(true);  // warm up
+  std::vector<double> times[2];
+  const auto start = Clock::now();
+  while (std::chrono::duration<double>(Clock::now() - start).count() < seconds ||
+         times[0].size() < 5) {
+    for (const bool with : {false, true}) {
+      const auto t0 = Clock::now();
+      run(with);
+      times[with].push_back(std::chrono::duration<double>(Clock::now() - t0).count());
+    }
   }
+  const double plain = bench::Median(times[0]), with = bench::Median(times[1]);
   std::printf("%-12s %-26s %2d %10.3f %10.3f %7.3fx\n", level, what, threads, 1e3 * plain,
               1e3 * with, with / plain);
   std::fflush(stdout);
@@ -70,27 +66,40 @@ void RunLevel(const char* name, const fs::path& file, const Eigen::Isometry3d& X
     face_normals.normals = true;
     const sensors::FaceScanner plain_face(face), normal_face(face_normals);
     sensors::FaceScan scan;
-    Pair(name, "face 6x201x201 (scanner)", threads, seconds, [&](bool normals) {
+    Pair(name, "face 201^2 normals", threads, seconds, [&](bool normals) {
       (normals ? normal_face : plain_face).Scan(world, caster, {}, X_WS, 0, &scan);
     });
     sensors::RayBatch rays;
     std::vector<sensors::RayGrid> grids;
     plain_face.GridRays(0, X_WS, &rays, &grids);
     sensors::RayHits hits;
-    Pair(name, "face 6x201x201 (cast)", threads, seconds, [&](bool normals) {
+    Pair(name, "face 201^2 normals (cast)", threads, seconds, [&](bool normals) {
       hits.with_normals = normals;
       caster.CastGrids(world, rays, grids, {}, &hits);
     });
     for (const auto& [channels, steps, label] :
-         {std::tuple{16, 1024, "lidar 16x1024 (sweep)"}, {64, 2048, "lidar 64x2048 (sweep)"}}) {
+         {std::tuple{16, 1024, "16x1024"}, {64, 2048, "64x2048"}}) {
+      // Plain: the exact geometry with ids only.
       sensors::LidarConfig config = sensors::LidarConfig::Uniform(channels, -25, 15, steps);
-      const sensors::Lidar plain_lidar(config);
+      config.intensity = false;
+      const sensors::Lidar plain(config);
       config.normals = true;
-      const sensors::Lidar normal_lidar(config);
+      const sensors::Lidar normals(config);
+      config.normals = false, config.intensity = true;
+      const sensors::Lidar intensity(config);
+      config.noise.range_sigma_m = 0.02, config.noise.range_sigma_per_m = 0.001;
+      config.noise.dropout_probability = 0.05, config.noise.dropout_below_intensity = 0.01;
+      config.noise.range_step_m = 0.005, config.noise.min_range_m = 0.5;
+      const sensors::Lidar noisy(config);
       sensors::LidarScan sweep;
-      Pair(name, label, threads, seconds, [&](bool normals) {
-        (normals ? normal_lidar : plain_lidar).Sweep(world, caster, {}, X_WL, X_WL, &sweep);
-      });
+      auto compare = [&](const char* what, const sensors::Lidar& without,
+                         const sensors::Lidar& with) {
+        Pair(name, (std::string("lidar ") + label + what).c_str(), threads, seconds,
+             [&](bool on) { (on ? with : without).Sweep(world, caster, {}, X_WL, X_WL, &sweep); });
+      };
+      compare(" normals", plain, normals);
+      compare(" intensity", plain, intensity);
+      compare(" +noise", intensity, noisy);
     }
   }
   // The compact faces' bytes, millimetres, with and without the id plane.
@@ -134,8 +143,8 @@ int main(int argc, char** argv) {
     }
   }
   std::printf("%s\nray kernel: %s\n", bench::Machine().c_str(), sensors::RayCaster::kernel());
-  std::printf("%-12s %-26s %2s %10s %10s %8s\n", "level", "sensor", "th", "plain ms", "normals ms",
-              "ratio");
+  std::printf("%-12s %-26s %2s %10s %10s %8s\n", "level", "sensor, with what", "th", "without ms",
+              "with ms", "ratio");
   try {
     const fs::path sample = fs::path(SANDBOX_SOURCE_DIR) / "assets/sample/level.toml";
     const Eigen::Isometry3d over_valley(Eigen::Translation3d(20, -25, 22) *
@@ -152,7 +161,11 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::printf(
-      "ratio: with normals over without (surface ids are in both). Compact face: the six "
+      "ratio: with over without (surface ids are in both). Face: the face scanner's whole scan "
+      "(6 x 201 x 201 at 0.25 m), and its cast alone. Lidar: a sweep with ids only against one "
+      "with normals or with intensity (reflectivity x incidence x range falloff), and with "
+      "intensity against intensity plus every kind of noise (range sigma and its growth, "
+      "dropout by chance and by intensity, range steps, a minimum range). Compact face: the six "
       "faces' encoded bytes with the id plane (runs of one id) over without.\n");
   return 0;
 }

@@ -141,6 +141,7 @@ void Layout(const lidar_scan_t*, WireReader& r) {
   r.Array(steps, 4, "time_s");
   r.Array(r.Count("num_surface"), 4, "surface");
   r.Array(r.Count("num_normal"), 4, "normal");
+  r.Array(r.Count("num_intensity"), 4, "intensity");
 }
 
 void Layout(const range_t*, WireReader& r) {
@@ -189,6 +190,7 @@ void Layout(const surface_table_t*, WireReader& r) {
   r.Array(surfaces, 4, "actor");
   r.Strings(surfaces, "robot");
   r.Strings(surfaces, "bone");
+  r.Array(surfaces, 4, "reflectivity");
 }
 
 void Layout(const wrench_t*, WireReader& r) {

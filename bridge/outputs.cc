@@ -169,6 +169,8 @@ void PublishOutput(const sensors::LidarScan& scan, const Header& header, Send&& 
   Offsets(scan.points_W, origin, &message.xyz);
   message.time_s.assign(scan.time_s.begin(), scan.time_s.end());
   SurfaceFields(scan.surface_ids, scan.surface, scan.normal_W, &message);
+  message.num_intensity = int(scan.intensity.size());
+  message.intensity = scan.intensity;
   send(message);
 }
 
@@ -257,6 +259,7 @@ void RobotOutputs::PublishSurfaces(const std::vector<scene::SurfaceEntry>& table
     message.actor.push_back(entry.actor);
     message.robot.push_back(entry.robot_name);
     message.bone.push_back(entry.bone_name);
+    message.reflectivity.push_back(entry.reflectivity);
   }
   Send("WORLD", message);
 }

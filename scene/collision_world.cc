@@ -267,6 +267,7 @@ std::vector<SurfaceEntry> CollisionWorld::SurfaceTable() const {
     entry.name = "terrain/" + std::to_string(id.file) + "/" + std::to_string(id.tx) + "," +
                  std::to_string(id.ty);
     entry.actor = w.terrain_actor;
+    entry.reflectivity = w.surface_ids->reflectivity(entry.id);
     table.push_back(std::move(entry));
   }
   return table;

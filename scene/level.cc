@@ -123,6 +123,7 @@ Level LoadManifest(const fs::path& file, const LoadOptions& options) {
     actor.collision = spec.collision;
     actor.movable = spec.movable;
     actor.surface = spec.surface;
+    actor.reflectivity = spec.reflectivity;
     actor.X_WA = spec.placement.pose();
     for (const ImportedNode& node : asset.nodes) {
       const Eigen::Affine3d X_AN = Eigen::Scaling(spec.placement.scale) * node.X_RN;

@@ -30,6 +30,9 @@ struct Actor {
   bool movable{false};  // true: may be placed from outside at run time
   // How cameras shade it, over its materials' own (heightmaps: terrain).
   std::optional<Surface> surface;
+  // What a lidar sees of it (its intensity law, docs/reference/sensors.md);
+  // none: derived from its materials' base colours (scene::SurfaceIds).
+  std::optional<double> reflectivity;
   std::vector<Mesh> meshes;      // in frame A
   Eigen::AlignedBox3d bounds_W;  // exact bounds of the meshes at X_WA; empty without meshes
 

@@ -222,6 +222,12 @@ ActorSpec ParseActor(const fs::path& file, const toml::table& table, int index) 
   } else if (actor.is_heightmap) {
     actor.surface = Surface::kTerrain;
   }
+  if (const auto reflectivity = read.Number("reflectivity")) {
+    if (!(*reflectivity >= 0.0 && *reflectivity <= 1.0)) {
+      read.Fail(read.Find("reflectivity"), "'reflectivity' must be 0 to 1");
+    }
+    actor.reflectivity = *reflectivity;
+  }
   read.RejectUnknownKeys("[[actor]]");
   return actor;
 }

@@ -25,8 +25,9 @@ struct ActorSpec {
   Placement placement;
   bool collision{true};
   bool movable{false};
-  std::optional<Surface> surface;  // `surface = "plain" | "terrain" | "water"`
-  int line{0};                     // where the table starts, for messages
+  std::optional<Surface> surface;      // `surface = "plain" | "terrain" | "water"`
+  std::optional<double> reflectivity;  // `reflectivity = 0..1` (the lidar's intensity)
+  int line{0};                         // where the table starts, for messages
 };
 
 // The [horizon] table: the ground beyond the level, drawn to the horizon.

@@ -1,25 +1,62 @@
 #include "scene/surface_ids.h"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 namespace sandbox::scene {
 
+namespace {
+
+float Linear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
+
+}  // namespace
+
+float DerivedReflectivity(const std::vector<const Mesh*>& meshes,
+                          const std::vector<Material>& materials) {
+  double sum = 0.0, triangles = 0.0;
+  const Material plain;
+  for (const Mesh* mesh : meshes) {
+    const Material& m = mesh->material >= 0 && std::size_t(mesh->material) < materials.size()
+                            ? materials[std::size_t(mesh->material)]
+                            : plain;
+    Eigen::Vector3f rgb = m.base_color.head<3>().cwiseMax(0.f).cwiseMin(1.f);
+    if (!m.linear_color) rgb = {Linear(rgb.x()), Linear(rgb.y()), Linear(rgb.z())};
+    double y = 0.2126 * rgb.x() + 0.7152 * rgb.y() + 0.0722 * rgb.z();
+    if (!m.base_color_texture_path.empty() || m.base_color_texture_embedded >= 0) y *= 0.5;
+    const double n = double(mesh->num_triangles());
+    sum += y * n, triangles += n;
+  }
+  return triangles > 0.0 ? float(sum / triangles) : SurfaceEntry::kDefaultReflectivity;
+}
+
 SurfaceIds::SurfaceIds(const Level& level) {
   for (std::size_t a = 0; a < level.actors.size(); ++a) {
+    const Actor& source = level.actors[a];
     SurfaceEntry entry;
-    entry.id = actor(int(a)), entry.kind = "actor", entry.name = level.actors[a].name;
+    entry.id = actor(int(a)), entry.kind = "actor", entry.name = source.name;
     entry.actor = int(a);
+    if (source.reflectivity) {
+      entry.reflectivity = float(*source.reflectivity);
+    } else {
+      std::vector<const Mesh*> meshes;
+      for (const Mesh& mesh : source.meshes) meshes.push_back(&mesh);
+      entry.reflectivity = DerivedReflectivity(meshes, level.materials);
+    }
     entries_.push_back(std::move(entry));
   }
   horizon_ = std::int32_t(level.actors.size() + 1);
   SurfaceEntry horizon;
   horizon.id = horizon_, horizon.kind = "horizon", horizon.name = "horizon";
+  horizon.reflectivity = 0.f;
   entries_.push_back(std::move(horizon));
   std::int32_t next = horizon_ + 1;
   for (std::size_t r = 0; r < level.robots.size(); ++r) {
     const RobotModel& robot = level.robots[r];
     robot_base_.push_back(next);
+    std::vector<const Mesh*> meshes;
+    for (const auto& mesh : robot.meshes) meshes.push_back(&mesh.bind);
+    const float robot_reflectivity = DerivedReflectivity(meshes, level.materials);
     for (std::size_t b = 0; b < robot.bones.size(); ++b) {
       SurfaceEntry entry;
       entry.id = next + std::int32_t(b), entry.kind = b == 0 ? "robot" : "bone";
@@ -28,11 +65,18 @@ SurfaceIds::SurfaceIds(const Level& level) {
       entry.robot_name = robot.name;
       entry.bone = int(b);
       entry.bone_name = robot.bones[b].name;
+      entry.reflectivity = robot_reflectivity;
       entries_.push_back(std::move(entry));
     }
     next += std::int32_t(std::max<std::size_t>(robot.bones.size(), 1));
   }
   end_ = next;
+  reflectivity_.assign(std::size_t(end_), 0.f);
+  for (const SurfaceEntry& entry : entries_) {
+    if (entry.kind != "horizon") reflectivity_[std::size_t(entry.id)] = entry.reflectivity;
+  }
+  if (level.terrain_actor >= 0)
+    tile_reflectivity_ = reflectivity_[std::size_t(actor(level.terrain_actor))];
 }
 
 const SurfaceEntry* SurfaceIds::Find(std::int32_t id) const {

@@ -9,6 +9,7 @@
 // level's ids depend on the level alone, so every camera and sensor of a run
 // agrees.
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -26,7 +27,19 @@ struct SurfaceEntry {
   std::string robot_name;  // its name, or ""
   int bone{-1};            // the robot's bone map entry, or -1
   std::string bone_name;   // that bone's name, or ""
+  // What a lidar sees of it, 0 to 1 (docs/reference/sensors.md, "Intensity"):
+  // an actor's `reflectivity`, else DerivedReflectivity of its meshes; a
+  // robot's of its meshes; a tile's its terrain actor's.
+  static constexpr float kDefaultReflectivity = 0.5f;
+  float reflectivity{kDefaultReflectivity};
 };
+
+// A surface's reflectivity from its meshes' materials: the luminance of the
+// base colour (linear light, Rec. 709 weights), halved for a material whose
+// colour a texture modulates (a texture's mean is taken as mid-grey: it is not
+// decoded at load), averaged over the triangles; 0.5 without meshes.
+float DerivedReflectivity(const std::vector<const Mesh*>& meshes,
+                          const std::vector<Material>& materials);
 
 class SurfaceIds {
  public:
@@ -43,6 +56,11 @@ class SurfaceIds {
   const std::vector<SurfaceEntry>& entries() const { return entries_; }
   // The entry of a level id, or null (nothing, a tile, out of range).
   const SurfaceEntry* Find(std::int32_t id) const;
+  // The reflectivity of surface `id` (nothing and the horizon: 0; a terrain
+  // tile: its terrain actor's). Inline: the lidar asks once a beam.
+  float reflectivity(std::int32_t id) const {
+    return id < end_ ? reflectivity_[std::size_t(std::max(id, 0))] : tile_reflectivity_;
+  }
   // "id,kind,name" lines with a header, as written beside segmentation images.
   std::string Csv() const;
 
@@ -50,6 +68,8 @@ class SurfaceIds {
   std::int32_t horizon_{0}, end_{0};
   std::vector<std::int32_t> robot_base_;
   std::vector<SurfaceEntry> entries_;
+  std::vector<float> reflectivity_;
+  float tile_reflectivity_{SurfaceEntry::kDefaultReflectivity};
 };
 
 // For each node of `model`, its bone group's bone map entry: its own bone,

@@ -27,12 +27,30 @@ struct LidarConfig {
   double rotation_hz{10.0};  // one sweep lasts 1 / rotation_hz
   bool surface_ids{true};    // publish each beam's surface id (LidarScan::surface)
   bool normals{false};       // publish each beam's normal (LidarScan::normal_W)
+  // Each return's intensity (LidarScan::intensity; docs/reference/sensors.md,
+  // "Intensity"): reflectivity x cos(incidence) x min(1, (reference / range)^2).
+  bool intensity{true};
+  double intensity_reference_m{10.0};
+  // Seeded imperfections (docs/reference/sensors.md, "Lidar noise"); all off
+  // by default: the returns are then the exact geometry.
+  struct Noise {
+    double range_sigma_m{0.0};            // Gaussian range noise, standard deviation
+    double range_sigma_per_m{0.0};        // and its growth per metre of range
+    double dropout_probability{0.0};      // that a return is lost
+    double dropout_below_intensity{0.0};  // returns dimmer than this are lost
+    double range_step_m{0.0};             // ranges rounded to multiples of it (0: none)
+    double min_range_m{0.0};              // nearer hits give no return
+    std::uint64_t seed{0};                // the same seed and inputs: the same noise
+    bool any() const;
+  } noise;
 
   // `channels` elevations evenly from min to max (degrees).
   static LidarConfig Uniform(int channels, double min_deg, double max_deg, int azimuth_steps,
                              double range_m = 100.0, double rotation_hz = 10.0);
   // Throws std::invalid_argument naming the field: no channels, a non-positive
-  // step count, range or rate, a non-finite elevation, or over 10 million rays.
+  // step count, range or rate, a non-finite elevation, over 10 million rays,
+  // a negative sigma, step or minimum range, a probability or intensity
+  // threshold outside [0, 1], or a non-positive intensity reference.
   void ValidateOrThrow() const;
   int channels() const { return static_cast<int>(elevations_rad.size()); }
 
@@ -50,6 +68,7 @@ struct LidarScan {
   std::vector<Eigen::Vector3d> points_W;  // the hit, or the beam's end
   std::vector<std::int32_t> surface;      // surface id of the hit; 0 without
   std::vector<Eigen::Vector3f> normal_W;  // unit, world, facing the beam (LidarConfig::normals)
+  std::vector<float> intensity;           // 0 to 1; 0 without a return (LidarConfig::intensity)
   bool surface_ids{true};                 // published (LidarConfig::surface_ids)
   std::vector<double> time_s;             // per azimuth step, from the sweep's start
   Eigen::Vector3d origin_W{Eigen::Vector3d::Zero()};  // the sensor at the sweep's start
@@ -74,10 +93,12 @@ class Lidar {
   // How long the robot's poses must be kept for Run.
   double history_s() const { return 2.0 / config_.rotation_hz; }
 
-  // One sweep from pose X_WS_start (at its start) to X_WS_end (at its end).
+  // One sweep from pose X_WS_start (at its start) to X_WS_end (at its end);
+  // `sweep` numbers it for the noise (Run: the tick), which beam by beam
+  // depends on the seed, the sweep and the beam alone.
   void Sweep(const scene::CollisionWorld& world, RayCaster& caster, const RayFilter& filter,
              const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3d& X_WS_end,
-             LidarScan* scan) const;
+             LidarScan* scan, std::uint64_t sweep = 0) const;
 
   // The rays of that sweep (origin_W is the start pose's position).
   RayBatch Rays(const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3d& X_WS_end) const;

@@ -89,6 +89,7 @@ struct Samples {
     lidar.num_xyz = 18, lidar.xyz.assign(18, 0.5f), lidar.time_s.assign(3, 0.01f);
     lidar.num_surface = 6, lidar.surface.assign(6, 2);
     lidar.num_normal = 18, lidar.normal.assign(18, 0.5f);
+    lidar.num_intensity = 6, lidar.intensity.assign(6, 0.25f);
     Add("lidar_scan_t", lidar);
     range_t range{};
     range.sensor = "altimeter", range.range_m = 12.0;
@@ -116,6 +117,7 @@ struct Samples {
     table.num_surfaces = 2, table.id = {1, 5}, table.kind = {"actor", "bone"};
     table.name = {"terrain", "ELAHA/wing_left"}, table.actor = {0, -1};
     table.robot = {"", "ELAHA"}, table.bone = {"", "wing_left"};
+    table.reflectivity = {0.3f, 0.5f};
     Add("surface_table_t", table);
     wrench_t wrench{};
     wrench.frame = "world";

@@ -86,6 +86,7 @@ void LcmSeeds(const fs::path& dir) {
   sandbox_msgs::surface_table_t table{};
   table.num_surfaces = 1, table.id = {7}, table.kind = {"bone"}, table.name = {"ELAHA/wing"};
   table.actor = {-1}, table.robot = {"ELAHA"}, table.bone = {"wing"};
+  table.reflectivity = {0.5f};
   Write(dir / "surfaces", Encode(table));
 }
 

@@ -1,0 +1,191 @@
+// The lidar as hardware reports: intensity by the documented law, and the
+// seeded imperfections measured against their settings on a flat wall whose
+// exact ranges follow from geometry alone.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "scene/collision_world.h"
+#include "scene/level.h"
+#include "sensors/lidar.h"
+#include "sensors/ray_caster.h"
+#include "sensors/sensor.h"
+#include "tests/test_util.h"
+
+namespace sandbox::sensors {
+namespace {
+
+using Eigen::Isometry3d;
+using Eigen::Vector3d;
+
+constexpr double kWall_m = 20.0;  // the wall's plane: x = 20, facing -x
+
+// A level of one wall, 400 m square, in the plane x = 20.
+scene::Level WallLevel(const testing::TempDir& dir, const std::string& extra = "") {
+  dir.Write("wall.obj",
+            "v 20 -200 -200\nv 20 200 -200\nv 20 200 200\nv 20 -200 200\nf 1 2 3\nf 1 3 4\n");
+  return scene::LoadLevel(
+      dir.Write("level.toml", "[[actor]]\nname = \"wall\"\nfile = \"wall.obj\"\n" + extra));
+}
+
+// 64 x 8192 beams, +-30 degrees: about a third of them (the front) meet the wall.
+LidarConfig Dense() { return LidarConfig::Uniform(64, -30, 30, 8192, 200.0); }
+
+// The wall's exact range along beam i: 20 / d.x.
+double ExactRange(const RayBatch& rays, std::size_t i) {
+  return kWall_m / double(rays.direction[i].x());
+}
+
+TEST(LidarNoiseTest, RangeNoiseAndDropoutMatchTheirSettingsOnAFlatWall) {
+  testing::TempDir dir;
+  const scene::Level level = WallLevel(dir);
+  const scene::CollisionWorld world(level);
+  LidarConfig config = Dense();
+  config.noise.range_sigma_m = 0.05;
+  config.noise.dropout_probability = 0.1;
+  config.noise.seed = 7;
+  const Lidar lidar(config);
+  const Isometry3d X_WS = Isometry3d::Identity();
+  const RayBatch rays = lidar.Rays(X_WS, X_WS);
+  RayCaster caster(2);
+  LidarScan scan;
+  lidar.Sweep(world, caster, {}, X_WS, X_WS, &scan, 3);
+  double sum = 0.0, sum2 = 0.0;
+  int on_wall = 0, lost = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    if (!(rays.direction[i].x() > 0.15f)) continue;  // beams that meet the wall
+    ++on_wall;
+    if (!scan.hit[i]) {
+      ++lost;
+      EXPECT_EQ(scan.range_m[i], 200.f);
+      EXPECT_EQ(scan.surface[i], 0);
+      continue;
+    }
+    const double error = double(scan.range_m[i]) - ExactRange(rays, i);
+    sum += error, sum2 += error * error;
+  }
+  ASSERT_GT(on_wall, 100000);
+  const int kept = on_wall - lost;
+  const double mean = sum / kept, sigma = std::sqrt(sum2 / kept - mean * mean);
+  EXPECT_NEAR(sigma, 0.05, 0.03 * 0.05) << on_wall << " beams on the wall";
+  EXPECT_NEAR(mean, 0.0, 0.001);
+  EXPECT_NEAR(double(lost) / on_wall, 0.1, 0.005);
+}
+
+TEST(LidarNoiseTest, SigmaGrowsWithRangeAndRangesAreQuantisedAndCutBelowTheMinimum) {
+  testing::TempDir dir;
+  const scene::Level level = WallLevel(dir);
+  const scene::CollisionWorld world(level);
+  LidarConfig config = Dense();
+  config.noise.range_sigma_per_m = 0.002;  // 4 cm at 20 m, 4.6 cm at 23 m
+  config.noise.range_step_m = 0.01;
+  config.noise.min_range_m = 23.0;  // beams more than 29.6 degrees off the wall's normal pass
+  const Lidar lidar(config);
+  const Isometry3d X_WS = Isometry3d::Identity();
+  const RayBatch rays = lidar.Rays(X_WS, X_WS);
+  RayCaster caster(2);
+  LidarScan scan;
+  lidar.Sweep(world, caster, {}, X_WS, X_WS, &scan);
+  double sum2 = 0.0, expected2 = 0.0;
+  int kept = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    if (!(rays.direction[i].x() > 0.15f)) continue;
+    const double exact = ExactRange(rays, i);
+    EXPECT_EQ(bool(scan.hit[i]), exact >= 23.0) << i;
+    if (!scan.hit[i]) continue;
+    const double r = scan.range_m[i];
+    EXPECT_NEAR(r / 0.01, std::round(r / 0.01), 1e-3) << r;  // a whole number of steps
+    const double error = r - exact;
+    sum2 += error * error, expected2 += std::pow(0.002 * exact, 2) + 0.01 * 0.01 / 12;
+    ++kept;
+  }
+  ASSERT_GT(kept, 20000);
+  EXPECT_NEAR(std::sqrt(sum2 / kept), std::sqrt(expected2 / kept),
+              0.03 * std::sqrt(expected2 / kept));
+}
+
+TEST(LidarNoiseTest, IntensityFollowsReflectivityIncidenceAndRange) {
+  testing::TempDir bright_dir, dark_dir;
+  const scene::Level bright = WallLevel(bright_dir, "reflectivity = 0.8\n");
+  const scene::Level dark = WallLevel(dark_dir, "reflectivity = 0.2\n");
+  const scene::CollisionWorld bright_world(bright), dark_world(dark);
+  LidarConfig config = LidarConfig::Uniform(8, -20, 20, 720, 200.0);
+  config.intensity_reference_m = 25.0;  // nearer than 25 m: no falloff
+  const Lidar lidar(config);
+  const Isometry3d X_WS = Isometry3d::Identity();
+  const RayBatch rays = lidar.Rays(X_WS, X_WS);
+  RayCaster caster(1);
+  LidarScan a, b;
+  lidar.Sweep(bright_world, caster, {}, X_WS, X_WS, &a);
+  lidar.Sweep(dark_world, caster, {}, X_WS, X_WS, &b);
+  int checked = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    if (!a.hit[i]) {
+      EXPECT_EQ(a.intensity[i], 0.f);
+      continue;
+    }
+    // Lambertian: the incidence cosine is the beam's x (the wall's normal is -x).
+    const double cosine = double(rays.direction[i].x()), r = ExactRange(rays, i);
+    const double falloff = std::min(1.0, 25.0 * 25.0 / (r * r));
+    EXPECT_NEAR(a.intensity[i], 0.8 * cosine * falloff, 1e-5) << i;
+    EXPECT_NEAR(a.intensity[i] / b.intensity[i], 4.0, 1e-4) << i;
+    ++checked;
+  }
+  EXPECT_GT(checked, 1000);
+}
+
+TEST(LidarNoiseTest, OneSeedGivesTheSameBytesOnAnyThreadsAnotherSeedOtherBytes) {
+  testing::TempDir dir;
+  const scene::Level level = WallLevel(dir);
+  const scene::CollisionWorld world(level);
+  LidarConfig config = LidarConfig::Uniform(16, -15, 15, 1024, 200.0);
+  config.noise.range_sigma_m = 0.02;
+  config.noise.dropout_probability = 0.05;
+  config.noise.seed = 11;
+  const Isometry3d X_WS = Isometry3d::Identity();
+  RayCaster one(1), two(2);
+  LidarScan first, second, other_seed, other_sweep;
+  Lidar(config).Sweep(world, one, {}, X_WS, X_WS, &first, 5);
+  Lidar(config).Sweep(world, two, {}, X_WS, X_WS, &second, 5);
+  Lidar(config).Sweep(world, two, {}, X_WS, X_WS, &other_sweep, 6);
+  config.noise.seed = 12;
+  Lidar(config).Sweep(world, one, {}, X_WS, X_WS, &other_seed, 5);
+  EXPECT_EQ(first.range_m, second.range_m);
+  EXPECT_EQ(first.hit, second.hit);
+  EXPECT_EQ(first.intensity, second.intensity);
+  EXPECT_NE(first.range_m, other_seed.range_m);
+  EXPECT_NE(first.range_m, other_sweep.range_m);
+}
+
+TEST(LidarNoiseTest, BadSettingsAreRefusedAtLoadNamingTheLineAndField) {
+  testing::TempDir dir;
+  dir.Write("wall.obj", "v 20 -2 -2\nv 20 2 -2\nv 20 2 2\nf 1 2 3\n");
+  auto error_of = [&dir](const std::string& toml) -> std::string {
+    try {
+      MakeRobotSensors(scene::LoadLevel(dir.Write("level.toml", toml)));
+    } catch (const scene::LevelError& error) {
+      return error.what();
+    }
+    return "";
+  };
+  const std::string reflectivity =
+      error_of("[[actor]]\nname = \"wall\"\nfile = \"wall.obj\"\nreflectivity = 1.5\n");
+  EXPECT_NE(reflectivity.find("level.toml:4: "), std::string::npos) << reflectivity;
+  EXPECT_NE(reflectivity.find("'reflectivity' must be 0 to 1"), std::string::npos) << reflectivity;
+  const std::string robot = "[[robot]]\nname = \"W\"\nfile = \"" + std::string(SANDBOX_SOURCE_DIR) +
+                            "/assets/robots/generated/flying_wing.gltf\"\nbones = [\"root\"]\n"
+                            "[[robot.sensor]]\nname = \"l\"\ntype = \"lidar\"\n";
+  for (const auto& [line, field] : {std::pair{"dropout_probability = 1.5", "dropout_probability"},
+                                    {"range_noise_sigma_m = -0.1", "range_noise_sigma_m"},
+                                    {"dropout_below_intensity = -1", "dropout_below_intensity"},
+                                    {"min_range_m = -2", "min_range_m"}}) {
+    const std::string error = error_of(robot + line + "\n");
+    EXPECT_NE(error.find("level.toml:"), std::string::npos) << error;
+    EXPECT_NE(error.find(field), std::string::npos) << error;
+  }
+}
+
+}  // namespace
+}  // namespace sandbox::sensors
