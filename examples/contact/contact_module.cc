@@ -3,7 +3,9 @@
 // into a signed distance field, then for every pose the sandbox applied
 // (<ROBOT>/STATE) it takes that pose's scan faces (<ROBOT>/SCAN_FACE), finds
 // the scan points inside the robot's shape, and publishes the penalty
-// contact's force and torque about the centre of mass (<ROBOT>/WRENCH).
+// contact's force and torque about the centre of mass (<ROBOT>/WRENCH). Each
+// scan point says what it hit (its surface id, named on <ROBOT>/WORLD): the
+// pairs log has the wrench per body pair (the robot on each surface).
 // docs/how-to/contact.md explains the chain and the law.
 //
 //   contact_module --mesh FILE --resolution M [options]   (--help lists them)
@@ -29,6 +31,7 @@
 #include "examples/rigid_body/rigid_body.h"
 #include "sandbox_msgs/robot_state_t.hpp"
 #include "sandbox_msgs/scan_face_t.hpp"
+#include "sandbox_msgs/surface_table_t.hpp"
 #include "sandbox_msgs/wrench_t.hpp"
 
 namespace sandbox::examples {
@@ -52,7 +55,9 @@ const char* kUsage =
     "                      refresh needs 5 or 11)\n"
     "  --faces CHANNEL     face channel after <ROBOT>/ (default SCAN_FACE)\n"
     "  --lcm-url URL       (default LCM's, with a 4 MB receive buffer)\n"
-    "  --log FILE          one CSV row per wrench\n";
+    "  --log FILE          one CSV row per wrench\n"
+    "  --pairs-log FILE    one CSV row per wrench and surface touched: the robot on that\n"
+    "                      surface alone (names from <ROBOT>/WORLD)\n";
 
 volatile sig_atomic_t g_stop = 0;
 void OnSignal(int) { g_stop = 1; }
@@ -64,7 +69,7 @@ std::int64_t NowUtime() {
 }
 
 struct Options {
-  std::string robot = "BOX", mesh, faces = "SCAN_FACE", log;
+  std::string robot = "BOX", mesh, faces = "SCAN_FACE", log, pairs_log;
   std::string url = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304";
   Eigen::Vector3d com = Eigen::Vector3d::Zero();
   SignedDistanceField::Options field;
@@ -111,6 +116,8 @@ std::optional<Options> ParseOptions(int argc, char** argv) {
       o.url = value;
     else if (key == "--log")
       o.log = value;
+    else if (key == "--pairs-log")
+      o.pairs_log = value;
     else if (key == "--com")
       ok = ParseVector(value, &o.com);
     else if (key == "--resolution")
@@ -170,7 +177,15 @@ class ContactModule {
               "cop_x,cop_y,cop_z\n";
       log_ << std::setprecision(10);
     }
+    if (!options.pairs_log.empty()) {
+      pairs_log_.open(options.pairs_log);
+      if (!pairs_log_) throw std::runtime_error(options.pairs_log + ": cannot write the log");
+      pairs_log_ << "input_seq,input_utime,surface,name,points,max_depth_m,normal_n,fx,fy,fz,"
+                    "tx,ty,tz\n";
+      pairs_log_ << std::setprecision(10);
+    }
     lcm.subscribe(options.robot + "/" + options.faces, &ContactModule::OnFace, this);
+    lcm.subscribe(options.robot + "/WORLD", &ContactModule::OnWorld, this);
     lcm.subscribe(options.robot + "/STATE", &ContactModule::OnState, this);
   }
 
@@ -200,6 +215,7 @@ class ContactModule {
     if (face.face < 0 || face.face > 5 || face.n <= 0 ||
         std::int64_t(face.num_points) != std::int64_t(face.n) * face.n ||
         face.num_xyz != 3 * face.num_points ||
+        (face.num_surface != 0 && face.num_surface != face.num_points) ||
         !(std::isfinite(face.origin[0]) && std::isfinite(face.origin[1]) &&
           std::isfinite(face.origin[2]))) {
       return Reject(channel, "face index, size or origin out of range");
@@ -209,6 +225,16 @@ class ContactModule {
       return;
     }
     faces_[std::size_t(face.face)] = std::move(face);
+  }
+
+  // The names of the surface ids (what the pairs log calls them).
+  void OnWorld(const lcm::ReceiveBuffer* buffer, const std::string& channel) {
+    sandbox_msgs::surface_table_t table;
+    if (table.decode(buffer->data, 0, int(buffer->data_size)) < 0 || table.num_surfaces < 0 ||
+        table.id.size() != std::size_t(table.num_surfaces)) {
+      return Reject(channel, "does not decode");
+    }
+    for (int k = 0; k < table.num_surfaces; ++k) names_[table.id[k]] = table.name[k];
   }
 
   void OnState(const lcm::ReceiveBuffer* buffer, const std::string& channel) {
@@ -246,6 +272,7 @@ class ContactModule {
     body.v_W = velocity_;
     body.w_W = angular_velocity_;
     ContactAccumulator contact(shape_, options_.law, body);
+    std::map<std::int32_t, ContactAccumulator> by_surface;  // 0: the face had no ids
     int faces_used = 0;
     for (const std::optional<sandbox_msgs::scan_face_t>& face : faces_) {
       if (!face || face->input_seq > state.input_seq ||
@@ -259,6 +286,10 @@ class ContactModule {
         if (face->occupancy[std::size_t(k)] != 1) continue;
         const float* xyz = &face->xyz[3 * std::size_t(k)];
         contact.AddPoint(origin, Eigen::Vector3f(xyz[0], xyz[1], xyz[2]));
+        if (!pairs_log_) continue;
+        const std::int32_t surface = face->num_surface > 0 ? face->surface[std::size_t(k)] : 0;
+        by_surface.try_emplace(surface, shape_, options_.law, body)
+            .first->second.AddPoint(origin, Eigen::Vector3f(xyz[0], xyz[1], xyz[2]));
       }
     }
     const ContactWrench wrench = contact.Result();
@@ -282,6 +313,18 @@ class ContactModule {
       }
       log_ << "\n";
     }
+    for (const auto& [surface, accumulator] : by_surface) {
+      const ContactWrench pair = accumulator.Result();
+      if (pair.points == 0) continue;  // seen, not touched
+      const auto name = names_.find(surface);
+      pairs_log_ << state.input_seq << "," << state.input_utime << "," << surface << ","
+                 << (name != names_.end() ? name->second : std::string("?")) << "," << pair.points
+                 << "," << pair.max_depth_m << "," << pair.normal_force_n;
+      for (const Eigen::Vector3d* v : {&pair.force_W, &pair.torque_W}) {
+        for (int k = 0; k < 3; ++k) pairs_log_ << "," << (*v)[k];
+      }
+      pairs_log_ << "\n";
+    }
     previous_ = Previous{body.com_W, body.R_WB, state.input_utime};
     computed_seq_ = state.input_seq;
     pending_.reset();
@@ -300,7 +343,8 @@ class ContactModule {
   const Options& options_;
   const SignedDistanceField& shape_;
   lcm::LCM& lcm_;
-  std::ofstream log_;
+  std::ofstream log_, pairs_log_;
+  std::map<std::int32_t, std::string> names_;  // surface ids' names (<ROBOT>/WORLD)
   std::array<std::optional<sandbox_msgs::scan_face_t>, 6> faces_;
   std::optional<sandbox_msgs::robot_state_t> pending_;
   std::optional<Previous> previous_;

@@ -19,6 +19,7 @@
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -178,7 +179,56 @@ void DrawPanel(cv::Mat& image, cv::Rect area, const std::string& title,
   }
 }
 
-void Plot(const std::string& file, const std::string& scenario, const Series& poses) {
+// What touched when (the contact module's pairs log): per surface, the
+// times (s, from the first wrench's input) of the poses it pushed on the
+// robot, and the normal force then.
+struct Touch {
+  double t, normal_n;
+  std::int64_t input_seq;
+  Eigen::Vector3d force_n;
+};
+using Touches = std::map<std::string, std::vector<Touch>>;
+
+Touches ReadPairs(const std::string& file, double first_utime) {
+  std::ifstream in(file);
+  if (!in) throw std::runtime_error(file + ": cannot read");
+  std::string line;
+  std::getline(in, line);  // input_seq,input_utime,surface,name,points,max_depth_m,normal_n,...
+  Touches touches;
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::stringstream row(line);
+    for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
+    if (cells.size() < 10) throw std::runtime_error(file + ": a row of " + line);
+    touches[cells[3]].push_back(
+        {1e-6 * (std::stod(cells[1]) - first_utime), std::stod(cells[6]), std::stoll(cells[0]),
+         Eigen::Vector3d(std::stod(cells[7]), std::stod(cells[8]), std::stod(cells[9]))});
+  }
+  return touches;
+}
+
+// One lane per surface: a mark at each pose it touched the robot.
+void DrawTouches(cv::Mat& image, cv::Rect area, const Touches& touches, double t0, double t1) {
+  const auto font = cv::FONT_HERSHEY_SIMPLEX;
+  cv::putText(image, "what touched the robot, when (contact module's pairs log)",
+              {area.x + 70, area.y + 18}, font, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  const cv::Rect plot(area.x + 70, area.y + 25, area.width - 90, area.height - 35);
+  cv::rectangle(image, plot, cv::Scalar(180, 180, 180));
+  const int lane = touches.empty() ? plot.height : plot.height / int(touches.size());
+  int k = 0;
+  for (const auto& [name, list] : touches) {
+    const int y = plot.y + k * lane + lane / 2;
+    cv::putText(image, name, {area.x + 2, y + 4}, font, 0.4, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+    for (const Touch& touch : list) {
+      const int x = plot.x + int((touch.t - t0) / std::max(t1 - t0, 1e-9) * plot.width);
+      cv::line(image, {x, y - lane / 3}, {x, y + lane / 3}, cv::Scalar(200, 80, 30));
+    }
+    ++k;
+  }
+}
+
+void Plot(const std::string& file, const std::string& scenario, const Series& poses,
+          const Touches* touches) {
   std::vector<double> t, z, turn[3], f[3], tau[3];
   const Eigen::Quaterniond R0 = Orientation(poses, 0);
   for (std::size_t i = 0; i < poses.rows.size(); ++i) {
@@ -192,7 +242,8 @@ void Plot(const std::string& file, const std::string& scenario, const Series& po
     }
   }
   const cv::Scalar red(40, 40, 220), green(40, 160, 40), blue(200, 80, 30);
-  cv::Mat image(1000, 900, CV_8UC3, cv::Scalar(255, 255, 255));
+  const int touch_rows = touches != nullptr ? 60 + 25 * int(touches->size()) : 0;
+  cv::Mat image(1000 + touch_rows, 900, CV_8UC3, cv::Scalar(255, 255, 255));
   DrawPanel(image, {0, 0, 900, 250}, scenario + ": height of the centre of mass (m)", t,
             {{"z", z, blue}});
   DrawPanel(image, {0, 250, 900, 250}, "orientation: turn since the start, world axes (deg)", t,
@@ -201,6 +252,8 @@ void Plot(const std::string& file, const std::string& scenario, const Series& po
             {{"fx", f[0], red}, {"fy", f[1], green}, {"fz", f[2], blue}});
   DrawPanel(image, {0, 750, 900, 250}, "contact torque about the centre of mass, world (N m)", t,
             {{"tx", tau[0], red}, {"ty", tau[1], green}, {"tz", tau[2], blue}});
+  if (touches != nullptr)
+    DrawTouches(image, {0, 1000, 900, touch_rows}, *touches, t.front(), t.back());
   if (!cv::imwrite(file, image)) throw std::runtime_error(file + ": cannot write the plot");
 }
 
@@ -298,7 +351,8 @@ int main(int argc, char** argv) {
   if (argc < 2) {
     std::fputs(
         "usage: scenario_report SCENARIO --args model|contact|level\n"
-        "       scenario_report SCENARIO --poses CSV --contacts CSV [--plot PNG] [--check]\n",
+        "       scenario_report SCENARIO --poses CSV --contacts CSV [--pairs CSV] [--plot PNG]\n"
+        "                       [--check]\n",
         stderr);
     return 2;
   }
@@ -318,8 +372,8 @@ int main(int argc, char** argv) {
     const std::string key = argv[i];
     if (key == "--check") {
       check = true;
-    } else if (i + 1 < argc &&
-               (key == "--args" || key == "--poses" || key == "--contacts" || key == "--plot")) {
+    } else if (i + 1 < argc && (key == "--args" || key == "--poses" || key == "--contacts" ||
+                                key == "--plot" || key == "--pairs")) {
       options[key] = argv[++i];
     } else {
       std::fprintf(stderr, "scenario_report: unknown option %s\n", key.c_str());
@@ -343,8 +397,35 @@ int main(int argc, char** argv) {
     if (name == "flat_drop" || name == "flat_rest") FlatGround(name, scenario, poses, &figures);
     if (name == "step_edge") StepEdge(poses, &figures);
     if (name == "landing") Landing(scenario, poses, contacts, &figures);
+    std::optional<Touches> touches;
+    if (options.count("--pairs") && !contacts.rows.empty()) {
+      touches = ReadPairs(options["--pairs"], contacts.At(0, "input_utime"));
+      for (const auto& [surface, list] : *touches) {
+        double peak = 0.0;
+        for (const Touch& touch : list) peak = std::max(peak, touch.normal_n);
+        std::printf("  touched %-28s %6zu poses, %.3f to %.3f s, peak normal force %.6g N\n",
+                    surface.c_str(), list.size(), list.front().t, list.back().t, peak);
+      }
+      // The pairs' forces add up to each wrench's total.
+      std::map<std::int64_t, Eigen::Vector3d> sums;
+      for (const auto& [surface, list] : *touches) {
+        for (const Touch& touch : list) {
+          sums.try_emplace(touch.input_seq, Eigen::Vector3d::Zero()).first->second += touch.force_n;
+        }
+      }
+      double worst = 0.0, largest = 1e-300;
+      for (std::size_t i = 0; i < contacts.rows.size(); ++i) {
+        const Eigen::Vector3d total(contacts.At(i, "fx"), contacts.At(i, "fy"),
+                                    contacts.At(i, "fz"));
+        const auto sum = sums.find(std::int64_t(contacts.At(i, "input_seq")));
+        const Eigen::Vector3d pairs = sum != sums.end() ? sum->second : Eigen::Vector3d::Zero();
+        worst = std::max(worst, (pairs - total).norm());
+        largest = std::max(largest, total.norm());
+      }
+      figures.Add("body pairs' forces against the total", worst / largest, 0.0, 1e-9, "");
+    }
     if (options.count("--plot")) {
-      Plot(options["--plot"], name, poses);
+      Plot(options["--plot"], name, poses, touches ? &*touches : nullptr);
       std::printf("  plot: %s\n", options["--plot"].c_str());
     }
     if (check && !figures.ok) {
