@@ -1,11 +1,13 @@
-function [points, occupancy] = scan_face_points(msg)
+function [points, occupancy, surface] = scan_face_points(msg)
 % SCAN_FACE_POINTS  World points of a compact face-scan message.
-%   [POINTS, OCCUPANCY] = SCAN_FACE_POINTS(MSG) turns a
+%   [POINTS, OCCUPANCY, SURFACE] = SCAN_FACE_POINTS(MSG) turns a
 %   sandbox_msgs.scan_face_compact_t (as lcm.jar delivers it, or any struct
 %   with its fields) into an n^2 x 3 matrix of world points, row r and column
 %   c of the face at index r * n + c + 1 (the hit, or the ray's end when free;
 %   NaN where not scanned yet or for a hit beyond the millimetre range), and
-%   the occupancy per point (-1 not scanned, 0 free, 1 occupied). The grid and
+%   the occupancy per point (-1 not scanned, 0 free, 1 occupied), and the
+%   surface id of what each point hit (0: nothing; the names come on
+%   <ROBOT>/WORLD), or an empty matrix when the message has no id plane. The grid and
 %   the codes are those of bridge/lcmtypes/scan_face_compact_t.lcm; the C++
 %   twin is sandbox::bridge::DecodeCompactFace (bridge/face_points.h).
 n = double(msg.n);
@@ -46,6 +48,14 @@ else
 end
 starts = (-E + c * res) * (R * u)' + (-E + r * res) * (R * v)';
 points = p' + starts + d .* (R * a)';
+% The id plane: runs of one id in grid order.
+runs = double(msg.num_runs);
+surface = [];
+if runs > 0
+  ids = as_column(msg.run_surface);
+  lengths = as_column(msg.run_length);
+  surface = repelem(ids, lengths);
+end
 end
 
 function values = as_column(field)

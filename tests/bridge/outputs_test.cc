@@ -286,6 +286,8 @@ TEST(CompactFaceTest, DecodedPointsAreTheScannersPoints) {
        {std::pair{sensors::FaceEncoding::kMillimetres, 0.5e-3 + 1e-5},
         std::pair{sensors::FaceEncoding::kFloat, 1e-5}}) {
     const sensors::FaceScan scan = SampleScan(encoding, 0.5, 25.0, X_WS);
+    sensors::FaceScan scan_without_ids = scan;
+    scan_without_ids.surface_ids = false;
     int occupied = 0, free = 0;
     double worst_m = 0.0;
     for (int f = 0; f < 6; ++f) {
@@ -294,6 +296,11 @@ TEST(CompactFaceTest, DecodedPointsAreTheScannersPoints) {
       const FacePoints decoded = DecodeCompactFace(message);
       const sensors::ScanFace& face = scan.faces[std::size_t(f)];
       ASSERT_EQ(decoded.occupancy, face.occupancy) << "face " << f;
+      ASSERT_EQ(decoded.surface, face.surface) << "face " << f;  // the id plane, whole
+      scan_without_ids.faces[std::size_t(f)] = face;
+      EncodeCompactFace(scan_without_ids, f, &message);
+      EXPECT_EQ(message.num_runs, 0);
+      EXPECT_TRUE(DecodeCompactFace(message).surface.empty());
       for (std::size_t k = 0; k < face.distance_m.size(); ++k) {
         worst_m = std::max(worst_m, (decoded.points_W[k] - scan.PointW(f, k)).norm());
         occupied += face.occupancy[k] == sensors::kOccupied;
@@ -431,8 +438,8 @@ TEST(CompactFaceTest, TheOctaveFunctionGivesTheScannersPoints) {
         "/examples'); "
         "msg = javaObject('sandbox_msgs.scan_face_compact_t', javaObject("
         "'java.io.DataInputStream', javaObject('java.io.FileInputStream', '" +
-        in.string() + "'))); [p, o] = scan_face_points(msg); dlmwrite('" + out.string() +
-        "', [p, o], 'precision', '%.9g');";
+        in.string() + "'))); [p, o, s] = scan_face_points(msg); dlmwrite('" + out.string() +
+        "', [p, o, s], 'precision', '%.9g');";
     ASSERT_EQ(std::system(("octave --no-gui --quiet --eval \"" + script + "\" > " +
                            (dir.path() / "octave.log").string() + " 2>&1")
                               .c_str()),
@@ -444,9 +451,12 @@ TEST(CompactFaceTest, TheOctaveFunctionGivesTheScannersPoints) {
     std::size_t k = 0;
     double worst_m = 0.0;
     while (std::getline(rows, line) && k < face.distance_m.size()) {
-      double x, y, z, occupancy;
-      ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf", &x, &y, &z, &occupancy), 4) << line;
+      double x, y, z, occupancy, surface;
+      ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf", &x, &y, &z, &occupancy, &surface),
+                5)
+          << line;
       EXPECT_EQ(int(occupancy), int(face.occupancy[k])) << "face " << f << ", point " << k;
+      EXPECT_EQ(int(surface), face.surface[k]) << "face " << f << ", point " << k;
       worst_m = std::max(worst_m, (Eigen::Vector3d(x, y, z) - scan.PointW(f, k)).norm());
       ++k;
     }
