@@ -181,7 +181,7 @@ TEST_F(RayCasterTest, FiltersAndThreadCountsChangeNothingElse) {
   const int water = world_->surface_ids().actor(level_->FindActor("water"));
   for (const int surface : one.surface) EXPECT_NE(surface, water);
   // Ignoring the robot or keeping only static actors never shows them.
-  auto robot_body = [this](std::int32_t surface) {
+  auto robot_body = [](std::int32_t surface) {
     const scene::SurfaceEntry* entry = world_->surface_ids().Find(surface);
     return entry != nullptr && entry->robot == 0;
   };
