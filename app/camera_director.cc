@@ -76,7 +76,8 @@ void CameraDirector::AddOverlay(const CameraRun& run, const Shot& shot, RenderJo
   for (const sensors::Sensor& sensor : *shot.sensors) {
     if (sensor.mounted().robot != run.camera->robot) continue;
     if (const auto* scan = std::get_if<sensors::FaceScan>(&sensor.output())) {
-      render::AddFaceScan(*scan, run.camera->overlay_stub_m, &job->overlay);
+      render::AddFaceScan(*scan, run.camera->overlay_stub_m, &job->overlay,
+                          run.camera->overlay_colour);
     }
   }
   render::AddBoneFrames(*shot.robots[std::size_t(run.camera->robot)], 1.0, &job->overlay);

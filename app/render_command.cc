@@ -14,9 +14,9 @@
 #include "app/loaded_level.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
+#include "scene/surface_ids.h"
 #include "sensors/render/cameras.h"
 #include "sensors/render/debug_overlay.h"
-#include "scene/surface_ids.h"
 #include "sensors/sensor.h"
 
 namespace sandbox::app {
@@ -25,7 +25,9 @@ namespace {
 const char* kUsage =
     "usage: sandbox render [LEVEL] --camera chase|trailing|payload|fixed --at X,Y,Z[,R,P,Y]\n"
     "                      [--robot NAME] [--bones LIST] [--width W] [--height H] [--fov DEG]\n"
-    "                      [--kind LIST] [--quality Q] [--overlay] [--stub M] [--isolate]\n"
+    "                      [--kind LIST] [--quality Q] [--overlay] [--stub M] [--overlay-colour "
+    "C]\n"
+    "                      [--isolate]\n"
     "                      --out FILE.jpg|.png\n"
     "  --camera  chase: the spring arm behind the robot; trailing: 25 m behind, 8 m up;\n"
     "            payload: on the robot, looking forward (also writes FILE_depth.png, 16-bit\n"
@@ -45,12 +47,13 @@ const char* kUsage =
     "            25 m) scanned in full at the pose, occupied samples red and free green,\n"
     "            bone frames and movable actors' bounds\n"
     "  --stub    draw samples as stubs of M metres along their rays instead of points\n"
+    "  --overlay-colour  samples coloured by occupancy (default) or by surface id: surface\n"
     "  --isolate read a manifest's files apart first, so that a crash of assimp is an error\n"
     "            (a scene file as LEVEL always is read so)\n";
 
 // The overlay at one robot state: its face scanners scanned in full.
 void BuildOverlay(const scene::Level& level, int robot_index, const scene::RobotState* robot,
-                  double stub_m, render::Overlay* overlay) {
+                  double stub_m, render::SampleColour colour, render::Overlay* overlay) {
   if (robot != nullptr) {
     scene::CollisionWorld world(level);
     world.UpdateRobot(robot_index, *robot);
@@ -70,7 +73,7 @@ void BuildOverlay(const scene::Level& level, int robot_index, const scene::Robot
       const sensors::FaceScanner scanner(config);
       sensors::FaceScan scan = scanner.EmptyScan();
       scanner.Scan(world, caster, filter, X_WS, 0, &scan);
-      render::AddFaceScan(scan, stub_m, overlay);
+      render::AddFaceScan(scan, stub_m, overlay, colour);
     }
     render::AddBoneFrames(*robot, 1.0, overlay);
   }
@@ -80,10 +83,11 @@ void BuildOverlay(const scene::Level& level, int robot_index, const scene::Robot
 }  // namespace
 
 int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  const auto parsed = ParseArgs(args, "render",
-                                {"--camera", "--at", "--robot", "--bones", "--width", "--height",
-                                 "--fov", "--out", "--stub", "--kind", "--quality"},
-                                {"--overlay", "--isolate"}, kUsage, err);
+  const auto parsed =
+      ParseArgs(args, "render",
+                {"--camera", "--at", "--robot", "--bones", "--width", "--height", "--fov", "--out",
+                 "--stub", "--kind", "--quality", "--overlay-colour"},
+                {"--overlay", "--isolate"}, kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
     out << kUsage;
@@ -175,7 +179,14 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
     if (parsed->flags.count("--overlay")) {
       const double stub_m =
           parsed->values.count("--stub") ? ParseNumber(parsed->Value("--stub"), "--stub") : 0.0;
-      BuildOverlay(level, robot_index, robot.get(), stub_m, &overlay);
+      const std::string colour = parsed->Value("--overlay-colour", "occupancy");
+      if (colour != "occupancy" && colour != "surface") {
+        throw UsageError("--overlay-colour must be occupancy or surface, got '" + colour + "'");
+      }
+      BuildOverlay(
+          level, robot_index, robot.get(), stub_m,
+          colour == "surface" ? render::SampleColour::kSurface : render::SampleColour::kOccupancy,
+          &overlay);
     }
     renderer->Render(view, {}, robots, settings, &frame, &overlay);
     const double ms =

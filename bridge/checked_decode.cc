@@ -142,6 +142,10 @@ void Layout(const lidar_scan_t*, WireReader& r) {
   r.Array(r.Count("num_surface"), 4, "surface");
   r.Array(r.Count("num_normal"), 4, "normal");
   r.Array(r.Count("num_intensity"), 4, "intensity");
+  r.Array(r.Count("num_last"), 4, "last_range_m");
+  r.Array(r.Count("num_last_xyz"), 4, "last_xyz");
+  r.Array(r.Count("num_last_surface"), 4, "last_surface");
+  r.Array(r.Count("num_last_intensity"), 4, "last_intensity");
 }
 
 void Layout(const range_t*, WireReader& r) {

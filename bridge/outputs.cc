@@ -171,6 +171,14 @@ void PublishOutput(const sensors::LidarScan& scan, const Header& header, Send&& 
   SurfaceFields(scan.surface_ids, scan.surface, scan.normal_W, &message);
   message.num_intensity = int(scan.intensity.size());
   message.intensity = scan.intensity;
+  message.num_last = int(scan.last_range_m.size());
+  message.last_range_m = scan.last_range_m;
+  message.num_last_xyz = int(3 * scan.last_points_W.size());
+  Offsets(scan.last_points_W, origin, &message.last_xyz);
+  message.num_last_surface = scan.surface_ids ? int(scan.last_surface.size()) : 0;
+  if (scan.surface_ids) message.last_surface = scan.last_surface;
+  message.num_last_intensity = int(scan.last_intensity.size());
+  message.last_intensity = scan.last_intensity;
   send(message);
 }
 

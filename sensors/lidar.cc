@@ -35,8 +35,18 @@ void LidarConfig::ValidateOrThrow() const {
   if (!(std::isfinite(rotation_hz) && rotation_hz > 0.0)) {
     fail("rotation_hz", rotation_hz, "must be positive");
   }
-  if (double(azimuth_steps) * double(elevations_rad.size()) > 1e7) {
-    throw std::invalid_argument("channels x azimuth_steps makes more than 10 million rays");
+  if (divergence.rays != 0 || divergence.angle_rad != 0.0) {
+    if (divergence.rays < 2) fail("divergence_rays", divergence.rays, "must be at least 2");
+    const double deg = divergence.angle_rad * 180.0 / M_PI;
+    if (!(deg > 0.0 && deg < 90.0)) fail("divergence_deg", deg, "must be more than 0 and under 90");
+  }
+  if (!(divergence.return_separation_m >= 0.0 && std::isfinite(divergence.return_separation_m))) {
+    fail("return_separation_m", divergence.return_separation_m, "must be 0 or more");
+  }
+  const double per_beam = std::max(divergence.rays, 1);
+  if (double(azimuth_steps) * double(elevations_rad.size()) * per_beam > 1e7) {
+    throw std::invalid_argument(
+        "channels x azimuth_steps x divergence_rays makes more than 10 million rays");
   }
   if (!(std::isfinite(intensity_reference_m) && intensity_reference_m > 0.0)) {
     fail("intensity_reference_m", intensity_reference_m, "must be positive");
@@ -72,11 +82,11 @@ std::uint64_t Mix(std::uint64_t x) {
   return x ^ (x >> 31);
 }
 
-// Draw k (0 or 1) of beam `beam`, given the sweep's key (Mix of the seed and
+// Draw k (0 to 3) of beam `beam`, given the sweep's key (Mix of the seed and
 // the sweep): uniform in (0, 1), a function of its arguments alone (no
 // generator state: threads and order do not matter).
 double Uniform(std::uint64_t sweep_key, std::uint64_t beam, std::uint64_t k) {
-  return (double(Mix(sweep_key ^ (beam << 1 | k)) >> 11) + 0.5) * 0x1.0p-53;
+  return (double(Mix(sweep_key ^ (beam << 2 | k)) >> 11) + 0.5) * 0x1.0p-53;
 }
 
 // The standard normal quantile at p in (0, 1) (inverse transform sampling):
@@ -110,11 +120,24 @@ double NormalQuantile(double p) {
 
 Lidar::Lidar(const LidarConfig& config) : config_(config) { config_.ValidateOrThrow(); }
 
-RayBatch Lidar::Rays(const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3d& X_WS_end) const {
+RayBatch Lidar::Rays(const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3d& X_WS_end,
+                     RayBatch* sub_rays) const {
   const int channels = config_.channels(), steps = config_.azimuth_steps;
+  const int per_beam = sub_rays != nullptr ? config_.divergence.rays : 0;
   RayBatch rays;
   rays.origin_W = X_WS_start.translation();
   rays.Resize(std::size_t(channels) * std::size_t(steps));
+  if (per_beam > 0) {
+    sub_rays->origin_W = rays.origin_W;
+    sub_rays->Resize(rays.size() * std::size_t(per_beam));
+  }
+  // Sub-ray j: cos(h) d + sin(h) (cos(phi_j) up + sin(phi_j) side).
+  const double h = config_.divergence.angle_rad / 2.0;
+  std::vector<Eigen::Vector2d> around(std::size_t(std::max(per_beam, 0)));
+  for (int j = 0; j < per_beam; ++j) {
+    const double phi = 2.0 * M_PI * j / per_beam;
+    around[std::size_t(j)] = std::sin(h) * Eigen::Vector2d(std::cos(phi), std::sin(phi));
+  }
   const Eigen::Quaterniond q0(X_WS_start.linear()), q1(X_WS_end.linear());
   const Eigen::Vector3d travel = X_WS_end.translation() - X_WS_start.translation();
   for (int k = 0; k < steps; ++k) {
@@ -123,18 +146,41 @@ RayBatch Lidar::Rays(const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3
     const Eigen::Matrix3d R = q0.slerp(s, q1).toRotationMatrix();
     const Eigen::Vector3f start = (s * travel).cast<float>();
     const double azimuth = 2.0 * M_PI * k / steps;
+    const double ca = std::cos(azimuth), sa = std::sin(azimuth);
     for (int c = 0; c < channels; ++c) {
       const double e = config_.elevations_rad[std::size_t(c)];
-      const Eigen::Vector3d d(std::cos(e) * std::cos(azimuth), std::cos(e) * std::sin(azimuth),
-                              std::sin(e));
+      const Eigen::Vector3d d(std::cos(e) * ca, std::cos(e) * sa, std::sin(e));
       const std::size_t i = std::size_t(c) * std::size_t(steps) + std::size_t(k);
       rays.start[i] = start;
       rays.direction[i] = (R * d).cast<float>();
       rays.length_m[i] = static_cast<float>(config_.range_m);
+      if (per_beam == 0) continue;
+      const Eigen::Vector3d up(-std::sin(e) * ca, -std::sin(e) * sa, std::cos(e)), side(-sa, ca, 0);
+      for (int j = 0; j < per_beam; ++j) {
+        const Eigen::Vector2d& o = around[std::size_t(j)];
+        const std::size_t q = i * std::size_t(per_beam) + std::size_t(j);
+        sub_rays->start[q] = start;
+        sub_rays->direction[q] =
+            (R * (std::cos(h) * d + o.x() * up + o.y() * side)).normalized().cast<float>();
+        sub_rays->length_m[q] = rays.length_m[i];
+      }
     }
   }
   return rays;
 }
+
+namespace {
+
+// One return of a beam: its range, what it hit and how bright it came back.
+struct Return {
+  float range_m{0.f};
+  std::int32_t surface{RayHits::kNoHit};
+  Eigen::Vector3f normal{Eigen::Vector3f::Zero()};
+  float brightness{0.f};
+  bool there() const { return surface != RayHits::kNoHit; }
+};
+
+}  // namespace
 
 void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const RayFilter& filter,
                   const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3d& X_WS_end,
@@ -142,65 +188,148 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
   if (!X_WS_start.matrix().allFinite() || !X_WS_end.matrix().allFinite()) {
     throw std::invalid_argument("Lidar::Sweep(): non-finite pose");
   }
-  const RayBatch rays = Rays(X_WS_start, X_WS_end);
-  thread_local RayHits hits;
+  const LidarConfig::Divergence& divergence = config_.divergence;
+  const int per_beam = std::max(divergence.rays, 1);
+  // Kept between sweeps (this thread's); the workers below read them through
+  // these references (a thread_local named in a lambda is the worker's own).
+  thread_local RayBatch kept_sub_rays;
+  thread_local RayHits kept_hits;
+  RayBatch& sub_rays = kept_sub_rays;
+  RayHits& hits = kept_hits;
+  const RayBatch beams = Rays(X_WS_start, X_WS_end, divergence.on() ? &sub_rays : nullptr);
+  const RayBatch& rays = divergence.on() ? sub_rays : beams;
   const LidarConfig::Noise& noise = config_.noise;
   const bool intensity = config_.intensity || noise.dropout_below_intensity > 0.0;
   hits.with_normals = config_.normals || intensity;
   caster.Cast(world, rays, filter, &hits);
-  const std::size_t n = rays.size();
+  const std::size_t n = beams.size(), lasts = divergence.on() ? n : 0;
   scan->channels = config_.channels();
-  scan->origin_W = rays.origin_W;
+  scan->origin_W = beams.origin_W;
   scan->azimuth_steps = config_.azimuth_steps;
   scan->hit.resize(n);
   scan->points_W.resize(n);
-  scan->intensity.assign(intensity ? n : 0, 0.f);
+  scan->range_m.resize(n);
+  scan->surface.resize(n);
+  scan->normal_W.resize(config_.normals ? n : 0);
+  scan->intensity.resize(config_.intensity ? n : 0);
+  scan->last_range_m.resize(lasts);
+  scan->last_points_W.resize(lasts);
+  scan->last_surface.resize(lasts);
+  scan->last_intensity.resize(config_.intensity ? lasts : 0);
   const bool noisy = noise.any();
   const std::uint64_t sweep_key = Mix(Mix(noise.seed) ^ sweep);
   const float range = static_cast<float>(config_.range_m);
   const double reference2 = config_.intensity_reference_m * config_.intensity_reference_m;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (hits.surface[i] == RayHits::kNoHit) continue;
-    float r = hits.distance_m[i];
-    float brightness = 0.f;
+  const scene::SurfaceIds& ids = world.surface_ids();
+
+  // Ray q's hit as a return (its brightness: "Intensity").
+  auto hit_of = [&](std::size_t q) {
+    Return hit;
+    hit.surface = hits.surface[q];
+    hit.range_m = hits.distance_m[q];
+    if (!hits.with_normals || !hit.there()) return hit;
+    hit.normal = hits.normal_W[q];
     if (intensity) {
-      const double cosine = -double(hits.normal_W[i].dot(rays.direction[i]));
-      const double falloff = r > 0.f ? std::min(1.0, reference2 / (double(r) * r)) : 1.0;
-      brightness = float(world.surface_ids().reflectivity(hits.surface[i]) * std::max(0.0, cosine) *
-                         falloff);
+      const double cosine = -double(hit.normal.dot(rays.direction[q]));
+      const double r = hit.range_m;
+      const double falloff = r > 0.0 ? std::min(1.0, reference2 / (r * r)) : 1.0;
+      hit.brightness = float(ids.reflectivity(hit.surface) * std::max(0.0, cosine) * falloff);
     }
-    if (noisy) {
-      const bool lost = r < noise.min_range_m || brightness < noise.dropout_below_intensity ||
-                        Uniform(sweep_key, i, 0) < noise.dropout_probability;
-      if (lost) {
-        hits.surface[i] = RayHits::kNoHit;
-        hits.distance_m[i] = range;
-        if (hits.with_normals) hits.normal_W[i].setZero();
-        continue;
-      }
-      const double sigma = noise.range_sigma_m + noise.range_sigma_per_m * r;
-      if (sigma > 0.0) r += float(sigma * NormalQuantile(Uniform(sweep_key, i, 1)));
-      if (noise.range_step_m > 0.0) {
-        r = float(std::round(r / noise.range_step_m) * noise.range_step_m);
-      }
-      r = std::clamp(r, 0.f, range);
-      hits.distance_m[i] = r;
+    return hit;
+  };
+  // A cone's sub-ray hits grouped into the first and the last return.
+  auto cone = [&](std::size_t i, Return* first, Return* last) {
+    const std::size_t q0 = i * std::size_t(per_beam);
+    float nearest = range, farthest = -1.f;
+    for (std::size_t q = q0; q < q0 + std::size_t(per_beam); ++q) {
+      if (hits.surface[q] == RayHits::kNoHit) continue;
+      nearest = std::min(nearest, hits.distance_m[q]);
+      farthest = std::max(farthest, hits.distance_m[q]);
     }
-    if (intensity) scan->intensity[i] = brightness;
-  }
-  scan->range_m = hits.distance_m;
-  for (std::size_t i = 0; i < n; ++i) {
-    scan->hit[i] = hits.surface[i] != RayHits::kNoHit;
-    scan->points_W[i] =
-        rays.origin_W + (rays.start[i] + hits.distance_m[i] * rays.direction[i]).cast<double>();
-  }
-  scan->surface = hits.surface;
+    *first = *last = Return{};
+    if (farthest < 0.f) return;
+    const float near_end = nearest + float(divergence.return_separation_m);
+    const float far_start = farthest - float(divergence.return_separation_m);
+    double sum[2] = {0.0, 0.0};
+    int count[2] = {0, 0};
+    for (std::size_t q = q0; q < q0 + std::size_t(per_beam); ++q) {
+      if (hits.surface[q] == RayHits::kNoHit) continue;
+      const float d = hits.distance_m[q];
+      const int group = d <= near_end ? 0 : d >= far_start ? 1 : -1;
+      if (group < 0) continue;
+      Return& to = group == 0 ? *first : *last;
+      const Return hit = hit_of(q);
+      // Its identity: the group's nearest sub-ray (the first), farthest (the
+      // last); a tie goes to the lower id.
+      const bool take = !to.there() || (group == 0 ? d < to.range_m : d > to.range_m) ||
+                        (d == to.range_m && hit.surface < to.surface);
+      const float brightness = to.brightness + hit.brightness / float(per_beam);
+      if (take) to = hit;
+      to.brightness = brightness;
+      sum[group] += d;
+      ++count[group];
+    }
+    first->range_m = float(sum[0] / count[0]);
+    if (count[1] == 0) {
+      *last = *first;
+    } else {
+      last->range_m = float(sum[1] / count[1]);
+    }
+  };
+  const double per_step = noise.range_step_m > 0.0 ? 1.0 / noise.range_step_m : 0.0;
+  // The noise on return k (0 first, 1 last) of beam i: false when it is lost.
+  auto perturb = [&](std::size_t i, int k, Return* ret) {
+    if (ret->range_m < noise.min_range_m || ret->brightness < noise.dropout_below_intensity) {
+      return false;
+    }
+    float r = ret->range_m;
+    const double sigma = noise.range_sigma_m + noise.range_sigma_per_m * r;
+    if (sigma > 0.0) r += float(sigma * NormalQuantile(Uniform(sweep_key, i, 1 + k)));
+    if (noise.range_step_m > 0.0) r = float(std::round(r * per_step) * noise.range_step_m);
+    ret->range_m = std::clamp(r, 0.f, range);
+    return true;
+  };
+  auto beam = [&](std::size_t i) {
+    Return first, last;
+    if (divergence.on()) {
+      cone(i, &first, &last);
+    } else if (hits.surface[i] != RayHits::kNoHit) {
+      first = hit_of(i);
+    }
+    if (noisy && first.there()) {
+      if (Uniform(sweep_key, i, 0) < noise.dropout_probability) {
+        first = last = Return{};
+      } else {
+        const bool separate = divergence.on() && last.range_m != first.range_m;
+        const bool keep_first = perturb(i, 0, &first);
+        const bool keep_last = separate ? perturb(i, 1, &last) : keep_first;
+        if (!separate) last = first;
+        if (!keep_first) first = keep_last ? last : Return{};
+        if (!keep_last) last = first;
+      }
+    }
+    const Eigen::Vector3d start = beams.origin_W + beams.start[i].cast<double>();
+    const Eigen::Vector3d direction = beams.direction[i].cast<double>();
+    const float r = first.there() ? first.range_m : range;
+    scan->hit[i] = first.there();
+    scan->range_m[i] = r;
+    scan->points_W[i] = start + double(r) * direction;
+    scan->surface[i] = first.surface;
+    if (config_.normals) scan->normal_W[i] = first.normal;
+    if (config_.intensity) scan->intensity[i] = first.brightness;
+    if (!divergence.on()) return;
+    const float r_last = last.there() ? last.range_m : range;
+    scan->last_range_m[i] = r_last;
+    scan->last_points_W[i] = start + double(r_last) * direction;
+    scan->last_surface[i] = last.surface;
+    if (config_.intensity) scan->last_intensity[i] = last.brightness;
+  };
+  constexpr std::size_t kChunk = 4096;
+  caster.RunParallel(int((n + kChunk - 1) / kChunk), [&](int chunk) {
+    const std::size_t end = std::min(n, std::size_t(chunk + 1) * kChunk);
+    for (std::size_t i = std::size_t(chunk) * kChunk; i < end; ++i) beam(i);
+  });
   scan->surface_ids = config_.surface_ids;
-  if (config_.normals) {
-    scan->normal_W = hits.normal_W;
-  } else {
-    scan->normal_W.clear();
-  }
   scan->sweep_s = 1.0 / config_.rotation_hz;
   scan->X_WS_start = X_WS_start;
   scan->X_WS_end = X_WS_end;
@@ -236,6 +365,11 @@ LidarConfig LidarConfig::Read(scene::SettingsReader& read) {
   noise.dropout_below_intensity = read.Number("dropout_below_intensity", 0.0);
   noise.range_step_m = read.Number("range_step_m", 0.0);
   noise.min_range_m = read.Number("min_range_m", 0.0);
+  const bool divergent = read.Has("divergence_rays") || read.Has("divergence_deg");
+  lidar.divergence.rays = read.Whole("divergence_rays", divergent ? 4 : 0);
+  lidar.divergence.angle_rad = read.Number("divergence_deg", 0.0) * M_PI / 180.0;
+  lidar.divergence.return_separation_m =
+      read.Number("return_separation_m", lidar.divergence.return_separation_m);
   const int seed = read.Whole("seed", 0);
   if (seed < 0) read.Fail("seed", "'seed' must be 0 or more");
   noise.seed = std::uint64_t(seed);

@@ -43,6 +43,15 @@ struct LidarConfig {
     std::uint64_t seed{0};                // the same seed and inputs: the same noise
     bool any() const;
   } noise;
+  // Beam divergence (docs/reference/sensors.md, "Beam divergence"): each beam
+  // a cone of `rays` sub-rays on its rim, `angle_rad` across; the sub-rays'
+  // hits make a first and a last return. rays = 0: one ray a beam.
+  struct Divergence {
+    int rays{0};
+    double angle_rad{0.0};
+    double return_separation_m{0.5};  // hits this far apart are two returns
+    bool on() const { return rays > 0; }
+  } divergence;
 
   // `channels` elevations evenly from min to max (degrees).
   static LidarConfig Uniform(int channels, double min_deg, double max_deg, int azimuth_steps,
@@ -50,7 +59,8 @@ struct LidarConfig {
   // Throws std::invalid_argument naming the field: no channels, a non-positive
   // step count, range or rate, a non-finite elevation, over 10 million rays,
   // a negative sigma, step or minimum range, a probability or intensity
-  // threshold outside [0, 1], or a non-positive intensity reference.
+  // threshold outside [0, 1], a non-positive intensity reference, or a
+  // divergence cone of fewer than 2 rays or an angle outside (0, 90) degrees.
   void ValidateOrThrow() const;
   int channels() const { return static_cast<int>(elevations_rad.size()); }
 
@@ -69,8 +79,15 @@ struct LidarScan {
   std::vector<std::int32_t> surface;      // surface id of the hit; 0 without
   std::vector<Eigen::Vector3f> normal_W;  // unit, world, facing the beam (LidarConfig::normals)
   std::vector<float> intensity;           // 0 to 1; 0 without a return (LidarConfig::intensity)
-  bool surface_ids{true};                 // published (LidarConfig::surface_ids)
-  std::vector<double> time_s;             // per azimuth step, from the sweep's start
+  // With beam divergence, the fields above hold each beam's first return and
+  // these its last (the same as the first when the beam has one return);
+  // empty without divergence.
+  std::vector<float> last_range_m;
+  std::vector<Eigen::Vector3d> last_points_W;
+  std::vector<std::int32_t> last_surface;
+  std::vector<float> last_intensity;                  // with LidarConfig::intensity
+  bool surface_ids{true};                             // published (LidarConfig::surface_ids)
+  std::vector<double> time_s;                         // per azimuth step, from the sweep's start
   Eigen::Vector3d origin_W{Eigen::Vector3d::Zero()};  // the sensor at the sweep's start
   double sweep_s{0.0};                                // 1 / rotation_hz
   Eigen::Isometry3d X_WS_start{Eigen::Isometry3d::Identity()};
@@ -100,8 +117,13 @@ class Lidar {
              const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3d& X_WS_end,
              LidarScan* scan, std::uint64_t sweep = 0) const;
 
-  // The rays of that sweep (origin_W is the start pose's position).
-  RayBatch Rays(const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3d& X_WS_end) const;
+  // The beams of that sweep (origin_W is the start pose's position), one ray
+  // each; with divergence and `sub_rays`, their sub-rays too: beam i's at
+  // i * rays .. i * rays + rays - 1, sub-ray j turned by half the angle from
+  // the beam towards 2 pi j / rays about it, counted from the beam's rising
+  // elevation towards its rising azimuth.
+  RayBatch Rays(const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3d& X_WS_end,
+                RayBatch* sub_rays = nullptr) const;
 
  private:
   LidarConfig config_;

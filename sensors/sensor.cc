@@ -96,11 +96,13 @@ std::vector<MountedSensor> MakeRobotSensors(const scene::Level& level) {
       scene::SettingsReader read(spec.settings);
       sensor.config = ReadConfig(sensor.kind, read, kAlternatives);
       read.RejectUnknownKeys(spec.type + " sensor");
-      // The config's own checks, named with the sensor.
+      // The config's own checks, named with the sensor, at the line of the
+      // key the message begins with (else the table's).
       try {
         std::visit([](const auto& c) { c.ValidateOrThrow(); }, sensor.config);
       } catch (const std::invalid_argument& error) {
-        throw scene::LevelError(spec.Where() + error.what());
+        const std::string what = error.what();
+        throw scene::LevelError(spec.settings.Where(what.substr(0, what.find(' '))) + what);
       }
       sensors.push_back(std::move(sensor));
     }

@@ -1,16 +1,47 @@
 #include "sensors/render/debug_overlay.h"
 
+#include <cmath>
+
 namespace sandbox::render {
 
-void AddFaceScan(const sensors::FaceScan& scan, double stub_m, Overlay* overlay) {
+Eigen::Vector3f SurfaceColour(std::int32_t id) {
+  if (id == 0) return {0.5f, 0.5f, 0.5f};
+  const double hue = 6.0 * std::fmod(double(id) * 0.6180339887498949, 1.0);
+  const float value = 0.95f, low = value * (1.f - 0.8f);
+  const int sector = int(hue) % 6;
+  const float f = float(hue - std::floor(hue));
+  const float falling = value - (value - low) * f, rising = low + (value - low) * f;
+  switch (sector) {
+    case 0:
+      return {value, rising, low};
+    case 1:
+      return {falling, value, low};
+    case 2:
+      return {low, value, rising};
+    case 3:
+      return {low, falling, value};
+    case 4:
+      return {rising, low, value};
+    default:
+      return {value, low, falling};
+  }
+}
+
+void AddFaceScan(const sensors::FaceScan& scan, double stub_m, Overlay* overlay,
+                 SampleColour colour) {
   const Eigen::Vector3f red(1.f, 0.1f, 0.1f), green(0.1f, 0.9f, 0.1f);
+  const bool by_surface = colour == SampleColour::kSurface;
   for (int f = 0; f < 6; ++f) {
     const sensors::ScanFace& face = scan.faces[std::size_t(f)];
     if (face.tick < 0) continue;
     const Eigen::Vector3d origin_W = face.X_WS.translation();
     for (std::size_t i = 0; i < face.distance_m.size() && i < face.occupancy.size(); ++i) {
       if (face.occupancy[i] == sensors::kUnvisited) continue;
-      const Eigen::Vector3f& rgb = face.occupancy[i] == sensors::kOccupied ? red : green;
+      const bool occupied = face.occupancy[i] == sensors::kOccupied;
+      const Eigen::Vector3f rgb =
+          by_surface ? SurfaceColour(occupied && i < face.surface.size() ? face.surface[i] : 0)
+          : occupied ? red
+                     : green;
       const Eigen::Vector3d p_W = scan.PointW(f, i);
       if (stub_m <= 0.0) {
         overlay->AddPoint(p_W, rgb);

@@ -108,6 +108,13 @@ std::vector<MountedCamera> MakeRobotCameras(const scene::Level& level) {
       if (!(camera.overlay_stub_m >= 0.0 && camera.overlay_stub_m <= 100.0)) {
         throw scene::LevelError(spec.Where() + "overlay_stub_m must be 0 (points) to 100 m");
       }
+      const std::string colour = read.Text("overlay_colour", "occupancy");
+      if (colour != "occupancy" && colour != "surface") {
+        read.Fail("overlay_colour",
+                  "'overlay_colour' must be occupancy or surface, got '" + colour + "'");
+      }
+      camera.overlay_colour =
+          colour == "surface" ? SampleColour::kSurface : SampleColour::kOccupancy;
       // The pixels the camera may have: a documented default, raised to a bound.
       const double pixel_budget =
           read.Number("pixel_budget", double(CameraView::kDefaultPixelBudget));

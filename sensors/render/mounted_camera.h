@@ -11,6 +11,7 @@
 #include "scene/robot_model.h"
 #include "scene/robot_state.h"
 #include "sensors/render/cameras.h"
+#include "sensors/render/debug_overlay.h"
 #include "sensors/render/renderer.h"
 #include "sensors/render/view.h"
 
@@ -37,6 +38,7 @@ struct MountedCamera {
   RenderSettings look;
   bool overlay{false};         // the debug overlay (scanner samples, bone frames, actor bounds)
   double overlay_stub_m{0.0};  // scanner samples as points (0) or stubs this long
+  SampleColour overlay_colour{SampleColour::kOccupancy};  // `overlay_colour`
 
   // The camera pose for a robot state (fixed cameras: their own pose; chase
   // cameras keep their lag in `chase_state`, advanced by dt_s).

@@ -90,6 +90,10 @@ struct Samples {
     lidar.num_surface = 6, lidar.surface.assign(6, 2);
     lidar.num_normal = 18, lidar.normal.assign(18, 0.5f);
     lidar.num_intensity = 6, lidar.intensity.assign(6, 0.25f);
+    lidar.num_last = 6, lidar.last_range_m.assign(6, 11.0f);
+    lidar.num_last_xyz = 18, lidar.last_xyz.assign(18, 0.75f);
+    lidar.num_last_surface = 6, lidar.last_surface.assign(6, 3);
+    lidar.num_last_intensity = 6, lidar.last_intensity.assign(6, 0.125f);
     Add("lidar_scan_t", lidar);
     range_t range{};
     range.sensor = "altimeter", range.range_m = 12.0;

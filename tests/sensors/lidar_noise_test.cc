@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <string>
+#include <tuple>
 
 #include "scene/collision_world.h"
 #include "scene/level.h"
@@ -159,6 +160,74 @@ TEST(LidarNoiseTest, OneSeedGivesTheSameBytesOnAnyThreadsAnotherSeedOtherBytes) 
   EXPECT_NE(first.range_m, other_sweep.range_m);
 }
 
+// A cone of four sub-rays over the edge of a near wall (x = 20, y < -0.2) in
+// front of a far one (x = 40): its first return is the near wall's, its last
+// the far one's, each the mean range and the summed brightness of its
+// sub-rays. Sub-ray j of a beam at azimuth a (elevation 0) is, by the
+// documented cone, at azimuth a + h (j = 1), a - h (j = 3), or at azimuth a
+// and elevation +-h (j = 0, 2); where each meets the walls is plain geometry.
+TEST(LidarNoiseTest, ADivergentBeamOverAnEdgeGivesTheNearFirstAndTheFarLastReturn) {
+  testing::TempDir dir;
+  dir.Write("near.obj",
+            "v 20 -50 -50\nv 20 -0.2 -50\nv 20 -0.2 50\nv 20 -50 50\nf 1 2 3\nf 1 3 4\n");
+  dir.Write("far.obj",
+            "v 40 -200 -200\nv 40 200 -200\nv 40 200 200\nv 40 -200 200\nf 1 2 3\nf 1 3 4\n");
+  const scene::Level level = scene::LoadLevel(
+      dir.Write("level.toml",
+                "[[actor]]\nname = \"near\"\nfile = \"near.obj\"\nreflectivity = 0.5\n"
+                "[[actor]]\nname = \"far\"\nfile = \"far.obj\"\nreflectivity = 0.5\n"));
+  const scene::CollisionWorld world(level);
+  LidarConfig config = LidarConfig::Uniform(1, 0, 0, 3600, 200.0);
+  const double h = 1.0 * M_PI / 180.0;  // half of a 2 degree cone
+  config.divergence.rays = 4;
+  config.divergence.angle_rad = 2.0 * h;
+  RayCaster caster(2);
+  LidarScan scan;
+  Lidar(config).Sweep(world, caster, {}, Isometry3d::Identity(), Isometry3d::Identity(), &scan);
+  ASSERT_EQ(scan.last_range_m.size(), 3600u);
+  int straddling = 0, whole = 0;
+  for (int k = 0; k < 3600; ++k) {
+    const double a = 2.0 * M_PI * k / 3600;
+    if (std::abs(std::remainder(a, 2.0 * M_PI)) > 10.0 * M_PI / 180.0) continue;
+    // Each sub-ray's azimuth and the x of its direction.
+    const double azimuth[4] = {a, a + h, a, a - h};
+    const double x[4] = {std::cos(h) * std::cos(a), std::cos(a + h), std::cos(h) * std::cos(a),
+                         std::cos(a - h)};
+    double sum[2] = {0, 0}, brightness[2] = {0, 0};
+    int count[2] = {0, 0};
+    bool near_edge = false;
+    for (int j = 0; j < 4; ++j) {
+      const double y_at_near = 20.0 * std::tan(azimuth[j]);
+      near_edge |= std::abs(y_at_near + 0.2) < 1e-3;
+      const int wall = y_at_near < -0.2 ? 0 : 1;
+      const double r = (wall == 0 ? 20.0 : 40.0) / x[j];
+      sum[wall] += r, ++count[wall];
+      brightness[wall] += 0.5 * x[j] * std::min(1.0, 100.0 / (r * r)) / 4.0;
+    }
+    if (near_edge) continue;
+    const std::size_t i = std::size_t(k);
+    ASSERT_TRUE(scan.hit[i]) << k;
+    const int first = count[0] > 0 ? 0 : 1, last = count[1] > 0 ? 1 : 0;
+    EXPECT_NEAR(scan.range_m[i], sum[first] / count[first], 1e-4) << k;
+    EXPECT_NEAR(scan.last_range_m[i], sum[last] / count[last], 1e-4) << k;
+    EXPECT_EQ(scan.surface[i], first + 1) << k;  // actor a is surface 1 + a
+    EXPECT_EQ(scan.last_surface[i], last + 1) << k;
+    const double together = brightness[0] + brightness[1];
+    EXPECT_NEAR(scan.intensity[i], first == last ? together : brightness[first], 1e-6) << k;
+    EXPECT_NEAR(scan.last_intensity[i], first == last ? together : brightness[last], 1e-6) << k;
+    // Both returns lie on the beam's axis.
+    EXPECT_NEAR((scan.points_W[i] - scan.range_m[i] * Vector3d(std::cos(a), std::sin(a), 0)).norm(),
+                0.0, 1e-4);
+    EXPECT_NEAR(
+        (scan.last_points_W[i] - scan.last_range_m[i] * Vector3d(std::cos(a), std::sin(a), 0))
+            .norm(),
+        0.0, 1e-4);
+    (first != last ? straddling : whole)++;
+  }
+  EXPECT_GE(straddling, 15);  // 2 degrees of 0.1 degree steps, minus the edge's own
+  EXPECT_GT(whole, 150);
+}
+
 TEST(LidarNoiseTest, BadSettingsAreRefusedAtLoadNamingTheLineAndField) {
   testing::TempDir dir;
   dir.Write("wall.obj", "v 20 -2 -2\nv 20 2 -2\nv 20 2 2\nf 1 2 3\n");
@@ -177,12 +246,18 @@ TEST(LidarNoiseTest, BadSettingsAreRefusedAtLoadNamingTheLineAndField) {
   const std::string robot = "[[robot]]\nname = \"W\"\nfile = \"" + std::string(SANDBOX_SOURCE_DIR) +
                             "/assets/robots/generated/flying_wing.gltf\"\nbones = [\"root\"]\n"
                             "[[robot.sensor]]\nname = \"l\"\ntype = \"lidar\"\n";
-  for (const auto& [line, field] : {std::pair{"dropout_probability = 1.5", "dropout_probability"},
-                                    {"range_noise_sigma_m = -0.1", "range_noise_sigma_m"},
-                                    {"dropout_below_intensity = -1", "dropout_below_intensity"},
-                                    {"min_range_m = -2", "min_range_m"}}) {
+  // The key's own line (the sensor table's keys start at line 8), or the
+  // table's (line 5) for a key that is missing.
+  for (const auto& [line, field, at] :
+       {std::tuple{"dropout_probability = 1.5", "dropout_probability", 8},
+        {"range_noise_sigma_m = -0.1", "range_noise_sigma_m", 8},
+        {"dropout_below_intensity = -1", "dropout_below_intensity", 8},
+        {"min_range_m = -2", "min_range_m", 8},
+        {"divergence_rays = 1\ndivergence_deg = 0.2", "divergence_rays", 8},
+        {"divergence_rays = 4\ndivergence_deg = 0", "divergence_deg", 9},
+        {"divergence_rays = 4", "divergence_deg", 5}}) {
     const std::string error = error_of(robot + line + "\n");
-    EXPECT_NE(error.find("level.toml:"), std::string::npos) << error;
+    EXPECT_NE(error.find("level.toml:" + std::to_string(at) + ": "), std::string::npos) << error;
     EXPECT_NE(error.find(field), std::string::npos) << error;
   }
 }

@@ -16,6 +16,7 @@
 #include <opencv2/imgproc.hpp>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include "app/images.h"
 #include "assets/generators/sample_terrain.h"
@@ -196,6 +197,62 @@ TEST_F(RendererTest, OverlayMarksEachScannedSampleInItsColourWithoutTouchingDept
       << right[0] << " of " << checked[0] << " free samples green";
   EXPECT_GT(right[1], 0.95 * checked[1])
       << right[1] << " of " << checked[1] << " occupied samples red";
+}
+
+// Coloured by surface id, each visible occupied sample shows its id's colour
+// (SurfaceColour) and the free ones grey; samples on two surfaces differ.
+TEST_F(RendererTest, OverlayByIdShowsEachSampleInItsSurfaceColour) {
+  const scene::CollisionWorld world(level_);
+  sensors::RayCaster caster(1);
+  sensors::FaceScannerConfig config;
+  config.resolution_m = 2.0;
+  config.refresh = sensors::Refresh::kFull;
+  const sensors::FaceScanner scanner(config);
+  sensors::FaceScan scan = scanner.EmptyScan();
+  // Beside the tower: the scan meets the terrain and the tower.
+  const Vector3d at(-20, 35, 14);
+  scanner.Scan(world, caster, {}, Isometry3d(Eigen::Translation3d(at)), 0, &scan);
+  Overlay overlay;
+  AddFaceScan(scan, 0.0, &overlay, SampleColour::kSurface);
+  std::set<std::int32_t> ids;
+  for (const sensors::ScanFace& face : scan.faces)
+    ids.insert(face.surface.begin(), face.surface.end());
+  ids.erase(0);
+  ASSERT_EQ(ids.size(), 2u);  // actors 0 and 1: ids 1 and 2
+  std::set<std::tuple<float, float, float>> colours;
+  for (const std::int32_t id : ids) {
+    const Eigen::Vector3f c = SurfaceColour(id);
+    colours.insert({c.x(), c.y(), c.z()});
+  }
+  EXPECT_EQ(colours.size(), ids.size());
+  // The samples' colours: those of the ids the scan met, and grey (free).
+  std::set<std::tuple<float, float, float>> drawn;
+  for (const Eigen::Vector3f& c : overlay.point_rgb) drawn.insert({c.x(), c.y(), c.z()});
+  colours.insert({0.5f, 0.5f, 0.5f});
+  EXPECT_EQ(drawn, colours);
+  CameraView view;
+  view.X_WC = LookAt(at + Vector3d(0, -70, 33), at + Vector3d(0, 0, -7));
+  Frame plain, marked;
+  renderer_->Render(view, {}, {}, {}, &plain);
+  renderer_->Render(view, {}, {}, {}, &marked, &overlay);
+  int checked = 0, right = 0;
+  for (std::size_t i = 0; i < overlay.points_W.size(); ++i) {
+    const Eigen::Vector2d pixel = Project(view, overlay.points_W[i]);
+    const double along = (view.X_WC.inverse() * overlay.points_W[i]).x();
+    const int column = int(std::floor(pixel.x())), row = int(std::floor(pixel.y()));
+    if (along <= 0 || column < 2 || row < 2 || column >= view.width - 2 || row >= view.height - 2)
+      continue;
+    const float depth =
+        plain.depth_m[std::size_t(row) * std::size_t(view.width) + std::size_t(column)];
+    if (along > depth * 1.001 + 0.05) continue;
+    const std::uint8_t* rgb = Pixel(marked, column, row);
+    bool near = true;
+    for (int k = 0; k < 3; ++k) near &= std::abs(rgb[k] - 255.f * overlay.point_rgb[i][k]) < 40.f;
+    ++checked;
+    right += near;
+  }
+  EXPECT_GT(checked, 500);
+  EXPECT_GT(right, 0.95 * checked) << right << " of " << checked << " samples in their colour";
 }
 
 TEST(DebugOverlayTest, ActorBoundsFollowTheActorAndStubsPointBackAlongTheRay) {
