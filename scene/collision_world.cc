@@ -46,7 +46,10 @@ CollisionWorld::CollisionWorld(const Level& level) : impl_(std::make_unique<Impl
     actor_names_.push_back(actor.name);
     if (!actor.collision) continue;
     std::vector<MeshArrays> meshes;
-    for (const Mesh& mesh : actor.meshes) meshes.push_back({&mesh.positions_A, &mesh.indices});
+    for (const Mesh& mesh : actor.meshes) {
+      meshes.push_back(
+          {&mesh.positions_A, &mesh.indices, MeshReflectivity(actor, mesh, level.materials)});
+    }
     w.AddBody(static_cast<int>(a), w.surface_ids->actor(static_cast<int>(a)), meshes,
               static_cast<int>(actor.movable ? kWorldMovable : kWorldStatic));
     w.Place(static_cast<int>(a), p_WO_);
@@ -81,8 +84,10 @@ CollisionWorld::CollisionWorld(const Level& level) : impl_(std::make_unique<Impl
     const std::vector<int> bone_of_node = BoneGroupOfNodes(model);
     for (auto& [node, piece] : pieces) {
       const int bone = node >= 0 ? bone_of_node[static_cast<std::size_t>(node)] : 0;
-      w.AddBody(body, w.surface_ids->bone(static_cast<int>(r), bone),
-                {{&piece->positions, &piece->indices}}, static_cast<int>(kRobot),
+      const std::int32_t surface = w.surface_ids->bone(static_cast<int>(r), bone);
+      w.AddBody(body, surface,
+                {{&piece->positions, &piece->indices, w.surface_ids->reflectivity(surface)}},
+                static_cast<int>(kRobot),
                 RigidPart(rest.node_poses_B()[static_cast<std::size_t>(node)]));
       w.robot_pieces[r].push_back(std::move(piece));
     }
@@ -124,6 +129,7 @@ void CollisionWorld::Impl::MergeStatic(const Eigen::Vector3d& p_WO) {
                        reinterpret_cast<const std::uint32_t*>(part.m_triangleIndexBase),
                        std::size_t(part.m_numTriangles)});
       merged_static.surface_of_part.push_back(object->surface);
+      merged_static.reflectivity_of_part.push_back(object->reflectivity_of_part[std::size_t(k)]);
     }
     merged_static.holds_actor[std::size_t(body)] = true;
     object->merged = true;
@@ -238,6 +244,8 @@ void CollisionWorld::AddTile(std::shared_ptr<PreparedTile> tile) {
     object.object->setUserIndex(w.terrain_actor);
     object.object->setUserIndex2(known->second);
     object.surface = known->second;
+    std::fill(object.reflectivity_of_part.begin(), object.reflectivity_of_part.end(),
+              w.surface_ids->reflectivity(known->second));
     w.Add(std::move(object), static_cast<int>(kWorldStatic));
   }
   w.tiles[key + 1] = tile->tile;

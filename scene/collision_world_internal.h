@@ -41,6 +41,7 @@ inline btTransform ToBulletTransform(const Eigen::Isometry3d& X, const Eigen::Ve
 struct MeshArrays {
   const std::vector<Eigen::Vector3f>* positions;
   const std::vector<std::uint32_t>* indices;
+  float reflectivity{SurfaceEntry::kDefaultReflectivity};  // scene::MeshReflectivity
 };
 
 // One Bullet object: a shape over at most kMaxPartsPerShape mesh parts, and
@@ -54,6 +55,7 @@ struct MeshObject {
   std::uint64_t tile{0};    // a terrain tile's key (TileId::key() + 1), 0 for the rest
   std::int32_t surface{0};  // its surface id (scene/surface_ids.h; also Bullet's user index 2)
   bool merged{false};       // its triangles are in CollisionWorld::Impl::merged_static too
+  std::vector<float> reflectivity_of_part;  // by mesh part: what a lidar sees of it
 };
 
 // One hierarchy over the triangles of the static actors' objects (not the
@@ -61,10 +63,12 @@ struct MeshObject {
 // p_WO: a ray walks one tree instead of one per object, nearest first across
 // them all (the objects of a game level overlap: those of the Quake 3 map of
 // ../shared/assets, 61, cover each other's boxes). Leaf lanes name their
-// triangle's part, surface_of_part its surface id (an actor's).
+// triangle's part, surface_of_part its surface id (an actor's) and
+// reflectivity_of_part what a lidar sees of it.
 struct MergedStatic {
   std::shared_ptr<const TriangleBvh> bvh;
   std::vector<std::int32_t> surface_of_part;
+  std::vector<float> reflectivity_of_part;
   std::vector<bool> holds_actor;  // by actor
   Eigen::Vector3d p_WO{Eigen::Vector3d::Zero()};
 };
@@ -168,6 +172,7 @@ struct CollisionWorld::Impl {
                                              const Eigen::Isometry3d& X_BO) {
     std::vector<MeshObject> made;
     std::vector<btIndexedMesh> parts;
+    std::vector<float> reflectivity;  // by part
     for (const MeshArrays& mesh : meshes) {
       const std::size_t triangles = mesh.indices->size() / 3;
       for (std::size_t first = 0; first < triangles; first += kMaxTrianglesPerPart) {
@@ -182,6 +187,7 @@ struct CollisionWorld::Impl {
         part.m_vertexStride = sizeof(Eigen::Vector3f);
         part.m_vertexType = PHY_FLOAT;
         parts.push_back(part);
+        reflectivity.push_back(mesh.reflectivity);
       }
     }
     for (std::size_t first = 0; first < parts.size(); first += kMaxPartsPerShape) {
@@ -189,6 +195,8 @@ struct CollisionWorld::Impl {
       object.mesh_interface = std::make_unique<btTriangleIndexVertexArray>();
       const std::size_t end = std::min(parts.size(), first + kMaxPartsPerShape);
       std::vector<TriangleSoup> soups;
+      object.reflectivity_of_part.assign(reflectivity.begin() + std::ptrdiff_t(first),
+                                         reflectivity.begin() + std::ptrdiff_t(end));
       for (std::size_t p = first; p < end; ++p) {
         object.mesh_interface->addIndexedMesh(parts[p]);
         soups.push_back({reinterpret_cast<const Eigen::Vector3f*>(parts[p].m_vertexBase),

@@ -2,6 +2,7 @@
 
 #include <map>
 #include <numeric>
+#include <set>
 #include <sstream>
 
 #include "scene/asset_import.h"
@@ -43,6 +44,26 @@ void CheckTriangles(const fs::path& file, const Level& level) {
   for (const RobotModel& robot : level.robots) triangles += robot.num_triangles();
   LoadLimits::Check(file, "the level has " + std::to_string(triangles) + " triangles", triangles,
                     level.limits.max_triangles, "max_triangles");
+}
+
+// Every material `material_reflectivity` names is one of the actor's.
+void CheckMaterialNames(const fs::path& file, const ActorSpec& spec, const Actor& actor,
+                        const std::vector<Material>& materials) {
+  std::set<std::string> names;
+  for (const Mesh& mesh : actor.meshes) {
+    if (mesh.material >= 0 && std::size_t(mesh.material) < materials.size()) {
+      names.insert(materials[std::size_t(mesh.material)].name);
+    }
+  }
+  for (const auto& [name, value] : spec.material_reflectivity) {
+    if (names.count(name) != 0) continue;
+    std::string have;
+    for (const std::string& n : names) have += (have.empty() ? "'" : ", '") + n + "'";
+    throw LevelError(file.string() + ":" + std::to_string(spec.material_reflectivity_line) +
+                     ": actor '" + spec.name + "': 'material_reflectivity' names '" + name +
+                     "', which is not a material of " + spec.file.filename().string() + " (" +
+                     (have.empty() ? "it has none" : "it has " + have) + ")");
+  }
 }
 
 void Reading(const LoadOptions& options, const fs::path& file, std::string_view reader) {
@@ -124,6 +145,7 @@ Level LoadManifest(const fs::path& file, const LoadOptions& options) {
     actor.movable = spec.movable;
     actor.surface = spec.surface;
     actor.reflectivity = spec.reflectivity;
+    actor.material_reflectivity = spec.material_reflectivity;
     actor.X_WA = spec.placement.pose();
     for (const ImportedNode& node : asset.nodes) {
       const Eigen::Affine3d X_AN = Eigen::Scaling(spec.placement.scale) * node.X_RN;
@@ -132,6 +154,7 @@ Level LoadManifest(const fs::path& file, const LoadOptions& options) {
         TransformMesh(X_AN, &actor.meshes.back());
       }
     }
+    CheckMaterialNames(file, spec, actor, level.materials);
     level.actors.push_back(std::move(actor));
     CheckTriangles(spec.file, level);
   }

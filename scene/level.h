@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -33,6 +34,9 @@ struct Actor {
   // What a lidar sees of it (its intensity law, docs/reference/sensors.md);
   // none: derived from its materials' base colours (scene::SurfaceIds).
   std::optional<double> reflectivity;
+  // Per material (by name), over `reflectivity`: what a lidar sees of the
+  // triangles of that material (scene::MeshReflectivity).
+  std::map<std::string, double> material_reflectivity;
   std::vector<Mesh> meshes;      // in frame A
   Eigen::AlignedBox3d bounds_W;  // exact bounds of the meshes at X_WA; empty without meshes
 

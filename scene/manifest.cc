@@ -228,6 +228,20 @@ ActorSpec ParseActor(const fs::path& file, const toml::table& table, int index) 
     }
     actor.reflectivity = *reflectivity;
   }
+  if (const toml::node* by_material = read.Find("material_reflectivity")) {
+    if (!by_material->is_table()) {
+      read.Fail(by_material, "'material_reflectivity' must be a table: { material = 0..1, ... }");
+    }
+    actor.material_reflectivity_line = static_cast<int>(by_material->source().begin.line);
+    for (const auto& [key, value] : *by_material->as_table()) {
+      const std::string material(key.str());
+      const double r = read.Number(&value, "material_reflectivity." + material);
+      if (!(r >= 0.0 && r <= 1.0)) {
+        read.Fail(&value, "'material_reflectivity." + material + "' must be 0 to 1");
+      }
+      actor.material_reflectivity[material] = r;
+    }
+  }
   read.RejectUnknownKeys("[[actor]]");
   return actor;
 }

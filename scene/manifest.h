@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -27,7 +28,10 @@ struct ActorSpec {
   bool movable{false};
   std::optional<Surface> surface;      // `surface = "plain" | "terrain" | "water"`
   std::optional<double> reflectivity;  // `reflectivity = 0..1` (the lidar's intensity)
-  int line{0};                         // where the table starts, for messages
+  // `material_reflectivity = { name = 0..1, ... }`: by material name, and the line.
+  std::map<std::string, double> material_reflectivity;
+  int material_reflectivity_line{0};
+  int line{0};  // where the table starts, for messages
 };
 
 // The [horizon] table: the ground beyond the level, drawn to the horizon.

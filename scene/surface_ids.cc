@@ -12,22 +12,51 @@ float Linear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f
 
 }  // namespace
 
-float DerivedReflectivity(const std::vector<const Mesh*>& meshes,
-                          const std::vector<Material>& materials) {
+namespace {
+
+const Material& MaterialOf(const Mesh& mesh, const std::vector<Material>& materials) {
+  static const Material plain;
+  return mesh.material >= 0 && std::size_t(mesh.material) < materials.size()
+             ? materials[std::size_t(mesh.material)]
+             : plain;
+}
+
+// The triangle-weighted mean of of(mesh) over `meshes`; 0.5 without triangles.
+template <typename Of>
+float TriangleMean(const std::vector<const Mesh*>& meshes, Of of) {
   double sum = 0.0, triangles = 0.0;
-  const Material plain;
   for (const Mesh* mesh : meshes) {
-    const Material& m = mesh->material >= 0 && std::size_t(mesh->material) < materials.size()
-                            ? materials[std::size_t(mesh->material)]
-                            : plain;
-    Eigen::Vector3f rgb = m.base_color.head<3>().cwiseMax(0.f).cwiseMin(1.f);
-    if (!m.linear_color) rgb = {Linear(rgb.x()), Linear(rgb.y()), Linear(rgb.z())};
-    double y = 0.2126 * rgb.x() + 0.7152 * rgb.y() + 0.0722 * rgb.z();
-    if (!m.base_color_texture_path.empty() || m.base_color_texture_embedded >= 0) y *= 0.5;
     const double n = double(mesh->num_triangles());
-    sum += y * n, triangles += n;
+    sum += double(of(*mesh)) * n, triangles += n;
   }
   return triangles > 0.0 ? float(sum / triangles) : SurfaceEntry::kDefaultReflectivity;
+}
+
+}  // namespace
+
+float MaterialReflectivity(const Material& m) {
+  Eigen::Vector3f rgb = m.base_color.head<3>().cwiseMax(0.f).cwiseMin(1.f);
+  if (!m.linear_color) rgb = {Linear(rgb.x()), Linear(rgb.y()), Linear(rgb.z())};
+  double y = 0.2126 * rgb.x() + 0.7152 * rgb.y() + 0.0722 * rgb.z();
+  if (!m.base_color_texture_path.empty() || m.base_color_texture_embedded >= 0) y *= 0.5;
+  return float(y);
+}
+
+float MeshReflectivity(const Actor& actor, const Mesh& mesh,
+                       const std::vector<Material>& materials) {
+  const Material& material = MaterialOf(mesh, materials);
+  if (mesh.material >= 0) {
+    const auto entry = actor.material_reflectivity.find(material.name);
+    if (entry != actor.material_reflectivity.end()) return float(entry->second);
+  }
+  if (actor.reflectivity) return float(*actor.reflectivity);
+  return MaterialReflectivity(material);
+}
+
+float DerivedReflectivity(const std::vector<const Mesh*>& meshes,
+                          const std::vector<Material>& materials) {
+  return TriangleMean(
+      meshes, [&](const Mesh& mesh) { return MaterialReflectivity(MaterialOf(mesh, materials)); });
 }
 
 SurfaceIds::SurfaceIds(const Level& level) {
@@ -36,13 +65,13 @@ SurfaceIds::SurfaceIds(const Level& level) {
     SurfaceEntry entry;
     entry.id = actor(int(a)), entry.kind = "actor", entry.name = source.name;
     entry.actor = int(a);
-    if (source.reflectivity) {
-      entry.reflectivity = float(*source.reflectivity);
-    } else {
-      std::vector<const Mesh*> meshes;
-      for (const Mesh& mesh : source.meshes) meshes.push_back(&mesh);
-      entry.reflectivity = DerivedReflectivity(meshes, level.materials);
-    }
+    std::vector<const Mesh*> meshes;
+    for (const Mesh& mesh : source.meshes) meshes.push_back(&mesh);
+    entry.reflectivity = meshes.empty() && source.reflectivity
+                             ? float(*source.reflectivity)
+                             : TriangleMean(meshes, [&](const Mesh& mesh) {
+                                 return MeshReflectivity(source, mesh, level.materials);
+                               });
     entries_.push_back(std::move(entry));
   }
   horizon_ = std::int32_t(level.actors.size() + 1);

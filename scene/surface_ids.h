@@ -28,16 +28,27 @@ struct SurfaceEntry {
   int bone{-1};            // the robot's bone map entry, or -1
   std::string bone_name;   // that bone's name, or ""
   // What a lidar sees of it, 0 to 1 (docs/reference/sensors.md, "Intensity"):
-  // an actor's `reflectivity`, else DerivedReflectivity of its meshes; a
-  // robot's of its meshes; a tile's its terrain actor's.
+  // an actor's MeshReflectivity averaged over its triangles (a hit takes its
+  // own mesh's: RayHits::reflectivity); a robot's DerivedReflectivity of its
+  // meshes; a tile's its terrain actor's.
   static constexpr float kDefaultReflectivity = 0.5f;
   float reflectivity{kDefaultReflectivity};
 };
 
-// A surface's reflectivity from its meshes' materials: the luminance of the
-// base colour (linear light, Rec. 709 weights), halved for a material whose
-// colour a texture modulates (a texture's mean is taken as mid-grey: it is not
-// decoded at load), averaged over the triangles; 0.5 without meshes.
+// A material's reflectivity: the luminance of its base colour (linear light,
+// Rec. 709 weights), halved when a texture modulates the colour (a texture's
+// mean is taken as mid-grey: it is not decoded at load).
+float MaterialReflectivity(const Material& material);
+
+// What a lidar sees of a mesh of `actor`: its material's entry in the
+// actor's material_reflectivity, else the actor's reflectivity, else
+// MaterialReflectivity of its material (a mesh without one: the default
+// material's).
+float MeshReflectivity(const Actor& actor, const Mesh& mesh,
+                       const std::vector<Material>& materials);
+
+// A surface's reflectivity from its meshes' materials: MaterialReflectivity
+// averaged over the triangles; 0.5 without meshes.
 float DerivedReflectivity(const std::vector<const Mesh*>& meshes,
                           const std::vector<Material>& materials);
 

@@ -201,6 +201,7 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
   const LidarConfig::Noise& noise = config_.noise;
   const bool intensity = config_.intensity || noise.dropout_below_intensity > 0.0;
   hits.with_normals = config_.normals || intensity;
+  hits.with_reflectivity = intensity;
   caster.Cast(world, rays, filter, &hits);
   const std::size_t n = beams.size(), lasts = divergence.on() ? n : 0;
   scan->channels = config_.channels();
@@ -220,7 +221,6 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
   const std::uint64_t sweep_key = Mix(Mix(noise.seed) ^ sweep);
   const float range = static_cast<float>(config_.range_m);
   const double reference2 = config_.intensity_reference_m * config_.intensity_reference_m;
-  const scene::SurfaceIds& ids = world.surface_ids();
 
   // Ray q's hit as a return (its brightness: "Intensity").
   auto hit_of = [&](std::size_t q) {
@@ -233,7 +233,7 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
       const double cosine = -double(hit.normal.dot(rays.direction[q]));
       const double r = hit.range_m;
       const double falloff = r > 0.0 ? std::min(1.0, reference2 / (r * r)) : 1.0;
-      hit.brightness = float(ids.reflectivity(hit.surface) * std::max(0.0, cosine) * falloff);
+      hit.brightness = float(double(hits.reflectivity[q]) * std::max(0.0, cosine) * falloff);
     }
     return hit;
   };

@@ -124,12 +124,14 @@ struct Packet16 {
   __mmask16 active;  // lanes that hold a ray
   // Each lane's nearest hit so far: its surface and normal (Bullet frame, unnormalised).
   alignas(64) std::int32_t surface[16];
+  alignas(64) float reflectivity[16];  // Target::ReflectivityOf the part hit
   alignas(64) float normal[3][16];
 };
 
-// HitLanes16 for the packet's lanes against one triangle (corners in the Bullet frame).
-inline void HitCorners16(const Eigen::Vector3f corner[3], int surface_id, Packet16* packet,
-                         __mmask16 lanes, __m512* t_max) {
+// HitLanes16 for the packet's lanes against one triangle (corners in the
+// Bullet frame) of `part` of `target`.
+inline void HitCorners16(const Eigen::Vector3f corner[3], int surface_id, const Target& target,
+                         int part, Packet16* packet, __mmask16 lanes, __m512* t_max) {
   V16 c[3];
   for (int k = 0; k < 3; ++k) c[k] = {Set(corner[k].x()), Set(corner[k].y()), Set(corner[k].z())};
   V16 n;
@@ -139,6 +141,7 @@ inline void HitCorners16(const Eigen::Vector3f corner[3], int surface_id, Packet
       HitLanes16(c, packet->o, packet->d, packet->box_inverse, lanes, ties, t_max, &n);
   if (hit == 0) return;
   _mm512_mask_store_epi32(packet->surface, hit, _mm512_set1_epi32(surface_id));
+  _mm512_mask_store_ps(packet->reflectivity, hit, Set(target.ReflectivityOf(part)));
   _mm512_mask_store_ps(packet->normal[0], hit, n.x);
   _mm512_mask_store_ps(packet->normal[1], hit, n.y);
   _mm512_mask_store_ps(packet->normal[2], hit, n.z);
@@ -269,7 +272,8 @@ void WalkWide16(const Target& target, const __m512 inverse_B[3], Packet16* packe
       for (int i = 0; i < leaf.count; ++i) {
         Eigen::Vector3f corner[3];
         LeafCorners(target, leaf, i, corner);
-        HitCorners16(corner, target.SurfaceOf(leaf.part[i]), packet, lanes, &t_max);
+        HitCorners16(corner, target.SurfaceOf(leaf.part[i]), target, leaf.part[i], packet, lanes,
+                     &t_max);
       }
       continue;
     }
@@ -360,7 +364,8 @@ void CastRays(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t
           return MeetsBox16(packet, inverse, lo, hi);
         },
         [&](const Target& target) { WalkWide16(target, inverse, &packet); });
-    if (full && !hits->with_normals) {  // WriteHit's two stores, sixteen at once
+    if (full && !hits->with_normals &&
+        !hits->with_reflectivity) {  // WriteHit's two stores, sixteen at once
       _mm512_storeu_ps(&hits->distance_m[i], packet.t_max);
       _mm512_storeu_si512(&hits->surface[i], _mm512_load_si512(packet.surface));
       continue;
@@ -370,7 +375,8 @@ void CastRays(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t
     for (int l = 0; l < 16 && i + std::size_t(l) < end; ++l) {
       const std::size_t r = i + std::size_t(l);
       const Eigen::Vector3f normal(packet.normal[0][l], packet.normal[1][l], packet.normal[2][l]);
-      WriteHit(r, t_max[l], packet.surface[l], normal, rays.direction[r], hits);
+      WriteHit(r, t_max[l], packet.surface[l], packet.reflectivity[l], normal, rays.direction[r],
+               hits);
     }
   }
 }

@@ -50,6 +50,7 @@ struct Packet {
   __m128 t_max;                   // per lane
   __m128 active;                  // all bits set in lanes that hold a ray
   int surface[4];
+  float reflectivity[4];      // Target::ReflectivityOf the part hit
   Eigen::Vector3f normal[4];  // in the Bullet frame, unnormalised
 };
 
@@ -143,11 +144,13 @@ inline __m128 HitLanes4(const Vec4 c[3], const Vec4& o, const Vec4& d, __m128 la
   return hit;
 }
 
-// HitLanes4 for four rays against one triangle: the lanes it hits take its
-// distance, `surface_id` and its (unnormalised) normal.
-inline void HitCorners4(const Eigen::Vector3f corner[3], int surface_id, const Vec4& o,
-                        const Vec4& d, __m128 lanes, __m128* t_max, int surface[4],
-                        Eigen::Vector3f normal[4]) {
+// HitLanes4 for four rays against one triangle (of `part` of `target`): the
+// lanes it hits take its distance, `surface_id`, reflectivity and its
+// (unnormalised) normal.
+inline void HitCorners4(const Eigen::Vector3f corner[3], int surface_id, const Target& target,
+                        int part, const Vec4& o, const Vec4& d, __m128 lanes, __m128* t_max,
+                        Packet* packet) {
+  int* surface = packet->surface;
   Vec4 c[3];
   for (int k = 0; k < 3; ++k) {
     c[k] = {_mm_set1_ps(corner[k].x()), _mm_set1_ps(corner[k].y()), _mm_set1_ps(corner[k].z())};
@@ -159,10 +162,12 @@ inline void HitCorners4(const Eigen::Vector3f corner[3], int surface_id, const V
   if (mask == 0) return;
   alignas(16) float nx[4], ny[4], nz[4];
   _mm_store_ps(nx, n.x), _mm_store_ps(ny, n.y), _mm_store_ps(nz, n.z);
+  const float reflectivity = target.ReflectivityOf(part);
   for (int lane = 0; lane < 4; ++lane) {
     if (mask & (1 << lane)) {
       surface[lane] = surface_id;
-      normal[lane] = Eigen::Vector3f(nx[lane], ny[lane], nz[lane]);
+      packet->reflectivity[lane] = reflectivity;
+      packet->normal[lane] = Eigen::Vector3f(nx[lane], ny[lane], nz[lane]);
     }
   }
 }
@@ -215,8 +220,8 @@ void WalkWide4(const Target& target, Packet* packet) {
       for (int i = 0; i < leaf.count; ++i) {
         Eigen::Vector3f corner[3];
         LeafCorners(target, leaf, i, corner);
-        HitCorners4(corner, target.SurfaceOf(leaf.part[i]), o_B, d_B, lanes, &t_max,
-                    packet->surface, packet->normal);
+        HitCorners4(corner, target.SurfaceOf(leaf.part[i]), target, leaf.part[i], o_B, d_B, lanes,
+                    &t_max, packet);
       }
       continue;
     }
@@ -374,7 +379,8 @@ void CastRays(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t
     _mm_store_ps(t_max, packet.t_max);
     for (int l = 0; l < 4 && i + std::size_t(l) < end; ++l) {
       const std::size_t r = i + std::size_t(l);
-      WriteHit(r, t_max[l], packet.surface[l], packet.normal[l], rays.direction[r], hits);
+      WriteHit(r, t_max[l], packet.surface[l], packet.reflectivity[l], packet.normal[l],
+               rays.direction[r], hits);
     }
   }
 }

@@ -61,6 +61,7 @@ const RayKernel& ChosenKernel() {
 void SizeHits(std::size_t n, RayHits* hits) {
   hits->distance_m.resize(n);
   if (hits->with_normals) hits->normal_W.resize(n);
+  if (hits->with_reflectivity) hits->reflectivity.resize(n);
   hits->surface.resize(n);
 }
 
@@ -569,6 +570,9 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
                           RayHits* hits) {
   const std::size_t n = rays.size();
   CheckGrids(grids, n);
+  if (hits->with_reflectivity) {
+    throw std::invalid_argument("RayCaster::CastGrids(): with_reflectivity is Cast()'s only");
+  }
   rays_cast_ += std::int64_t(n);
   SizeHits(n, hits);
   if (n == 0) return;

@@ -73,6 +73,10 @@ struct RayHits {
   std::vector<float> distance_m;
   std::vector<Eigen::Vector3f> normal_W;  // unit, facing the ray; zero without a hit
   std::vector<std::int32_t> surface;
+  // With with_reflectivity (Cast() only): what a lidar sees of the hit
+  // triangle's mesh (scene::MeshReflectivity), 0 to 1; 0 without a hit.
+  std::vector<float> reflectivity;
+  bool with_reflectivity{false};
   // False: normal_W is left as it was, not read (a caller that needs no
   // normals saves a square root and a division a hit, and 12 bytes a ray).
   bool with_normals{true};
@@ -107,8 +111,9 @@ class RayCaster {
   // the same rays hit, at the same distances (Cast()'s arithmetic; see
   // docs/reference/sensors.md for the one difference a tie can make) when the batch's
   // rays run along their block's direction for its length. Throws
-  // std::invalid_argument when the blocks do not cover the batch in order or
-  // a block's direction is not unit or its length not positive.
+  // std::invalid_argument when the blocks do not cover the batch in order,
+  // a block's direction is not unit or its length not positive, or hits ask
+  // for reflectivity.
   void CastGrids(const scene::CollisionWorld& world, const RayBatch& rays,
                  const std::vector<RayGrid>& grids, const RayFilter& filter, RayHits* hits);
 

@@ -81,12 +81,16 @@ static inline void FacingUnits(const std::int32_t* surface, std::size_t count,
   }
 }
 
-// Ray r's result: its distance, the surface hit and, when asked for, the
-// unit normal facing the ray (zero without a hit).
-static inline void WriteHit(std::size_t r, float t, int surface, const Eigen::Vector3f& normal,
-                            const Eigen::Vector3f& direction, RayHits* hits) {
+// Ray r's result: its distance, the surface hit and, when asked for, its
+// reflectivity and the unit normal facing the ray (zero without a hit).
+static inline void WriteHit(std::size_t r, float t, int surface, float reflectivity,
+                            const Eigen::Vector3f& normal, const Eigen::Vector3f& direction,
+                            RayHits* hits) {
   hits->distance_m[r] = t;
   hits->surface[r] = surface;
+  if (hits->with_reflectivity) {
+    hits->reflectivity[r] = surface == RayHits::kNoHit ? 0.f : reflectivity;
+  }
   if (!hits->with_normals) return;
   if (surface == RayHits::kNoHit) {
     hits->normal_W[r].setZero();

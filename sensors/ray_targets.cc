@@ -28,6 +28,7 @@ Target MergedTarget(const scene::CollisionWorld& world) {
   t.group = scene::kWorldStatic;
   t.bvh = merged.bvh.get();
   t.surface_of_part = merged.surface_of_part.data();
+  t.reflectivity_of_part = merged.reflectivity_of_part.data();
   const btVector3 offset = scene::ToBullet(merged.p_WO - world.origin());
   t.X_BL.setIdentity();
   t.X_BL.setOrigin(offset);
@@ -49,6 +50,7 @@ std::vector<Target> CollectTargets(const scene::CollisionWorld& world) {
     Target t;
     t.body = o.getUserIndex();
     t.surface = object.surface;
+    t.reflectivity_of_part = object.reflectivity_of_part.data();
     t.group = static_cast<std::uint32_t>(o.getBroadphaseHandle()->m_collisionFilterGroup);
     t.aabb_min = ToEigen(o.getBroadphaseHandle()->m_aabbMin);
     t.aabb_max = ToEigen(o.getBroadphaseHandle()->m_aabbMax);

@@ -40,6 +40,13 @@ struct Target {
   int SurfaceOf(int part) const {
     return surface_of_part != nullptr ? surface_of_part[part] : surface;
   }
+  // What a lidar sees of each part (scene::MeshReflectivity: a part is one
+  // mesh, of one material); read at a hit only.
+  const float* reflectivity_of_part{nullptr};
+  float ReflectivityOf(int part) const {
+    return reflectivity_of_part != nullptr ? reflectivity_of_part[part]
+                                           : scene::SurfaceEntry::kDefaultReflectivity;
+  }
 };
 
 inline Eigen::Vector3f ToEigen(const btVector3& v) {

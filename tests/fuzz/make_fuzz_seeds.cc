@@ -226,6 +226,14 @@ void ManifestSeeds(const fs::path& dir, const fs::path& source) {
         "[level]\nname = \"l\"\nmax_triangles = 100\nmax_file_mb = 1\n"
         "[[actor]]\nname = \"a\"\nheightmap = \"h.png\"\nsize = [1, 2, 3]\n"
         "quaternion_wxyz = [1, 0, 0, 0]\nscale = [1, 2, 3]\nup = \"y\"\nunit_scale = 0.01\n");
+  Write(dir / "reflectivity.toml",
+        "[[actor]]\nname = \"w\"\nfile = \"w.obj\"\nreflectivity = 0.4\n"
+        "material_reflectivity = { Rock = 0.2, \"Snow 1\" = 0.9 }\n"
+        "[[robot]]\nname = \"R\"\nfile = \"r.gltf\"\n[[robot.sensor]]\nname = \"l\"\n"
+        "type = \"lidar\"\ndivergence_deg = 0.5\ndivergence_rays = 6\nreturn_separation_m = 1\n"
+        "range_noise_sigma_m = 0.02\ndropout_probability = 0.1\nseed = 3\n"
+        "[[robot.camera]]\nname = \"c\"\ntype = \"chase\"\noverlay = true\n"
+        "overlay_colour = \"surface\"\n");
 }
 
 // A small GeoTIFF in WGS84 near (lon 8, lat 46), as bytes: `bands` of

@@ -160,6 +160,77 @@ TEST(LidarNoiseTest, OneSeedGivesTheSameBytesOnAnyThreadsAnotherSeedOtherBytes) 
   EXPECT_NE(first.range_m, other_sweep.range_m);
 }
 
+// One wall of two materials (x = 20; y < 0 "Bright", y > 0 "Dark"): each
+// beam's intensity takes its own material's reflectivity, from the manifest
+// or, without it, from the material's colour (OBJ colours are sRGB).
+TEST(LidarNoiseTest, EachMaterialOfAnActorHasItsOwnReflectivity) {
+  auto sweep_of = [](const std::string& extra, const std::string& toml_tail, LidarScan* scan,
+                     RayBatch* rays, std::vector<scene::SurfaceEntry>* table) {
+    testing::TempDir dir;
+    dir.Write("wall.mtl", "newmtl Bright\nKd 0.8 0.8 0.8\nnewmtl Dark\nKd 0.2 0.3 0.1\n");
+    dir.Write("wall.obj",
+              "mtllib wall.mtl\nv 20 -200 -200\nv 20 0 -200\nv 20 0 200\nv 20 -200 200\n"
+              "v 20 200 -200\nv 20 200 200\ng bright\nusemtl Bright\nf 1 2 3\nf 1 3 4\n"
+              "g dark\nusemtl Dark\nf 2 5 6\nf 2 6 3\n");
+    dir.Write("post.obj", "v -30 -1 -5\nv -30 1 -5\nv -30 1 5\nf 1 2 3\n");
+    const scene::Level level = scene::LoadLevel(dir.Write(
+        "level.toml", "[[actor]]\nname = \"wall\"\nfile = \"wall.obj\"\n" + extra + toml_tail));
+    const scene::CollisionWorld world(level);
+    LidarConfig config = LidarConfig::Uniform(8, -20, 20, 720, 200.0);
+    config.intensity_reference_m = 25.0;
+    const Lidar lidar(config);
+    *rays = lidar.Rays(Isometry3d::Identity(), Isometry3d::Identity());
+    RayCaster caster(2);
+    lidar.Sweep(world, caster, {}, Isometry3d::Identity(), Isometry3d::Identity(), scan);
+    *table = world.SurfaceTable();
+  };
+  auto srgb = [](double c) { return std::pow((c + 0.055) / 1.055, 2.4); };
+  const double bright = 0.2126 * srgb(0.8) + 0.7152 * srgb(0.8) + 0.0722 * srgb(0.8);
+  const double dark = 0.2126 * srgb(0.2) + 0.7152 * srgb(0.3) + 0.0722 * srgb(0.1);
+  for (const auto& [extra, expect_bright, expect_dark] :
+       {std::tuple{std::string(), bright, dark},
+        {"material_reflectivity = { Bright = 0.9, Dark = 0.1 }\n", 0.9, 0.1},
+        {"reflectivity = 0.3\nmaterial_reflectivity = { Dark = 0.15 }\n", 0.3, 0.15}}) {
+    // Alone, and beside a second static actor (behind the sensor): then the
+    // caster walks one hierarchy merged over both.
+    for (const std::string tail : {"", "[[actor]]\nname = \"post\"\nfile = \"post.obj\"\n"}) {
+      LidarScan scan;
+      RayBatch rays;
+      std::vector<scene::SurfaceEntry> table;
+      sweep_of(extra, tail, &scan, &rays, &table);
+      int checked[2] = {0, 0};
+      for (std::size_t i = 0; i < rays.size(); ++i) {
+        if (!scan.hit[i]) continue;
+        const double y = scan.points_W[i].y();
+        if (std::abs(y) < 0.01 || scan.points_W[i].x() < 0) continue;  // the seam, the post
+        const double cosine = double(rays.direction[i].x()), range = ExactRange(rays, i);
+        const double falloff = std::min(1.0, 25.0 * 25.0 / (range * range));
+        const double r = y < 0 ? expect_bright : expect_dark;
+        EXPECT_NEAR(scan.intensity[i], r * cosine * falloff, 1e-5) << extra << " beam " << i;
+        ++checked[y > 0];
+      }
+      EXPECT_GT(checked[0], 500) << extra;
+      EXPECT_GT(checked[1], 500) << extra;
+      // The table gives the actor's mean over its triangles (two of each).
+      ASSERT_GE(table.size(), 1u);
+      EXPECT_NEAR(table[0].reflectivity, (expect_bright + expect_dark) / 2.0, 1e-6) << extra;
+    }
+  }
+  // A material the file does not have is refused, naming the line and what it has.
+  LidarScan scan;
+  RayBatch rays;
+  std::vector<scene::SurfaceEntry> table;
+  try {
+    sweep_of("material_reflectivity = { Shiny = 0.9 }\n", "", &scan, &rays, &table);
+    ADD_FAILURE() << "an unknown material was taken";
+  } catch (const scene::LevelError& error) {
+    const std::string what = error.what();
+    EXPECT_NE(what.find("level.toml:4: "), std::string::npos) << what;
+    EXPECT_NE(what.find("'Shiny'"), std::string::npos) << what;
+    EXPECT_NE(what.find("'Bright', 'Dark'"), std::string::npos) << what;
+  }
+}
+
 // A cone of four sub-rays over the edge of a near wall (x = 20, y < -0.2) in
 // front of a far one (x = 40): its first return is the near wall's, its last
 // the far one's, each the mean range and the summed brightness of its
@@ -243,6 +314,12 @@ TEST(LidarNoiseTest, BadSettingsAreRefusedAtLoadNamingTheLineAndField) {
       error_of("[[actor]]\nname = \"wall\"\nfile = \"wall.obj\"\nreflectivity = 1.5\n");
   EXPECT_NE(reflectivity.find("level.toml:4: "), std::string::npos) << reflectivity;
   EXPECT_NE(reflectivity.find("'reflectivity' must be 0 to 1"), std::string::npos) << reflectivity;
+  const std::string by_material = error_of(
+      "[[actor]]\nname = \"wall\"\nfile = \"wall.obj\"\n\nmaterial_reflectivity = { Rock = -0.5 "
+      "}\n");
+  EXPECT_NE(by_material.find("level.toml:5: "), std::string::npos) << by_material;
+  EXPECT_NE(by_material.find("'material_reflectivity.Rock' must be 0 to 1"), std::string::npos)
+      << by_material;
   const std::string robot = "[[robot]]\nname = \"W\"\nfile = \"" + std::string(SANDBOX_SOURCE_DIR) +
                             "/assets/robots/generated/flying_wing.gltf\"\nbones = [\"root\"]\n"
                             "[[robot.sensor]]\nname = \"l\"\ntype = \"lidar\"\n";
