@@ -91,6 +91,9 @@ void RunLevel(const char* name, const fs::path& file, const Eigen::Isometry3d& X
       config.noise.dropout_probability = 0.05, config.noise.dropout_below_intensity = 0.01;
       config.noise.range_step_m = 0.005, config.noise.min_range_m = 0.5;
       const sensors::Lidar noisy(config);
+      sensors::LidarConfig cone = intensity.config();
+      cone.divergence.rays = 4, cone.divergence.angle_rad = 0.3 * M_PI / 180.0;
+      const sensors::Lidar divergent(cone);
       sensors::LidarScan sweep;
       auto compare = [&](const char* what, const sensors::Lidar& without,
                          const sensors::Lidar& with) {
@@ -100,6 +103,7 @@ void RunLevel(const char* name, const fs::path& file, const Eigen::Isometry3d& X
       compare(" normals", plain, normals);
       compare(" intensity", plain, intensity);
       compare(" +noise", intensity, noisy);
+      compare(" +cone x4", intensity, divergent);
     }
   }
   // The compact faces' bytes, millimetres, with and without the id plane.
@@ -165,7 +169,9 @@ int main(int argc, char** argv) {
       "(6 x 201 x 201 at 0.25 m), and its cast alone. Lidar: a sweep with ids only against one "
       "with normals or with intensity (reflectivity x incidence x range falloff), and with "
       "intensity against intensity plus every kind of noise (range sigma and its growth, "
-      "dropout by chance and by intensity, range steps, a minimum range). Compact face: the six "
+      "dropout by chance and by intensity, range steps, a minimum range), and with intensity "
+      "against a beam divergence of four sub-rays a beam (0.3 degrees; first and last "
+      "returns). Compact face: the six "
       "faces' encoded bytes with the id plane (runs of one id) over without.\n");
   return 0;
 }
