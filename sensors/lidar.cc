@@ -45,8 +45,11 @@ void LidarConfig::ValidateOrThrow() const {
   }
   const double per_beam = std::max(divergence.rays, 1);
   if (double(azimuth_steps) * double(elevations_rad.size()) * per_beam > 1e7) {
-    throw std::invalid_argument(
-        "channels x azimuth_steps x divergence_rays makes more than 10 million rays");
+    throw std::invalid_argument(divergence.on()
+                                    ? "channels x azimuth_steps x divergence_rays makes "
+                                      "more than 10 million rays"
+                                    : "channels x azimuth_steps makes more than 10 "
+                                      "million rays");
   }
   if (!(std::isfinite(intensity_reference_m) && intensity_reference_m > 0.0)) {
     fail("intensity_reference_m", intensity_reference_m, "must be positive");

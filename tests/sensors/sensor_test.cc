@@ -195,14 +195,16 @@ std::string ErrorOf(const std::string& kind, const std::string& table) {
 std::string Error(const std::string& sensor_table) { return ErrorOf("sensor", sensor_table); }
 std::string CameraError(const std::string& camera_table) { return ErrorOf("camera", camera_table); }
 
+// A setting's own checks name the line of its key (9: the second line of
+// the sensor table, after its type); others the table's (6).
 TEST(SensorTest, MistakesNameTheSensorAndField) {
   EXPECT_EQ(Error("type = \"face\"\nmount = \"elbow\"\n"),
             "level.toml:6: sensor 's': mount 'elbow' is not a node of arm.gltf (nodes: base, "
             "link1, link2, link3, link4, link5, link6, tool)");
   EXPECT_EQ(Error("type = \"face\"\nresolution_m = 0\n"),
-            "level.toml:6: sensor 's': resolution_m must be positive, got 0");
+            "level.toml:9: sensor 's': resolution_m must be positive, got 0");
   EXPECT_EQ(Error("type = \"face\"\nresolution_m = -0.5\n"),
-            "level.toml:6: sensor 's': resolution_m must be positive, got -0.5");
+            "level.toml:9: sensor 's': resolution_m must be positive, got -0.5");
   EXPECT_EQ(Error("type = \"face\"\nresolution_m = 0.05\n"),
             "level.toml:6: sensor 's': half_extent_m 25 at resolution_m 0.05 makes 6 x 1001 x "
             "1001 = 6012006 samples a scan, over sample_budget 2000000");
@@ -288,13 +290,13 @@ namespace {
 
 TEST(SensorTest, SettingsThatMakeNoTraversalAreRefusedAtLoad) {
   EXPECT_EQ(Error("type = \"ray\"\nrange_m = 0\n"),
-            "level.toml:6: sensor 's': range_m must be positive, got 0");
+            "level.toml:9: sensor 's': range_m must be positive, got 0");
   EXPECT_EQ(Error("type = \"lidar\"\nrange_m = 0\n"),
-            "level.toml:6: sensor 's': range_m must be positive, got 0");
+            "level.toml:9: sensor 's': range_m must be positive, got 0");
   EXPECT_EQ(Error("type = \"ground\"\ndepth_m = 0\n"),
-            "level.toml:6: sensor 's': depth_m must be positive, got 0");
+            "level.toml:9: sensor 's': depth_m must be positive, got 0");
   EXPECT_EQ(Error("type = \"ray\"\ndirection = [0, 0, 0]\n"),
-            "level.toml:6: sensor 's': direction must be a unit vector");
+            "level.toml:9: sensor 's': direction must be a unit vector");
   EXPECT_EQ(Error("type = \"face\"\nposition = [nan, 0, 0]\n"),
             "level.toml:9: sensor 's': 'position' must be finite, got nan");
   EXPECT_EQ(Error("type = \"lidar\"\nrpy_deg = [0, inf, 0]\n"),
