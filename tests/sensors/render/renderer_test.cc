@@ -153,29 +153,25 @@ TEST_F(RendererTest, DepthAgreesWithTheRayCaster) {
   EXPECT_GT(compared, 60);
 }
 
-TEST_F(RendererTest, OverlayMarksEachScannedSampleInItsColourWithoutTouchingDepth) {
-  // A full face scan 12 m above the valley floor: the lower face hits the
-  // terrain (occupied), the upper faces reach into the sky (free).
-  const scene::CollisionWorld world(level_);
+// A full face scan at `at` (2 m samples) of the fixture's level.
+sensors::FaceScan FullScan(const scene::Level& level, const Vector3d& at) {
+  const scene::CollisionWorld world(level);
   sensors::RayCaster caster(1);
   sensors::FaceScannerConfig config;
   config.resolution_m = 2.0;
   config.refresh = sensors::Refresh::kFull;
   const sensors::FaceScanner scanner(config);
   sensors::FaceScan scan = scanner.EmptyScan();
-  const Isometry3d X_WS(Eigen::Translation3d(0, 0, 12));
-  scanner.Scan(world, caster, {}, X_WS, 0, &scan);
-  Overlay overlay;
-  AddFaceScan(scan, 0.0, &overlay);
-  CameraView view;
-  view.X_WC = LookAt(Vector3d(0, -70, 45), Vector3d(0, 0, 5));
-  Frame plain, marked;
-  renderer_->Render(view, {}, {}, {}, &plain);
-  renderer_->Render(view, {}, {}, {}, &marked, &overlay);
-  EXPECT_EQ(plain.depth_m, marked.depth_m);
-  // Each sample in front of the scene (its distance along the optical axis
-  // at most the depth drawn there) shows its own colour at its pixel.
-  int checked[2] = {0, 0}, right[2] = {0, 0};
+  scanner.Scan(world, caster, {}, Isometry3d(Eigen::Translation3d(at)), 0, &scan);
+  return scan;
+}
+
+// Calls visit(i, rgb) for each overlay point i in front of the scene (its
+// distance along the optical axis at most the depth `plain` drew there) with
+// the colour `marked` shows at its pixel.
+template <typename Visit>
+void ForEachVisibleSample(const CameraView& view, const Overlay& overlay, const Frame& plain,
+                          const Frame& marked, Visit visit) {
   for (std::size_t i = 0; i < overlay.points_W.size(); ++i) {
     const Eigen::Vector2d pixel = Project(view, overlay.points_W[i]);
     const double along = (view.X_WC.inverse() * overlay.points_W[i]).x();
@@ -185,12 +181,30 @@ TEST_F(RendererTest, OverlayMarksEachScannedSampleInItsColourWithoutTouchingDept
     const float depth =
         plain.depth_m[std::size_t(row) * std::size_t(view.width) + std::size_t(column)];
     if (along > depth * 1.001 + 0.05) continue;  // behind the terrain: hidden
+    visit(i, Pixel(marked, column, row));
+  }
+}
+
+TEST_F(RendererTest, OverlayMarksEachScannedSampleInItsColourWithoutTouchingDepth) {
+  // A full face scan 12 m above the valley floor: the lower face hits the
+  // terrain (occupied), the upper faces reach into the sky (free).
+  const sensors::FaceScan scan = FullScan(level_, Vector3d(0, 0, 12));
+  Overlay overlay;
+  AddFaceScan(scan, 0.0, &overlay);
+  CameraView view;
+  view.X_WC = LookAt(Vector3d(0, -70, 45), Vector3d(0, 0, 5));
+  Frame plain, marked;
+  renderer_->Render(view, {}, {}, {}, &plain);
+  renderer_->Render(view, {}, {}, {}, &marked, &overlay);
+  EXPECT_EQ(plain.depth_m, marked.depth_m);
+  // Each visible sample shows its own colour at its pixel.
+  int checked[2] = {0, 0}, right[2] = {0, 0};
+  ForEachVisibleSample(view, overlay, plain, marked, [&](std::size_t i, const std::uint8_t* rgb) {
     const bool occupied = overlay.point_rgb[i].x() > 0.5f;
-    const std::uint8_t* rgb = Pixel(marked, column, row);
     const bool red = rgb[0] > 200 && rgb[1]<80, green = rgb[1]> 180 && rgb[0] < 80;
     ++checked[occupied];
     right[occupied] += occupied ? red : green;
-  }
+  });
   EXPECT_GT(checked[0], 500);
   EXPECT_GT(checked[1], 200);
   EXPECT_GT(right[0], 0.95 * checked[0])
@@ -202,16 +216,9 @@ TEST_F(RendererTest, OverlayMarksEachScannedSampleInItsColourWithoutTouchingDept
 // Coloured by surface id, each visible occupied sample shows its id's colour
 // (SurfaceColour) and the free ones grey; samples on two surfaces differ.
 TEST_F(RendererTest, OverlayByIdShowsEachSampleInItsSurfaceColour) {
-  const scene::CollisionWorld world(level_);
-  sensors::RayCaster caster(1);
-  sensors::FaceScannerConfig config;
-  config.resolution_m = 2.0;
-  config.refresh = sensors::Refresh::kFull;
-  const sensors::FaceScanner scanner(config);
-  sensors::FaceScan scan = scanner.EmptyScan();
   // Beside the tower: the scan meets the terrain and the tower.
   const Vector3d at(-20, 35, 14);
-  scanner.Scan(world, caster, {}, Isometry3d(Eigen::Translation3d(at)), 0, &scan);
+  const sensors::FaceScan scan = FullScan(level_, at);
   Overlay overlay;
   AddFaceScan(scan, 0.0, &overlay, SampleColour::kSurface);
   std::set<std::int32_t> ids;
@@ -236,21 +243,12 @@ TEST_F(RendererTest, OverlayByIdShowsEachSampleInItsSurfaceColour) {
   renderer_->Render(view, {}, {}, {}, &plain);
   renderer_->Render(view, {}, {}, {}, &marked, &overlay);
   int checked = 0, right = 0;
-  for (std::size_t i = 0; i < overlay.points_W.size(); ++i) {
-    const Eigen::Vector2d pixel = Project(view, overlay.points_W[i]);
-    const double along = (view.X_WC.inverse() * overlay.points_W[i]).x();
-    const int column = int(std::floor(pixel.x())), row = int(std::floor(pixel.y()));
-    if (along <= 0 || column < 2 || row < 2 || column >= view.width - 2 || row >= view.height - 2)
-      continue;
-    const float depth =
-        plain.depth_m[std::size_t(row) * std::size_t(view.width) + std::size_t(column)];
-    if (along > depth * 1.001 + 0.05) continue;
-    const std::uint8_t* rgb = Pixel(marked, column, row);
+  ForEachVisibleSample(view, overlay, plain, marked, [&](std::size_t i, const std::uint8_t* rgb) {
     bool near = true;
     for (int k = 0; k < 3; ++k) near &= std::abs(rgb[k] - 255.f * overlay.point_rgb[i][k]) < 40.f;
     ++checked;
     right += near;
-  }
+  });
   EXPECT_GT(checked, 500);
   EXPECT_GT(right, 0.95 * checked) << right << " of " << checked << " samples in their colour";
 }
