@@ -34,8 +34,12 @@ using Clock = std::chrono::steady_clock;
 
 // Runs without and with in turns, call by call, for `seconds`: the median
 // time of each (the machine's drift and its slow moments fall on both alike).
+// Only the pairs whose name holds this (all when empty): --only.
+std::string only;
+
 template <typename Run>
 void Pair(const char* level, const char* what, int threads, double seconds, Run run) {
+  if (std::string(what).find(only) == std::string::npos) return;
   run(false), run(true);  // warm up
   std::vector<double> times[2];
   const auto start = Clock::now();
@@ -141,8 +145,10 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--seconds") == 0 && i + 1 < argc) {
       seconds = std::max(0.05, std::atof(argv[++i]));
+    } else if (std::strcmp(argv[i], "--only") == 0 && i + 1 < argc) {
+      only = argv[++i];
     } else {
-      std::fprintf(stderr, "usage: bench_samples [--seconds S]\n");
+      std::fprintf(stderr, "usage: bench_samples [--seconds S] [--only PART_OF_A_NAME]\n");
       return 2;
     }
   }

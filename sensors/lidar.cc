@@ -86,11 +86,13 @@ std::uint64_t Mix(std::uint64_t x) {
 }
 
 // Draw k (0 to 3) of beam `beam`, given the sweep's key (Mix of the seed and
-// the sweep): uniform in (0, 1), a function of its arguments alone (no
-// generator state: threads and order do not matter).
-double Uniform(std::uint64_t sweep_key, std::uint64_t beam, std::uint64_t k) {
-  return (double(Mix(sweep_key ^ (beam << 2 | k)) >> 11) + 0.5) * 0x1.0p-53;
+// the sweep): 64 random bits, a function of its arguments alone (no generator
+// state: threads and order do not matter).
+std::uint64_t Draw(std::uint64_t sweep_key, std::uint64_t beam, std::uint64_t k) {
+  return Mix(sweep_key ^ (beam << 2 | k));
 }
+// Those bits as a uniform number in (0, 1).
+double Uniform(std::uint64_t bits) { return (double(bits >> 11) + 0.5) * 0x1.0p-53; }
 
 // The standard normal quantile at p in (0, 1) (inverse transform sampling):
 // Acklam's rational approximation, relative error under 1.2e-9; the tails
@@ -118,6 +120,27 @@ double NormalQuantile(double p) {
   return (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q /
          (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1.0);
 }
+
+// A standard normal draw from 64 random bits by the quantile at their uniform:
+// the quantiles at j / 4096 tabled, linear in between (the top 12 bits pick
+// the segment, the next 23 the place in it); the two outer segments, where
+// the quantile bends fastest, exact. Five times faster than NormalQuantile.
+class NormalDraw {
+ public:
+  NormalDraw() {
+    for (int j = 1; j < kSegments; ++j) quantile_[j] = float(NormalQuantile(double(j) / kSegments));
+  }
+  float operator()(std::uint64_t bits) const {
+    const std::uint32_t j = std::uint32_t(bits >> (64 - kBits));
+    if (j == 0 || j == kSegments - 1) return float(NormalQuantile(Uniform(bits)));
+    const float along = float((bits >> (64 - kBits - 23)) & ((1u << 23) - 1)) * 0x1.0p-23f;
+    return quantile_[j] + along * (quantile_[j + 1] - quantile_[j]);
+  }
+
+ private:
+  static constexpr int kBits = 12, kSegments = 1 << kBits;
+  float quantile_[kSegments + 1] = {};
+};
 
 }  // namespace
 
@@ -280,19 +303,25 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
     }
   };
   const double per_step = noise.range_step_m > 0.0 ? 1.0 / noise.range_step_m : 0.0;
+  static const NormalDraw normal;
   // The noise on return k (0 first, 1 last) of beam i: false when it is lost.
-  auto perturb = [&](std::size_t i, int k, Return* ret) {
-    if (ret->range_m < noise.min_range_m || ret->brightness < noise.dropout_below_intensity) {
-      return false;
-    }
+  // Branch-free where the draws decide (a mispredicted branch costs more than
+  // the draw it skips).
+  auto perturb = [&](float z, Return* ret) {
     float r = ret->range_m;
+    const bool kept = (r >= noise.min_range_m) & (ret->brightness >= noise.dropout_below_intensity);
     const double sigma = noise.range_sigma_m + noise.range_sigma_per_m * r;
-    if (sigma > 0.0) r += float(sigma * NormalQuantile(Uniform(sweep_key, i, 1 + k)));
-    if (noise.range_step_m > 0.0) r = float(std::round(r * per_step) * noise.range_step_m);
+    r += float(sigma * z);
+    if (noise.range_step_m > 0.0) {
+      // Nearest step, inline (std::round is a library call without SSE4.1).
+      const double steps = double(r) * per_step;
+      r = float(double(std::int64_t(steps + (steps < 0.0 ? -0.5 : 0.5))) * noise.range_step_m);
+    }
     ret->range_m = std::clamp(r, 0.f, range);
-    return true;
+    return kept;
   };
-  auto beam = [&](std::size_t i) {
+  // Beam i, given its first return's normal draw z and whether chance drops it.
+  auto beam = [&](std::size_t i, float z, bool dropped) {
     Return first, last;
     if (divergence.on()) {
       cone(i, &first, &last);
@@ -300,12 +329,19 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
       first = hit_of(i);
     }
     if (noisy && first.there()) {
-      if (Uniform(sweep_key, i, 0) < noise.dropout_probability) {
+      if (!divergence.on()) {
+        const bool keep = perturb(z, &first) & !dropped;
+        const float on = keep ? 1.f : 0.f;
+        first.surface = keep ? first.surface : RayHits::kNoHit;
+        first.brightness *= on;
+        first.normal *= on;
+      } else if (dropped) {
         first = last = Return{};
       } else {
-        const bool separate = divergence.on() && last.range_m != first.range_m;
-        const bool keep_first = perturb(i, 0, &first);
-        const bool keep_last = separate ? perturb(i, 1, &last) : keep_first;
+        const bool separate = last.range_m != first.range_m;
+        const bool keep_first = perturb(z, &first);
+        const bool keep_last =
+            separate ? perturb(normal(Draw(sweep_key, i, 2)), &last) : keep_first;
         if (!separate) last = first;
         if (!keep_first) first = keep_last ? last : Return{};
         if (!keep_last) last = first;
@@ -329,8 +365,19 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
   };
   constexpr std::size_t kChunk = 4096;
   caster.RunParallel(int((n + kChunk - 1) / kChunk), [&](int chunk) {
-    const std::size_t end = std::min(n, std::size_t(chunk + 1) * kChunk);
-    for (std::size_t i = std::size_t(chunk) * kChunk; i < end; ++i) beam(i);
+    const std::size_t begin = std::size_t(chunk) * kChunk;
+    const std::size_t end = std::min(n, begin + kChunk);
+    // The chunk's draws first, in a loop of their own (their hash chains
+    // overlap there; inside the beam's long body they would not).
+    float z[kChunk];
+    bool dropped[kChunk];
+    if (noisy) {
+      for (std::size_t i = begin; i < end; ++i) {
+        z[i - begin] = normal(Draw(sweep_key, i, 1));
+        dropped[i - begin] = Uniform(Draw(sweep_key, i, 0)) < noise.dropout_probability;
+      }
+    }
+    for (std::size_t i = begin; i < end; ++i) beam(i, z[i - begin], dropped[i - begin]);
   });
   scan->surface_ids = config_.surface_ids;
   scan->sweep_s = 1.0 / config_.rotation_hz;
