@@ -42,8 +42,15 @@ static inline Eigen::Vector3f FacingUnit(const Eigen::Vector3f& normal,
   return normal * (normal.dot(direction) > 0.0f ? -scale : scale);
 }
 
+// [a[i0], a[i1], b[i2], b[i3]].
+template <int i0, int i1, int i2, int i3>
+static inline __m128 Pick(__m128 a, __m128 b) {
+  return _mm_shuffle_ps(a, b, _MM_SHUFFLE(i3, i2, i1, i0));
+}
+
 // The hits' normals of a band, unit and facing rays along `d`, in place; zero
-// where nothing was hit. Four at a time: the reciprocal square root's
+// where nothing was hit. Four at a time: three loads turned into x, y and z
+// by shuffles (and back for the stores), the reciprocal square root's
 // estimate and one Newton step (within 2 ulps of 1 / sqrt), a product each.
 static inline void FacingUnits(const std::int32_t* surface, std::size_t count,
                                const Eigen::Vector3f& d, Eigen::Vector3f* normal) {
@@ -54,9 +61,11 @@ static inline void FacingUnits(const std::int32_t* surface, std::size_t count,
   std::size_t i = 0;
   for (; i + 4 <= count; i += 4) {
     float* p = normal[i].data();
-    const __m128 x = _mm_setr_ps(p[0], p[3], p[6], p[9]);
-    const __m128 y = _mm_setr_ps(p[1], p[4], p[7], p[10]);
-    const __m128 z = _mm_setr_ps(p[2], p[5], p[8], p[11]);
+    // a = x0 y0 z0 x1, b = y1 z1 x2 y2, c = z2 x3 y3 z3
+    const __m128 a = _mm_loadu_ps(p), b = _mm_loadu_ps(p + 4), c = _mm_loadu_ps(p + 8);
+    const __m128 x = Pick<0, 3, 0, 2>(a, Pick<2, 2, 1, 1>(b, c));
+    const __m128 y = Pick<0, 2, 0, 2>(Pick<1, 1, 0, 0>(a, b), Pick<3, 3, 2, 2>(b, c));
+    const __m128 z = Pick<0, 2, 0, 3>(Pick<2, 2, 1, 1>(a, b), c);
     const __m128 n2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, x), _mm_mul_ps(y, y)), _mm_mul_ps(z, z));
     const __m128 r0 = _mm_rsqrt_ps(n2);
     // r = r0 (3 - n2 r0^2) / 2
@@ -70,11 +79,12 @@ static inline void FacingUnits(const std::int32_t* surface, std::size_t count,
                         _mm_set1_epi32(RayHits::kNoHit)),
         _mm_set1_epi32(-1));
     const __m128 keep = _mm_castsi128_ps(hit);  // whatever a lane without a hit holds
-    alignas(16) float out[3][4];
-    _mm_store_ps(out[0], _mm_and_ps(_mm_mul_ps(x, scale), keep));
-    _mm_store_ps(out[1], _mm_and_ps(_mm_mul_ps(y, scale), keep));
-    _mm_store_ps(out[2], _mm_and_ps(_mm_mul_ps(z, scale), keep));
-    for (int l = 0; l < 4; ++l) normal[i + std::size_t(l)] = {out[0][l], out[1][l], out[2][l]};
+    const __m128 ux = _mm_and_ps(_mm_mul_ps(x, scale), keep);
+    const __m128 uy = _mm_and_ps(_mm_mul_ps(y, scale), keep);
+    const __m128 uz = _mm_and_ps(_mm_mul_ps(z, scale), keep);
+    _mm_storeu_ps(p, Pick<0, 2, 0, 2>(Pick<0, 0, 0, 0>(ux, uy), Pick<0, 0, 1, 1>(uz, ux)));
+    _mm_storeu_ps(p + 4, Pick<0, 2, 0, 2>(Pick<1, 1, 1, 1>(uy, uz), Pick<2, 2, 2, 2>(ux, uy)));
+    _mm_storeu_ps(p + 8, Pick<0, 2, 0, 2>(Pick<2, 2, 3, 3>(uz, ux), Pick<3, 3, 3, 3>(uy, uz)));
   }
   for (; i < count; ++i) {
     normal[i] = surface[i] == RayHits::kNoHit ? Eigen::Vector3f::Zero() : FacingUnit(normal[i], d);
