@@ -164,6 +164,12 @@ RayBatch Lidar::Rays(const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3
     const double phi = 2.0 * M_PI * j / per_beam;
     around[std::size_t(j)] = std::sin(h) * Eigen::Vector2d(std::cos(phi), std::sin(phi));
   }
+  // Each channel's elevation's cosine and sine, once a sweep.
+  std::vector<Eigen::Vector2d> elevation(static_cast<std::size_t>(channels));
+  for (int c = 0; c < channels; ++c) {
+    const double e = config_.elevations_rad[std::size_t(c)];
+    elevation[std::size_t(c)] = {std::cos(e), std::sin(e)};
+  }
   const Eigen::Quaterniond q0(X_WS_start.linear()), q1(X_WS_end.linear());
   const Eigen::Vector3d travel = X_WS_end.translation() - X_WS_start.translation();
   for (int k = 0; k < steps; ++k) {
@@ -174,14 +180,14 @@ RayBatch Lidar::Rays(const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3
     const double azimuth = 2.0 * M_PI * k / steps;
     const double ca = std::cos(azimuth), sa = std::sin(azimuth);
     for (int c = 0; c < channels; ++c) {
-      const double e = config_.elevations_rad[std::size_t(c)];
-      const Eigen::Vector3d d(std::cos(e) * ca, std::cos(e) * sa, std::sin(e));
+      const double cos_e = elevation[std::size_t(c)].x(), sin_e = elevation[std::size_t(c)].y();
+      const Eigen::Vector3d d(cos_e * ca, cos_e * sa, sin_e);
       const std::size_t i = std::size_t(c) * std::size_t(steps) + std::size_t(k);
       rays.start[i] = start;
       rays.direction[i] = (R * d).cast<float>();
       rays.length_m[i] = static_cast<float>(config_.range_m);
       if (per_beam == 0) continue;
-      const Eigen::Vector3d up(-std::sin(e) * ca, -std::sin(e) * sa, std::cos(e)), side(-sa, ca, 0);
+      const Eigen::Vector3d up(-sin_e * ca, -sin_e * sa, cos_e), side(-sa, ca, 0);
       for (int j = 0; j < per_beam; ++j) {
         const Eigen::Vector2d& o = around[std::size_t(j)];
         const std::size_t q = i * std::size_t(per_beam) + std::size_t(j);
