@@ -10,10 +10,6 @@ namespace {
 
 float Linear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
 
-}  // namespace
-
-namespace {
-
 const Material& MaterialOf(const Mesh& mesh, const std::vector<Material>& materials) {
   static const Material plain;
   return mesh.material >= 0 && std::size_t(mesh.material) < materials.size()
@@ -21,7 +17,7 @@ const Material& MaterialOf(const Mesh& mesh, const std::vector<Material>& materi
              : plain;
 }
 
-// The triangle-weighted mean of of(mesh) over `meshes`; 0.5 without triangles.
+// The triangle-weighted mean of `of(mesh)` over `meshes`; 0.5 without triangles.
 template <typename Of>
 float TriangleMean(const std::vector<const Mesh*>& meshes, Of of) {
   double sum = 0.0, triangles = 0.0;
