@@ -24,6 +24,13 @@
 namespace sandbox::app {
 namespace {
 
+// A robot description's joint kind, from its bone.
+const char* JointType(const scene::Bone& bone) {
+  if (bone.rotation == scene::BoneRotation::kSlide) return "prismatic";
+  return std::isfinite(bone.lower) || std::isfinite(bone.upper) ? "revolute" : "continuous";
+}
+
+
 using scene::Level;
 
 struct LoadFigures {
@@ -120,7 +127,29 @@ void PrintJson(const Level& level, const std::vector<sensors::MountedSensor>& se
         << ", \"bones\": " << r.bones.size() << ", \"bone_values\": " << r.num_values
         << ", \"vertices\": " << r.num_vertices() << ", \"triangles\": " << r.num_triangles()
         << ", \"collision\": " << (r.collision ? "true" : "false")
-        << ", \"spawn_position\": " << JsonVector(r.X_WB_spawn.translation()) << ", \"sensors\": [";
+        << ", \"spawn_position\": " << JsonVector(r.X_WB_spawn.translation());
+    if (r.described) {
+      out << ", \"links\": [";
+      for (std::size_t n = 0; n < r.nodes.size(); ++n) {
+        out << (n > 0 ? ", " : "") << JsonString(r.nodes[n].name);
+      }
+      out << "], \"joints\": [";
+      for (std::size_t b = 0; b < r.bones.size(); ++b) {
+        const scene::Bone& bone = r.bones[b];
+        const scene::RobotNode& link = r.nodes[std::size_t(bone.node)];
+        auto limit = [](double value) {
+          return std::isfinite(value) ? std::to_string(value) : std::string("null");
+        };
+        out << (b > 0 ? ", " : "") << "{\"name\": " << JsonString(bone.name)
+            << ", \"type\": " << JsonString(JointType(bone))
+            << ", \"link\": " << JsonString(link.name)
+            << ", \"parent\": " << JsonString(r.nodes[std::size_t(link.parent)].name)
+            << ", \"axis\": " << JsonVector(bone.axes[0]) << ", \"lower\": " << limit(bone.lower)
+            << ", \"upper\": " << limit(bone.upper) << "}";
+      }
+      out << "]";
+    }
+    out << ", \"sensors\": [";
     bool first = true;
     for (const sensors::MountedSensor& sensor : sensors) {
       if (sensor.robot != static_cast<int>(i)) continue;
@@ -198,6 +227,25 @@ void PrintText(const Level& level, const std::vector<sensors::MountedSensor>& se
         << r.num_vertices() << " vertices, " << r.num_triangles() << " triangles, collision "
         << (r.collision ? "on" : "off") << ", spawn (" << p.x() << ", " << p.y() << ", " << p.z()
         << ")\n";
+    if (r.described) {
+      out << "  links:";
+      for (const scene::RobotNode& node : r.nodes) out << " " << node.name;
+      out << "\n";
+      for (std::size_t b = 0; b < r.bones.size(); ++b) {
+        const scene::Bone& bone = r.bones[b];
+        const scene::RobotNode& link = r.nodes[std::size_t(bone.node)];
+        const Eigen::Vector3d& axis = bone.axes[0];
+        out << "  joint " << b << " " << bone.name << ": " << JointType(bone) << ", moves "
+            << link.name << " on " << r.nodes[std::size_t(link.parent)].name << ", axis ("
+            << axis.x() << ", " << axis.y() << ", " << axis.z() << ")";
+        if (std::isfinite(bone.lower) || std::isfinite(bone.upper)) {
+          out << std::setprecision(4) << ", limits " << bone.lower << " .. " << bone.upper
+              << (bone.rotation == scene::BoneRotation::kSlide ? " m" : " rad")
+              << std::setprecision(2);
+        }
+        out << "\n";
+      }
+    }
     for (const sensors::MountedSensor& sensor : sensors) {
       if (level.robots[static_cast<std::size_t>(sensor.robot)].name != r.name) continue;
       out << "  sensor " << sensor.spec.name << ": " << sensor.Describe() << "\n";

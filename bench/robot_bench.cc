@@ -133,7 +133,7 @@ int main(int argc, char** argv) {
     bent.SetBone(b, values, 2);
   }
   bent.Update();
-  const std::vector<int> node_of = DominantNodePerTriangle(wing, 0);
+  const std::vector<int> node_of = DominantNodePerTriangle(wing, wing.meshes[0]);
   const auto& indices = wing.meshes[0].bind.indices;
   double worst_m = 0.0;
   for (std::size_t t = 0; t < node_of.size(); ++t) {

@@ -13,6 +13,26 @@
 namespace sandbox::scene {
 namespace {
 
+// A mesh's vertices at the state's pose, in frame B (linear-blend skinning
+// in double, as RobotState::Update does for the drawn meshes).
+std::vector<Eigen::Vector3f> RestPositions(const RobotModel& model, const RobotState& rest,
+                                           const SkinnedMesh& mesh) {
+  std::vector<Eigen::Vector3f> out(mesh.bind.positions_A.size());
+  for (std::size_t v = 0; v < out.size(); ++v) {
+    Eigen::Matrix4d M = Eigen::Matrix4d::Zero();
+    for (std::uint32_t i = mesh.influence_begin[v]; i < mesh.influence_begin[v + 1]; ++i) {
+      const SkinJoint& joint = model.joints[mesh.influence_joint[i]];
+      M += mesh.influence_weight[i] *
+           (rest.node_poses_B()[static_cast<std::size_t>(joint.node)] * joint.offset).matrix();
+    }
+    out[v] = (M.topLeftCorner<3, 3>() * mesh.bind.positions_A[v].cast<double>() +
+              M.topRightCorner<3, 1>())
+                 .cast<float>();
+  }
+  return out;
+}
+
+
 Eigen::Vector3d FromBullet(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
 
 // Ray callback that skips the bodies (actors or robots) of the world it is told.
@@ -64,10 +84,13 @@ CollisionWorld::CollisionWorld(const Level& level) : impl_(std::make_unique<Impl
     w.robot_pieces.emplace_back();
     if (!model.collision) continue;
     std::map<int, std::unique_ptr<RobotPiece>> pieces;  // by node
-    for (std::size_t m = 0; m < model.meshes.size(); ++m) {
-      const std::vector<int> node_of = DominantNodePerTriangle(model, static_cast<int>(m));
-      const std::vector<std::uint32_t>& indices = model.meshes[m].bind.indices;
-      const auto& rest_B = rest.positions_B(static_cast<int>(m));
+    const bool own = !model.collision_meshes.empty();  // else the drawn meshes
+    const std::vector<SkinnedMesh>& meshes = own ? model.collision_meshes : model.meshes;
+    for (std::size_t m = 0; m < meshes.size(); ++m) {
+      const std::vector<int> node_of = DominantNodePerTriangle(model, meshes[m]);
+      const std::vector<std::uint32_t>& indices = meshes[m].bind.indices;
+      const std::vector<Eigen::Vector3f> rest_B =
+          own ? RestPositions(model, rest, meshes[m]) : rest.positions_B(static_cast<int>(m));
       for (std::size_t t = 0; t < node_of.size(); ++t) {
         auto& piece = pieces[node_of[t]];
         if (!piece) piece = std::make_unique<RobotPiece>(), piece->node = node_of[t];

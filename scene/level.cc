@@ -9,6 +9,7 @@
 #include "scene/files.h"
 #include "scene/heightmap.h"
 #include "scene/manifest.h"
+#include "scene/robot_description.h"
 #include "scene/terrain_source.h"
 
 namespace sandbox::scene {
@@ -109,6 +110,20 @@ Level LoadSceneFile(const fs::path& file, const LoadOptions& options) {
   return level;
 }
 
+// A robot description as a level: the robot alone, at the origin, named
+// after the file.
+Level LoadDescriptionFile(const fs::path& file, const LoadOptions& options) {
+  Level level;
+  level.file = file;
+  level.name = file.stem().string();
+  level.limits = options.limits;
+  RobotSpec spec;
+  spec.name = level.name;
+  spec.file = file;
+  level.robots.push_back(LoadRobotModel(spec, file, &level, options.on_file));
+  return level;
+}
+
 // A manifest as a level: one actor per [[actor]], all of its asset's nodes
 // merged into it, scaled in the asset root frame and then placed.
 Level LoadManifest(const fs::path& file, const LoadOptions& options) {
@@ -187,8 +202,7 @@ Level LoadManifest(const fs::path& file, const LoadOptions& options) {
     level.horizon->visibility_m = manifest.horizon->visibility_m;
   }
   for (const RobotSpec& spec : manifest.robots) {
-    Reading(options, spec.file, AssetReader(spec.file));
-    level.robots.push_back(LoadRobotModel(spec, file, &level));
+    level.robots.push_back(LoadRobotModel(spec, file, &level, options.on_file));
     CheckTriangles(spec.file, level);
   }
   return level;
@@ -253,8 +267,9 @@ Level LoadLevel(const fs::path& file, const LoadOptions& options) {
   if (const std::string problem = RegularFileProblem(file); !problem.empty()) {
     throw LevelError(file.string() + ": " + problem);
   }
-  Level level =
-      LowerExtension(file) == ".toml" ? LoadManifest(file, options) : LoadSceneFile(file, options);
+  Level level = LowerExtension(file) == ".toml" ? LoadManifest(file, options)
+                : IsRobotDescription(file)       ? LoadDescriptionFile(file, options)
+                                                 : LoadSceneFile(file, options);
   CheckTriangles(file, level);
   for (Actor& actor : level.actors) ComputeBounds(&actor);
   if (level.horizon && level.horizon->hole_W.isEmpty() && !level.bounds_W().isEmpty()) {

@@ -8,7 +8,10 @@
 
 #include "scene/asset_import.h"
 #include "scene/assimp_read.h"
+#include "scene/files.h"
 #include "scene/level.h"
+#include "scene/robot_description.h"
+#include "scene/shape_meshes.h"
 
 namespace sandbox::scene {
 namespace {
@@ -137,6 +140,181 @@ void MapBones(const RobotSpec& spec, bool has_skeleton, RobotModel* model,
   }
 }
 
+// Sensor and camera mounts: a node of the robot, or its body frame.
+void ResolveMounts(const RobotSpec& spec, RobotModel* model_out) {
+  RobotModel& model = *model_out;
+  for (const auto* list : {&spec.sensors, &spec.cameras}) {
+    for (SensorSpec sensor : *list) {
+      if (!sensor.mount.empty() && sensor.mount != "body") {
+        sensor.mount_node = model.FindNode(sensor.mount);
+        if (sensor.mount_node < 0) {
+          throw LevelError(sensor.Where() + "mount '" + sensor.mount + "' is not a node of " +
+                           spec.file.filename().string() + " (nodes: " + NodeList(model) + ")");
+        }
+      }
+      (list == &spec.sensors ? model.sensors : model.cameras).push_back(std::move(sensor));
+    }
+  }
+}
+
+// Every vertex of `mesh` rigidly on node `node` (its bind space is the node's frame).
+SkinnedMesh RigidOnNode(Mesh mesh, int node, RobotModel* model) {
+  SkinnedMesh out;
+  out.bind = std::move(mesh);
+  const std::uint16_t joint = JointIndex(model, node, Eigen::Affine3d::Identity());
+  const std::size_t n = out.bind.positions_A.size();
+  out.influence_begin.resize(n + 1);
+  std::iota(out.influence_begin.begin(), out.influence_begin.end(), 0u);
+  out.influence_joint.assign(n, joint);
+  out.influence_weight.assign(n, 1.0f);
+  PrepareSkinning(&out);
+  return out;
+}
+
+// A robot description's links as nodes, movable joints as bones, geometry as
+// meshes rigid on their links (drawn: the visuals; rays: the collisions).
+class DescribedRobotBuilder {
+ public:
+  DescribedRobotBuilder(const RobotSpec& spec, const std::string& where, Level* level,
+                        const std::function<void(const fs::path&, std::string_view)>& on_file)
+      : spec_(spec), where_(where), level_(level), on_file_(on_file) {}
+
+  void Build(RobotModel* model) {
+    if (!spec_.bones.empty() || !spec_.angle_axes.empty() || !spec_.bone_axes.empty()) {
+      throw LevelError(where_ + "'bones', 'angle_axes' and 'bone_axes' are for skeleton files; " +
+                       spec_.file.filename().string() +
+                       " is a robot description, whose bones are its movable joints");
+    }
+    RobotDescription description;
+    try {
+      description = ReadRobotDescription(spec_.file);
+    } catch (const LevelError& error) {
+      throw LevelError(where_ + error.what());
+    }
+    for (std::string& warning : description.warnings) level_->warnings.push_back(warning);
+    model->described = true;
+    model->X_BF = Eigen::Affine3d(Eigen::Scaling(spec_.placement.scale));  // Z up, metres
+    for (const DescribedLink& link : description.links) {
+      RobotNode node;
+      node.name = link.name;
+      model->nodes.push_back(node);
+    }
+    for (const DescribedJoint& joint : description.joints) {
+      RobotNode& child = model->nodes[std::size_t(joint.child)];
+      child.parent = joint.parent;
+      child.X_PN = Eigen::Affine3d(joint.X_PC.matrix());
+      if (!joint.moves()) continue;
+      Bone bone;
+      bone.name = joint.name;
+      bone.node = joint.child;
+      bone.rotation = joint.type == DescribedJoint::Type::kPrismatic ? BoneRotation::kSlide
+                                                                      : BoneRotation::kAngles;
+      bone.axes = {joint.axis};
+      bone.first_value = model->num_values;
+      bone.num_values = 1;
+      bone.lower = joint.lower, bone.upper = joint.upper;
+      model->num_values += 1;
+      model->bones.push_back(std::move(bone));
+    }
+    for (std::size_t l = 0; l < description.links.size(); ++l) {
+      const DescribedLink& link = description.links[l];
+      for (const LinkGeometry& geometry : link.visuals) {
+        for (Mesh& mesh : Meshes(geometry, link.name, true)) {
+          model->meshes.push_back(RigidOnNode(std::move(mesh), int(l), model));
+        }
+      }
+      for (const LinkGeometry& geometry : link.collisions) {
+        for (Mesh& mesh : Meshes(geometry, link.name, false)) {
+          model->collision_meshes.push_back(RigidOnNode(std::move(mesh), int(l), model));
+        }
+      }
+    }
+  }
+
+ private:
+  // The geometry as meshes in its link's frame; drawn ones get materials.
+  std::vector<Mesh> Meshes(const LinkGeometry& geometry, const std::string& link, bool drawn) {
+    std::vector<Mesh> out;
+    const Eigen::Affine3d X_LG(geometry.X_LG.matrix());
+    switch (geometry.kind) {
+      case LinkGeometry::Kind::kBox:
+        out.push_back(BoxMesh(geometry.size));
+        break;
+      case LinkGeometry::Kind::kCylinder:
+        out.push_back(CylinderMesh(geometry.radius, geometry.length));
+        break;
+      case LinkGeometry::Kind::kSphere:
+        out.push_back(SphereMesh(geometry.radius));
+        break;
+      case LinkGeometry::Kind::kMesh: {
+        const Asset& asset = Read(geometry.mesh, drawn);
+        const Eigen::Affine3d X_LF = X_LG * Eigen::Scaling(geometry.scale);
+        for (const ImportedNode& node : asset.imported.nodes) {
+          for (Mesh mesh : node.meshes) {
+            TransformMesh(X_LF * node.X_RN, &mesh);
+            mesh.material = mesh.material >= 0 && asset.material_base >= 0
+                                ? mesh.material + asset.material_base
+                                : -1;
+            if (!drawn) mesh.uvs.clear(), mesh.lightmap_uvs.clear(), mesh.colors.clear();
+            out.push_back(std::move(mesh));
+          }
+        }
+        for (Mesh& mesh : out) mesh.material = drawn ? mesh.material : -1;
+        break;
+      }
+    }
+    if (geometry.kind != LinkGeometry::Kind::kMesh) {
+      for (Mesh& mesh : out) TransformMesh(X_LG, &mesh);
+    }
+    if (drawn) {
+      // A colour the description gives: for shapes, and meshes without their own.
+      for (Mesh& mesh : out) {
+        if (mesh.material >= 0) continue;
+        Material material;
+        material.name = geometry.material.empty() ? link : geometry.material;
+        material.base_color = geometry.rgba.value_or(Eigen::Vector4f(0.7f, 0.7f, 0.7f, 1.0f));
+        std::ostringstream key;
+        key << material.name << ' ' << material.base_color.transpose();
+        auto [at, is_new] = materials_.try_emplace(key.str(), -1);
+        if (is_new) at->second = AppendMaterials({material}, {}, level_);
+        mesh.material = at->second;
+      }
+    }
+    return out;
+  }
+
+  struct Asset {
+    ImportedAsset imported;
+    int material_base{-1};  // -1: its materials are not in the level yet
+  };
+
+  // A mesh file, read once (its materials added to the level once drawn).
+  const Asset& Read(const fs::path& file, bool drawn) {
+    auto [at, is_new] = assets_.try_emplace(file.string());
+    Asset& asset = at->second;
+    if (is_new) {
+      if (on_file_) on_file_(file, AssetReader(file));
+      try {
+        asset.imported = ImportAsset(file, {}, level_->limits);
+      } catch (const LevelError& error) {
+        throw LevelError(where_ + error.what());
+      }
+      for (std::string& warning : asset.imported.warnings) level_->warnings.push_back(warning);
+    }
+    if (drawn && asset.material_base < 0 && !asset.imported.materials.empty()) {
+      asset.material_base = AppendMaterials(asset.imported.materials, asset.imported.textures, level_);
+    }
+    return asset;
+  }
+
+  const RobotSpec& spec_;
+  const std::string& where_;
+  Level* level_;
+  const std::function<void(const fs::path&, std::string_view)>& on_file_;
+  std::map<std::string, Asset> assets_;
+  std::map<std::string, int> materials_;  // the description's colours, by name and value
+};
+
 }  // namespace
 
 void PrepareSkinning(SkinnedMesh* mesh) {
@@ -191,8 +369,7 @@ void PrepareSkinning(SkinnedMesh* mesh) {
   }
 }
 
-std::vector<int> DominantNodePerTriangle(const RobotModel& model, int mesh_index) {
-  const SkinnedMesh& mesh = model.meshes.at(static_cast<std::size_t>(mesh_index));
+std::vector<int> DominantNodePerTriangle(const RobotModel& model, const SkinnedMesh& mesh) {
   const std::vector<std::uint32_t>& indices = mesh.bind.indices;
   std::vector<int> nodes(indices.size() / 3);
   std::map<int, float> weight_of_node;
@@ -251,15 +428,30 @@ std::size_t RobotModel::num_triangles() const {
       [](std::size_t sum, const SkinnedMesh& m) { return sum + m.bind.num_triangles(); });
 }
 
-RobotModel LoadRobotModel(const RobotSpec& spec, const fs::path& manifest, Level* level) {
+RobotModel LoadRobotModel(const RobotSpec& spec, const fs::path& manifest, Level* level,
+                          const std::function<void(const fs::path&, std::string_view)>& on_file) {
+  // Messages start "manifest:line: robot 'name': " (a description given as
+  // the level itself: its own messages name it).
   const std::string where =
-      manifest.string() + ":" + std::to_string(spec.line) + ": robot '" + spec.name + "': ";
+      spec.line > 0 ? manifest.string() + ":" + std::to_string(spec.line) + ": robot '" +
+                          spec.name + "': "
+                    : "";
   RobotModel model;
   model.name = spec.name;
   model.file = spec.file;
   model.collision = spec.collision;
   model.bridge = spec.bridge;
   model.X_WB_spawn = spec.placement.pose();
+  if (IsRobotDescription(spec.file)) {
+    if (on_file) on_file(spec.file, "urdfdom");
+    DescribedRobotBuilder(spec, where, level, on_file).Build(&model);
+    if (model.meshes.empty() && model.collision_meshes.empty()) {
+      throw LevelError(where + spec.file.string() + ": no link has geometry");
+    }
+    ResolveMounts(spec, &model);
+    return model;
+  }
+  if (on_file) on_file(spec.file, AssetReader(spec.file));
 
   Assimp::Importer importer;
   AssimpScene read;
@@ -300,19 +492,7 @@ RobotModel LoadRobotModel(const RobotSpec& spec, const fs::path& manifest, Level
     throw LevelError(where + spec.file.string() + ": has no triangle meshes");
   }
 
-  // Sensor and camera mounts: a node of the robot, or its body frame.
-  for (const auto* list : {&spec.sensors, &spec.cameras}) {
-    for (SensorSpec sensor : *list) {
-      if (!sensor.mount.empty() && sensor.mount != "body") {
-        sensor.mount_node = model.FindNode(sensor.mount);
-        if (sensor.mount_node < 0) {
-          throw LevelError(sensor.Where() + "mount '" + sensor.mount + "' is not a node of " +
-                           spec.file.filename().string() + " (nodes: " + NodeList(model) + ")");
-        }
-      }
-      (list == &spec.sensors ? model.sensors : model.cameras).push_back(std::move(sensor));
-    }
-  }
+  ResolveMounts(spec, &model);
   return model;
 }
 

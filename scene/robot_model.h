@@ -8,6 +8,8 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
+#include <limits>
 #include <map>
 #include <string>
 #include <variant>
@@ -25,6 +27,7 @@ struct Level;
 enum class BoneRotation {
   kQuaternion,  // 4 values (w, x, y, z), a unit quaternion
   kAngles,      // one angle (radians) per axis, applied in order about the bone's rest axes
+  kSlide,       // one length (metres) along axes[0]: a prismatic joint (no rotation)
 };
 
 // A [[robot.sensor]] table: a sensor mounted on the robot. The scene keeps its
@@ -73,7 +76,11 @@ struct Bone {
   BoneRotation rotation{BoneRotation::kQuaternion};
   std::vector<Eigen::Vector3d> axes;  // kAngles: unit axes in the bone's rest frame
   int first_value{0};                 // where this bone's values start in the flat value vector
-  int num_values{4};                  // 4 for a quaternion, axes.size() for angles
+  int num_values{4};                  // 4 for a quaternion, axes.size() for angles, 1 to slide
+  // The range each value must be in (a joint's <limit>: radians or metres);
+  // a value outside is rejected, never clamped.
+  double lower{-std::numeric_limits<double>::infinity()};
+  double upper{std::numeric_limits<double>::infinity()};
 };
 
 // A node that moves vertices: vertex v follows X_BN(node) * offset * v.
@@ -117,6 +124,12 @@ struct RobotModel {
   int num_values{0};             // length of the flat bone value vector
   std::vector<SkinJoint> joints;
   std::vector<SkinnedMesh> meshes;  // Mesh::material indexes Level::materials
+  // What rays see, when it differs from `meshes` (a robot description's
+  // collision geometry, rigid on its links); empty: `meshes`.
+  std::vector<SkinnedMesh> collision_meshes;
+  // From a robot description (URDF): nodes are its links, bones its movable
+  // joints in the description's order.
+  bool described{false};
   // The robot body frame B from the file frame F: up axis, unit and scale.
   Eigen::Affine3d X_BF{Eigen::Affine3d::Identity()};
   Eigen::Isometry3d X_WB_spawn{Eigen::Isometry3d::Identity()};
@@ -131,9 +144,10 @@ struct RobotModel {
   std::size_t num_triangles() const;
 };
 
-// For each triangle of mesh `mesh`, the node that carries most of its
-// vertices' weight: the robot's collision body is split into rigid pieces by it.
-std::vector<int> DominantNodePerTriangle(const RobotModel& model, int mesh);
+// For each triangle of `mesh` (one of the model's), the node that carries
+// most of its vertices' weight: the robot's collision body is split into
+// rigid pieces by it.
+std::vector<int> DominantNodePerTriangle(const RobotModel& model, const SkinnedMesh& mesh);
 
 // The rigid part (rotation and translation) of a node pose whose 3x3 part is
 // a rotation times a uniform scale (as robot node poses are).
@@ -144,7 +158,11 @@ Eigen::Isometry3d RigidPart(const Eigen::Affine3d& X);
 // robot 'name': what" for an unknown bone, a bone map longer than the
 // skeleton, a bone 0 that is not the root of the others, or bones declared
 // for a file without a skeleton.
-RobotModel LoadRobotModel(const RobotSpec& spec, const std::filesystem::path& manifest,
-                          Level* level);
+// A robot description (robot_description.h) builds a node per link and a
+// bone per movable joint; its mesh files are read as the level's are.
+// `on_file` is called before each file is read (LoadOptions::on_file).
+RobotModel LoadRobotModel(
+    const RobotSpec& spec, const std::filesystem::path& manifest, Level* level,
+    const std::function<void(const std::filesystem::path&, std::string_view)>& on_file = {});
 
 }  // namespace sandbox::scene

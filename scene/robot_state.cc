@@ -15,6 +15,7 @@ RobotState::RobotState(const RobotModel& model)
     : model_(&model),
       X_WB_(model.X_WB_spawn),
       rotation_(model.nodes.size(), Eigen::Quaterniond::Identity()),
+      translation_(model.nodes.size(), Eigen::Vector3d::Zero()),
       X_BN_(model.nodes.size(), Eigen::Affine3d::Identity()),
       skin_(model.joints.size()),
       rigid_(model.joints.size()) {
@@ -55,6 +56,11 @@ std::string BoneValuesProblem(const Bone& bone, const double* values, int num_va
           1e-3) {
     return "non-unit bone quaternion";
   }
+  if (bone.rotation != BoneRotation::kQuaternion) {
+    for (int i = 0; i < num_values; ++i) {
+      if (values[i] < bone.lower || values[i] > bone.upper) return "joint value beyond its limits";
+    }
+  }
   return "";
 }
 
@@ -75,6 +81,8 @@ bool RobotState::SetBone(int bone, const double* values, int num_values) {
   Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
   if (b.rotation == BoneRotation::kQuaternion) {
     q = Eigen::Quaterniond(values[0], values[1], values[2], values[3]).normalized();
+  } else if (b.rotation == BoneRotation::kSlide) {
+    translation_[static_cast<std::size_t>(b.node)] = values[0] * b.axes[0];
   } else {
     for (std::size_t a = 0; a < b.axes.size(); ++a) {
       q = q * Eigen::Quaterniond(Eigen::AngleAxisd(values[a], b.axes[a]));
@@ -111,6 +119,7 @@ void RobotState::Update() {
     const Eigen::Affine3d& X_BP =
         node.parent < 0 ? model_->X_BF : X_BN_[static_cast<std::size_t>(node.parent)];
     X_BN_[n] = X_BP * node.X_PN;
+    X_BN_[n].translate(translation_[n]);
     X_BN_[n].linear() *= rotation_[n].toRotationMatrix();
   }
   // One skinning matrix per joint, in float.

@@ -27,7 +27,8 @@ class RobotState {
   // is counted under its reason in rejected(); the last good value stays.
   bool SetPose(const Eigen::Isometry3d& X_WB);
   // One bone of the bone map: Bone::num_values values (radians for angles,
-  // (w, x, y, z) for a quaternion, relative to the bone's rest rotation).
+  // metres for a slide, (w, x, y, z) for a quaternion, relative to the bone's
+  // rest rotation); angles and slides within the bone's limits.
   bool SetBone(int bone, const double* values, int num_values);
   // Every bone at once, flat in bone-map order (RobotModel::num_values values).
   bool SetBones(const std::vector<double>& values);
@@ -61,6 +62,7 @@ class RobotState {
   const RobotModel* model_;
   Eigen::Isometry3d X_WB_;
   std::vector<Eigen::Quaterniond> rotation_;  // per node, relative to its rest transform
+  std::vector<Eigen::Vector3d> translation_;  // per node (a slide), before its rotation
   std::vector<double> values_;                // the bone values that set rotation_
   std::vector<Eigen::Affine3d> X_BN_;
   std::vector<Eigen::Matrix<float, 3, 4>> skin_;  // per joint: X_BN * offset

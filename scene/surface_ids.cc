@@ -136,7 +136,7 @@ std::vector<int> BoneGroupOfNodes(const RobotModel& model) {
 std::vector<std::uint32_t> BoneGroupPerTriangle(const RobotModel& model, int mesh) {
   const std::vector<int> group = BoneGroupOfNodes(model);
   std::vector<std::uint32_t> out;
-  for (const int node : DominantNodePerTriangle(model, mesh)) {
+  for (const int node : DominantNodePerTriangle(model, model.meshes.at(std::size_t(mesh)))) {
     out.push_back(node >= 0 && std::size_t(node) < group.size()
                       ? std::uint32_t(group[std::size_t(node)])
                       : 0u);

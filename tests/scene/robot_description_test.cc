@@ -1,0 +1,285 @@
+// Robots from URDF: links and joints as read, forward kinematics against
+// kinematics computed here from the file's own XML (read with TinyXML, not
+// urdfdom), limits, the collision body, and bad descriptions.
+
+#include <gtest/gtest.h>
+#include <tinyxml.h>
+
+#include <cmath>
+#include <map>
+#include <random>
+#include <sstream>
+
+#include "scene/collision_world.h"
+#include "scene/level.h"
+#include "scene/robot_state.h"
+#include "tests/test_util.h"
+
+namespace sandbox::scene {
+namespace {
+
+namespace fs = std::filesystem;
+using Eigen::Isometry3d;
+using Eigen::Vector3d;
+
+fs::path BundledArm() { return fs::path(SANDBOX_SOURCE_DIR) / "assets/arm/arm.urdf"; }
+fs::path Kuka() {
+  return fs::path(SANDBOX_SHARED_ASSETS) / "kuka-iiwa/lbr_iiwa_14_r820.urdf";
+}
+
+// A joint as the XML gives it.
+struct XmlJoint {
+  std::string name, type, parent, child;
+  Isometry3d origin{Isometry3d::Identity()};
+  Vector3d axis{1, 0, 0};
+  double lower{-M_PI}, upper{M_PI};
+};
+
+Vector3d Triple(const TiXmlElement* element, const char* attribute, const Vector3d& otherwise) {
+  const char* text = element != nullptr ? element->Attribute(attribute) : nullptr;
+  if (text == nullptr) return otherwise;
+  std::istringstream in(text);
+  Vector3d v;
+  in >> v.x() >> v.y() >> v.z();
+  return v;
+}
+
+// URDF: origin = translation(xyz) * Rz(yaw) * Ry(pitch) * Rx(roll).
+std::map<std::string, XmlJoint> ReadJoints(const fs::path& file) {
+  TiXmlDocument document;
+  EXPECT_TRUE(document.LoadFile(file.string()));
+  std::map<std::string, XmlJoint> joints;  // by child link
+  for (const TiXmlElement* j = document.RootElement()->FirstChildElement("joint"); j != nullptr;
+       j = j->NextSiblingElement("joint")) {
+    XmlJoint joint;
+    joint.name = j->Attribute("name");
+    joint.type = j->Attribute("type");
+    joint.parent = j->FirstChildElement("parent")->Attribute("link");
+    joint.child = j->FirstChildElement("child")->Attribute("link");
+    const TiXmlElement* origin = j->FirstChildElement("origin");
+    const Vector3d xyz = Triple(origin, "xyz", Vector3d::Zero());
+    const Vector3d rpy = Triple(origin, "rpy", Vector3d::Zero());
+    joint.origin = Eigen::Translation3d(xyz) * Eigen::AngleAxisd(rpy.z(), Vector3d::UnitZ()) *
+                   Eigen::AngleAxisd(rpy.y(), Vector3d::UnitY()) *
+                   Eigen::AngleAxisd(rpy.x(), Vector3d::UnitX());
+    joint.axis = Triple(j->FirstChildElement("axis"), "xyz", Vector3d::UnitX()).normalized();
+    if (const TiXmlElement* limit = j->FirstChildElement("limit")) {
+      limit->QueryDoubleAttribute("lower", &joint.lower);
+      limit->QueryDoubleAttribute("upper", &joint.upper);
+    }
+    joints[joint.child] = joint;
+  }
+  return joints;
+}
+
+// The pose of `link` in the robot frame for joint values by joint name.
+Isometry3d LinkPose(const std::map<std::string, XmlJoint>& joints, const std::string& link,
+                    const std::map<std::string, double>& q) {
+  const auto joint = joints.find(link);
+  if (joint == joints.end()) return Isometry3d::Identity();  // the root
+  const XmlJoint& j = joint->second;
+  Isometry3d motion = Isometry3d::Identity();
+  const double value = q.count(j.name) > 0 ? q.at(j.name) : 0.0;
+  if (j.type == "prismatic") {
+    motion = Eigen::Translation3d(value * j.axis);
+  } else if (j.type != "fixed") {
+    motion = Eigen::AngleAxisd(value, j.axis);
+  }
+  return LinkPose(joints, j.parent, q) * j.origin * motion;
+}
+
+// Sets ten random joint vectors within the limits and compares every link's
+// pose with the independent kinematics.
+void ExpectKinematicsAgree(const fs::path& file) {
+  const Level level = LoadLevel(file);
+  ASSERT_EQ(level.robots.size(), 1u);
+  const RobotModel& model = level.robots[0];
+  const std::map<std::string, XmlJoint> joints = ReadJoints(file);
+  RobotState state(model);
+  std::mt19937 random(7);
+  for (int trial = 0; trial < 10; ++trial) {
+    std::map<std::string, double> q;
+    for (std::size_t b = 0; b < model.bones.size(); ++b) {
+      const XmlJoint& j = joints.at(model.nodes[std::size_t(model.bones[b].node)].name);
+      ASSERT_EQ(j.name, model.bones[b].name);
+      const double lower = j.type == "continuous" ? -6.0 : j.lower;
+      const double upper = j.type == "continuous" ? 6.0 : j.upper;
+      q[j.name] = std::uniform_real_distribution<double>(lower, upper)(random);
+      ASSERT_TRUE(state.SetBone(int(b), &q[j.name], 1)) << state.last_rejection();
+    }
+    state.Update();
+    for (std::size_t n = 0; n < model.nodes.size(); ++n) {
+      const Isometry3d expected = LinkPose(joints, model.nodes[n].name, q);
+      const Eigen::Affine3d& got = state.node_poses_B()[n];
+      EXPECT_LT((got.translation() - expected.translation()).norm(), 1e-9)
+          << model.nodes[n].name << " trial " << trial;
+      EXPECT_LT((got.linear() - expected.linear()).norm(), 1e-9) << model.nodes[n].name;
+    }
+  }
+}
+
+TEST(RobotDescriptionTest, BundledArmReadsLinksJointsLimitsAndIgnoredElements) {
+  const Level level = LoadLevel(BundledArm());
+  ASSERT_EQ(level.robots.size(), 1u);
+  const RobotModel& arm = level.robots[0];
+  EXPECT_TRUE(arm.described);
+  EXPECT_EQ(arm.name, "arm");
+  ASSERT_EQ(arm.nodes.size(), 7u);
+  EXPECT_EQ(arm.nodes[0].name, "base");
+  EXPECT_EQ(arm.nodes[0].parent, -1);
+  const std::map<std::string, XmlJoint> joints = ReadJoints(BundledArm());
+  ASSERT_EQ(arm.bones.size(), 5u);  // six joints, one fixed
+  for (const Bone& bone : arm.bones) {
+    const XmlJoint& j = joints.at(arm.nodes[std::size_t(bone.node)].name);
+    EXPECT_EQ(bone.name, j.name);
+    EXPECT_EQ(arm.nodes[std::size_t(arm.nodes[std::size_t(bone.node)].parent)].name, j.parent);
+    EXPECT_LT((bone.axes[0] - j.axis).norm(), 1e-12);
+    EXPECT_EQ(bone.rotation,
+              j.type == "prismatic" ? BoneRotation::kSlide : BoneRotation::kAngles);
+    if (j.type == "continuous") {
+      EXPECT_TRUE(std::isinf(bone.lower) && std::isinf(bone.upper));
+    } else {
+      EXPECT_EQ(bone.lower, j.lower);
+      EXPECT_EQ(bone.upper, j.upper);
+    }
+  }
+  // Drawn: every link's visual; rays: the collision shapes (the flange has none).
+  EXPECT_EQ(arm.meshes.size(), 7u);
+  EXPECT_EQ(arm.collision_meshes.size(), 6u);
+  int inertial = 0;
+  for (const std::string& warning : level.warnings) {
+    inertial += warning.find("ignored 1 <inertial> element") != std::string::npos;
+  }
+  EXPECT_EQ(inertial, 1);
+}
+
+TEST(RobotDescriptionTest, BundledArmKinematicsAgreeWithItsXml) {
+  ExpectKinematicsAgree(BundledArm());
+}
+
+TEST(RobotDescriptionTest, KukaKinematicsAgreeWithItsXml) {
+  if (!fs::exists(Kuka())) GTEST_SKIP() << "no " << Kuka();
+  const Level level = LoadLevel(Kuka());
+  EXPECT_EQ(level.robots.at(0).nodes.size(), 10u);  // urdfdom: 10 links, 9 joints
+  EXPECT_EQ(level.robots.at(0).bones.size(), 7u);
+  ExpectKinematicsAgree(Kuka());
+}
+
+TEST(RobotDescriptionTest, ValuesBeyondLimitsAreRejectedAndCountedNeverClamped) {
+  const Level level = LoadLevel(BundledArm());
+  const RobotModel& arm = level.robots[0];
+  RobotState state(arm);
+  const int shoulder = arm.FindBone("shoulder"), extend = arm.FindBone("extend");
+  const int yaw = arm.FindBone("base_yaw");
+  const double good = 0.5, over = 1.5000001, nan = std::nan(""), slide = 0.2, turns = 20.0;
+  EXPECT_TRUE(state.SetBone(shoulder, &good, 1));
+  EXPECT_FALSE(state.SetBone(shoulder, &over, 1));
+  EXPECT_FALSE(state.SetBone(shoulder, &nan, 1));
+  EXPECT_FALSE(state.SetBone(extend, &slide, 1));
+  EXPECT_TRUE(state.SetBone(yaw, &turns, 1));  // continuous: no limits
+  EXPECT_EQ(state.rejected().at("joint value beyond its limits"), 2);
+  EXPECT_EQ(state.rejected().at("non-finite bone value"), 1);
+  EXPECT_EQ(state.bone_values()[std::size_t(arm.bones[std::size_t(shoulder)].first_value)], good);
+}
+
+TEST(RobotDescriptionTest, CollisionBodyFollowsTheLinksCollisionShapes) {
+  const Level level = LoadLevel(BundledArm());
+  const RobotModel& arm = level.robots[0];
+  CollisionWorld world(level);
+  RobotState state(arm);
+  // The forearm level (0.4 - 0.3 - 0.1 about y), so that the wrist's sphere
+  // is the highest thing over its centre.
+  const std::map<std::string, double> q = {
+      {"base_yaw", 0.7}, {"shoulder", 0.4}, {"elbow", -0.1}, {"extend", 0.1}, {"wrist_roll", 1.0}};
+  for (const auto& [name, value] : q) ASSERT_TRUE(state.SetBone(arm.FindBone(name), &value, 1));
+  state.Update();
+  world.UpdateRobot(0, state);
+  // Straight down onto the wrist's sphere (radius 0.04) from 1 m above its centre.
+  const Vector3d centre = LinkPose(ReadJoints(BundledArm()), "wrist", q).translation();
+  const auto hit = world.CastRay(centre + Vector3d(0, 0, 1), centre);
+  ASSERT_TRUE(hit);
+  EXPECT_EQ(hit->robot, 0);
+  // The sphere's polygon lies inside the radius by at most 1 - cos(pi / 16).
+  EXPECT_NEAR(hit->distance_m, 1.0 - 0.04, 0.04 * (1.0 - std::cos(M_PI / 16)) + 1e-6);
+  // The flange (a disc from x = 0 to 0.02 of its frame, where the wrist's
+  // sphere ends) has no collision shape: a ray into it finds nothing.
+  const Isometry3d flange = LinkPose(ReadJoints(BundledArm()), "flange", q);
+  EXPECT_FALSE(world.CastRay(flange * Vector3d(0.5, 0, 0), flange * Vector3d(0.015, 0, 0)));
+  EXPECT_TRUE(world.CastRay(flange * Vector3d(0.5, 0, 0), flange * Vector3d(-0.01, 0, 0)));
+}
+
+// A bad description: the error names the file and what is wrong.
+void ExpectRefused(const std::string& xml, const std::vector<std::string>& parts,
+                   const std::string& name = "bad.urdf") {
+  const testing::TempDir dir;
+  const fs::path file = dir.Write(name, xml);
+  try {
+    LoadLevel(file);
+    ADD_FAILURE() << "loaded: " << xml;
+  } catch (const LevelError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find(file.string()), std::string::npos) << message;
+    for (const std::string& part : parts) {
+      EXPECT_NE(message.find(part), std::string::npos) << "'" << part << "' not in: " << message;
+    }
+  }
+}
+
+std::string Robot(const std::string& body) {
+  return "<?xml version=\"1.0\"?>\n<robot name=\"r\">\n" + body + "</robot>\n";
+}
+const std::string kBox = "<visual><geometry><box size=\"1 1 1\"/></geometry></visual>";
+
+TEST(RobotDescriptionTest, BadDescriptionsAreRefusedNamingFileAndElement) {
+  ExpectRefused("<robot name=\"r\">\n<link name=\"a\">\n</robot>", {":3: malformed XML"});
+  ExpectRefused(Robot("<link name=\"a\">" + kBox + "</link><link name=\"a\">" + kBox + "</link>"),
+                {"not a valid URDF", "a"});
+  ExpectRefused(Robot("<link name=\"a\">" + kBox + "</link><link name=\"b\">" + kBox +
+                      "</link><joint name=\"j\" type=\"fixed\"><parent link=\"a\"/><child "
+                      "link=\"b\"/></joint><joint name=\"k\" type=\"fixed\"><parent "
+                      "link=\"b\"/><child link=\"a\"/></joint>"),
+                {"not a valid URDF"});
+  ExpectRefused(Robot("<link name=\"a\">" + kBox + "</link><link name=\"b\">" + kBox +
+                      "</link><joint name=\"j\" type=\"revolute\"><parent link=\"a\"/><child "
+                      "link=\"b\"/><limit lower=\"1\" upper=\"-1\" effort=\"1\" "
+                      "velocity=\"1\"/></joint>"),
+                {"joint 'j'", "lower 1", "above upper"});
+  ExpectRefused(Robot("<link name=\"a\"><visual><geometry><mesh "
+                      "filename=\"package://no_such_package/m.stl\"/></geometry></visual></link>"),
+                {"link 'a' visual", "package://no_such_package/m.stl", "searched", "no_such_package"});
+  ExpectRefused(Robot("<link name=\"a\"><visual><geometry><mesh "
+                      "filename=\"meshes/missing.stl\"/></geometry></visual></link>"),
+                {"link 'a' visual", "meshes/missing.stl", "not found"});
+  ExpectRefused(Robot("<link name=\"a\"><visual><geometry><box size=\"1 0 1\"/>"
+                      "</geometry></visual></link>"),
+                {"link 'a' visual", "box size must be positive"});
+  ExpectRefused(Robot("<link name=\"a\"/>"), {"no link has geometry"});
+}
+
+TEST(RobotDescriptionTest, PackageUrisResolveByFolderNameOrPackageXml) {
+  const testing::TempDir dir;
+  // A package folder named otherwise, found by its package.xml beside the robot.
+  dir.Write("ws/src/arm_pkg/package.xml", "<package><name>my_arm</name></package>");
+  const std::string stl_text =
+      "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+      "endloop\nendfacet\nendsolid t\n";
+  dir.Write("ws/src/arm_pkg/meshes/part.stl", stl_text);
+  const fs::path file =
+      dir.Write("ws/src/arm_pkg/urdf/r.urdf",
+                Robot("<link name=\"a\"><visual><geometry><mesh "
+                      "filename=\"package://my_arm/meshes/part.stl\"/></geometry></visual></link>"));
+  const Level level = LoadLevel(file);
+  EXPECT_EQ(level.robots.at(0).num_triangles(), 1u);
+  // Elsewhere, by SANDBOX_RESOURCE_PATH: a folder called after the package.
+  dir.Write("elsewhere/other_pkg/m.stl", stl_text);
+  const fs::path other = dir.Write(
+      "r2.urdf", Robot("<link name=\"a\"><visual><geometry><mesh "
+                       "filename=\"package://other_pkg/m.stl\"/></geometry></visual></link>"));
+  EXPECT_THROW(LoadLevel(other), LevelError);
+  ::setenv("SANDBOX_RESOURCE_PATH", (dir.path() / "elsewhere").c_str(), 1);
+  EXPECT_EQ(LoadLevel(other).robots.at(0).num_triangles(), 1u);
+  ::unsetenv("SANDBOX_RESOURCE_PATH");
+}
+
+}  // namespace
+}  // namespace sandbox::scene
