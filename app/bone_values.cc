@@ -45,11 +45,12 @@ void ApplyBones(const std::string& spec, const RobotModel& model, RobotState* st
     std::string word;
     while (words >> word) values.push_back(ParseNumber(word, "--bones " + bone_word));
     if (static_cast<int>(values.size()) != b.num_values) {
-      throw UsageError("--bones: bone '" + b.name + "' takes " + std::to_string(b.num_values) +
-                       (b.rotation == scene::BoneRotation::kQuaternion ? " values (quaternion w x y z)"
-                        : b.rotation == scene::BoneRotation::kSlide  ? " value (metres)"
-                                                                     : " values (angles in degrees)") +
-                       ", got " + std::to_string(values.size()));
+      throw UsageError(
+          "--bones: bone '" + b.name + "' takes " + std::to_string(b.num_values) +
+          (b.rotation == scene::BoneRotation::kQuaternion ? " values (quaternion w x y z)"
+           : b.rotation == scene::BoneRotation::kSlide    ? " value (metres)"
+                                                          : " values (angles in degrees)") +
+          ", got " + std::to_string(values.size()));
     }
     if (b.rotation == scene::BoneRotation::kAngles) {
       for (double& v : values) v *= scene::kDegToRad;

@@ -30,7 +30,6 @@ const char* JointType(const scene::Bone& bone) {
   return std::isfinite(bone.lower) || std::isfinite(bone.upper) ? "revolute" : "continuous";
 }
 
-
 using scene::Level;
 
 struct LoadFigures {

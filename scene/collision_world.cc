@@ -32,7 +32,6 @@ std::vector<Eigen::Vector3f> RestPositions(const RobotModel& model, const RobotS
   return out;
 }
 
-
 Eigen::Vector3d FromBullet(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
 
 // Ray callback that skips the bodies (actors or robots) of the world it is told.
@@ -84,7 +83,7 @@ CollisionWorld::CollisionWorld(const Level& level) : impl_(std::make_unique<Impl
     w.robot_pieces.emplace_back();
     if (!model.collision) continue;
     std::map<int, std::unique_ptr<RobotPiece>> pieces;  // by node
-    const bool own = !model.collision_meshes.empty();  // else the drawn meshes
+    const bool own = !model.collision_meshes.empty();   // else the drawn meshes
     const std::vector<SkinnedMesh>& meshes = own ? model.collision_meshes : model.meshes;
     for (std::size_t m = 0; m < meshes.size(); ++m) {
       const std::vector<int> node_of = DominantNodePerTriangle(model, meshes[m]);

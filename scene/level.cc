@@ -268,8 +268,8 @@ Level LoadLevel(const fs::path& file, const LoadOptions& options) {
     throw LevelError(file.string() + ": " + problem);
   }
   Level level = LowerExtension(file) == ".toml" ? LoadManifest(file, options)
-                : IsRobotDescription(file)       ? LoadDescriptionFile(file, options)
-                                                 : LoadSceneFile(file, options);
+                : IsRobotDescription(file)      ? LoadDescriptionFile(file, options)
+                                                : LoadSceneFile(file, options);
   CheckTriangles(file, level);
   for (Actor& actor : level.actors) ComputeBounds(&actor);
   if (level.horizon && level.horizon->hole_W.isEmpty() && !level.bounds_W().isEmpty()) {

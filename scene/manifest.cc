@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "scene/files.h"
+#include "scene/robot_description.h"
 
 namespace sandbox::scene {
 namespace {
@@ -348,8 +349,16 @@ RobotSpec ParseRobot(const fs::path& file, const toml::table& table, int index) 
   TableReader read(file, table, "robot '" + robot.name + "': ");
   read.Find("name");
   const std::optional<std::string> model = read.Text("file");
-  if (!model) read.Fail(nullptr, "'file' is required");
-  robot.file = AssetPath(file, *model);
+  const std::optional<std::string> description = read.Text("description");
+  if (model && description)
+    read.Fail(read.Find("description"), "give 'file' or 'description', not both");
+  if (!model && !description)
+    read.Fail(nullptr, "'file' (a model) or 'description' (URDF) is required");
+  robot.file = AssetPath(file, model ? *model : *description);
+  if (description && !IsRobotDescription(robot.file)) {
+    read.Fail(read.Find("description"),
+              "'description' must be a robot description (.urdf), got '" + *description + "'");
+  }
   robot.placement = ParsePlacement(read);
   robot.collision = read.Flag("collision").value_or(true);
 

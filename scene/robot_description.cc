@@ -1,9 +1,8 @@
 #include "scene/robot_description.h"
 
+#include <console_bridge/console.h>
 #include <tinyxml.h>
 #include <urdf_parser/urdf_parser.h>
-
-#include <console_bridge/console.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -42,10 +41,10 @@ std::string Joined(const std::vector<std::string>& lines) {
 Eigen::Isometry3d ToEigen(const urdf::Pose& pose) {
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
   X.translation() = Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z);
-  X.linear() = Eigen::Quaterniond(pose.rotation.w, pose.rotation.x, pose.rotation.y,
-                                  pose.rotation.z)
-                   .normalized()
-                   .toRotationMatrix();
+  X.linear() =
+      Eigen::Quaterniond(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z)
+          .normalized()
+          .toRotationMatrix();
   return X;
 }
 
@@ -162,8 +161,10 @@ fs::path ResolveResourceUri(const std::string& uri, const fs::path& describing_f
     const std::string rest = uri.substr(prefix.size());
     const std::size_t slash = rest.find('/');
     const std::string name = rest.substr(0, slash);
-    const fs::path inside = slash == std::string::npos ? fs::path() : fs::path(rest.substr(slash + 1));
-    if (name.empty()) throw LevelError("'" + uri + "' names no " + prefix.substr(0, prefix.size() - 3));
+    const fs::path inside =
+        slash == std::string::npos ? fs::path() : fs::path(rest.substr(slash + 1));
+    if (name.empty())
+      throw LevelError("'" + uri + "' names no " + prefix.substr(0, prefix.size() - 3));
     std::vector<fs::path> searched;
     // A package or model folder under (or being) `dir`.
     auto look = [&](const fs::path& dir) -> std::optional<fs::path> {
@@ -183,7 +184,8 @@ fs::path ResolveResourceUri(const std::string& uri, const fs::path& describing_f
       if (dir == dir.parent_path()) break;
     }
     for (const char* variable :
-         {"SANDBOX_RESOURCE_PATH", prefix == "package://" ? "ROS_PACKAGE_PATH" : "GZ_SIM_RESOURCE_PATH"}) {
+         {"SANDBOX_RESOURCE_PATH",
+          prefix == "package://" ? "ROS_PACKAGE_PATH" : "GZ_SIM_RESOURCE_PATH"}) {
       for (const fs::path& dir : PathList(variable)) places.push_back(dir);
     }
     for (const fs::path& dir : places) {
@@ -235,7 +237,8 @@ RobotDescription ReadRobotDescription(const fs::path& file) {
   RobotDescription out;
   out.file = file;
   out.name = model->getName();
-  for (const std::string& line : messages.lines) out.warnings.push_back(file.string() + ": " + line);
+  for (const std::string& line : messages.lines)
+    out.warnings.push_back(file.string() + ": " + line);
   WarnIgnored(file, xml, &out.warnings);
 
   // Depth first from the root: parents before children.
@@ -247,14 +250,16 @@ RobotDescription ReadRobotDescription(const fs::path& file) {
     const urdf::JointConstSharedPtr joint = via.back();
     stack.pop_back(), via.pop_back();
     if (!index_of.emplace(link->name, int(out.links.size())).second) {
-      throw LevelError(file.string() + ": link '" + link->name + "' is reached twice (a joint loop)");
+      throw LevelError(file.string() + ": link '" + link->name +
+                       "' is reached twice (a joint loop)");
     }
     DescribedLink described;
     described.name = link->name;
     const std::string where = "link '" + link->name + "'";
     for (const urdf::VisualSharedPtr& visual : link->visual_array) {
       if (visual == nullptr || visual->geometry == nullptr) continue;
-      LinkGeometry geometry = ConvertGeometry(*visual->geometry, visual->origin, file, where + " visual");
+      LinkGeometry geometry =
+          ConvertGeometry(*visual->geometry, visual->origin, file, where + " visual");
       if (visual->material != nullptr) {
         const urdf::Color& c = visual->material->color;
         geometry.rgba = Eigen::Vector4f(c.r, c.g, c.b, c.a);
@@ -276,13 +281,22 @@ RobotDescription ReadRobotDescription(const fs::path& file) {
       j.X_PC = ToEigen(joint->parent_to_joint_origin_transform);
       const std::string at = file.string() + ": joint '" + joint->name + "': ";
       switch (joint->type) {
-        case urdf::Joint::REVOLUTE: j.type = DescribedJoint::Type::kRevolute; break;
-        case urdf::Joint::CONTINUOUS: j.type = DescribedJoint::Type::kContinuous; break;
-        case urdf::Joint::PRISMATIC: j.type = DescribedJoint::Type::kPrismatic; break;
-        case urdf::Joint::FIXED: j.type = DescribedJoint::Type::kFixed; break;
+        case urdf::Joint::REVOLUTE:
+          j.type = DescribedJoint::Type::kRevolute;
+          break;
+        case urdf::Joint::CONTINUOUS:
+          j.type = DescribedJoint::Type::kContinuous;
+          break;
+        case urdf::Joint::PRISMATIC:
+          j.type = DescribedJoint::Type::kPrismatic;
+          break;
+        case urdf::Joint::FIXED:
+          j.type = DescribedJoint::Type::kFixed;
+          break;
         default:
-          out.warnings.push_back(at + "a floating or planar joint is held fixed (its value is the "
-                                      "robot's pose, or not supported)");
+          out.warnings.push_back(at +
+                                 "a floating or planar joint is held fixed (its value is the "
+                                 "robot's pose, or not supported)");
           j.type = DescribedJoint::Type::kFixed;
       }
       if (j.moves()) {
@@ -310,7 +324,8 @@ RobotDescription ReadRobotDescription(const fs::path& file) {
     }
   }
   if (out.links.size() != model->links_.size()) {
-    throw LevelError(file.string() + ": " + std::to_string(model->links_.size() - out.links.size()) +
+    throw LevelError(file.string() + ": " +
+                     std::to_string(model->links_.size() - out.links.size()) +
                      " links are not connected to the root link '" + out.links[0].name + "'");
   }
   return out;

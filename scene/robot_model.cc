@@ -208,7 +208,7 @@ class DescribedRobotBuilder {
       bone.name = joint.name;
       bone.node = joint.child;
       bone.rotation = joint.type == DescribedJoint::Type::kPrismatic ? BoneRotation::kSlide
-                                                                      : BoneRotation::kAngles;
+                                                                     : BoneRotation::kAngles;
       bone.axes = {joint.axis};
       bone.first_value = model->num_values;
       bone.num_values = 1;
@@ -302,7 +302,8 @@ class DescribedRobotBuilder {
       for (std::string& warning : asset.imported.warnings) level_->warnings.push_back(warning);
     }
     if (drawn && asset.material_base < 0 && !asset.imported.materials.empty()) {
-      asset.material_base = AppendMaterials(asset.imported.materials, asset.imported.textures, level_);
+      asset.material_base =
+          AppendMaterials(asset.imported.materials, asset.imported.textures, level_);
     }
     return asset;
   }
@@ -432,10 +433,9 @@ RobotModel LoadRobotModel(const RobotSpec& spec, const fs::path& manifest, Level
                           const std::function<void(const fs::path&, std::string_view)>& on_file) {
   // Messages start "manifest:line: robot 'name': " (a description given as
   // the level itself: its own messages name it).
-  const std::string where =
-      spec.line > 0 ? manifest.string() + ":" + std::to_string(spec.line) + ": robot '" +
-                          spec.name + "': "
-                    : "";
+  const std::string where = spec.line > 0 ? manifest.string() + ":" + std::to_string(spec.line) +
+                                                ": robot '" + spec.name + "': "
+                                          : "";
   RobotModel model;
   model.name = spec.name;
   model.file = spec.file;

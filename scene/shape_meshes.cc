@@ -63,7 +63,8 @@ Mesh CylinderMesh(double radius, double length, int segments) {
       AddVertex(&mesh, Eigen::Vector3d(radius * std::cos(a), radius * std::sin(a), sign * h), n);
     }
     for (int s = 0; s < segments; ++s) {
-      const std::uint32_t i = first + std::uint32_t(s), j = first + std::uint32_t((s + 1) % segments);
+      const std::uint32_t i = first + std::uint32_t(s),
+                          j = first + std::uint32_t((s + 1) % segments);
       if (sign > 0.0) {
         AddTriangle(&mesh, centre, i, j);
       } else {

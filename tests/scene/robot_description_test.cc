@@ -23,9 +23,7 @@ using Eigen::Isometry3d;
 using Eigen::Vector3d;
 
 fs::path BundledArm() { return fs::path(SANDBOX_SOURCE_DIR) / "assets/arm/arm.urdf"; }
-fs::path Kuka() {
-  return fs::path(SANDBOX_SHARED_ASSETS) / "kuka-iiwa/lbr_iiwa_14_r820.urdf";
-}
+fs::path Kuka() { return fs::path(SANDBOX_SHARED_ASSETS) / "kuka-iiwa/lbr_iiwa_14_r820.urdf"; }
 
 // A joint as the XML gives it.
 struct XmlJoint {
@@ -134,8 +132,7 @@ TEST(RobotDescriptionTest, BundledArmReadsLinksJointsLimitsAndIgnoredElements) {
     EXPECT_EQ(bone.name, j.name);
     EXPECT_EQ(arm.nodes[std::size_t(arm.nodes[std::size_t(bone.node)].parent)].name, j.parent);
     EXPECT_LT((bone.axes[0] - j.axis).norm(), 1e-12);
-    EXPECT_EQ(bone.rotation,
-              j.type == "prismatic" ? BoneRotation::kSlide : BoneRotation::kAngles);
+    EXPECT_EQ(bone.rotation, j.type == "prismatic" ? BoneRotation::kSlide : BoneRotation::kAngles);
     if (j.type == "continuous") {
       EXPECT_TRUE(std::isinf(bone.lower) && std::isinf(bone.upper));
     } else {
@@ -244,9 +241,10 @@ TEST(RobotDescriptionTest, BadDescriptionsAreRefusedNamingFileAndElement) {
                       "link=\"b\"/><limit lower=\"1\" upper=\"-1\" effort=\"1\" "
                       "velocity=\"1\"/></joint>"),
                 {"joint 'j'", "lower 1", "above upper"});
-  ExpectRefused(Robot("<link name=\"a\"><visual><geometry><mesh "
-                      "filename=\"package://no_such_package/m.stl\"/></geometry></visual></link>"),
-                {"link 'a' visual", "package://no_such_package/m.stl", "searched", "no_such_package"});
+  ExpectRefused(
+      Robot("<link name=\"a\"><visual><geometry><mesh "
+            "filename=\"package://no_such_package/m.stl\"/></geometry></visual></link>"),
+      {"link 'a' visual", "package://no_such_package/m.stl", "searched", "no_such_package"});
   ExpectRefused(Robot("<link name=\"a\"><visual><geometry><mesh "
                       "filename=\"meshes/missing.stl\"/></geometry></visual></link>"),
                 {"link 'a' visual", "meshes/missing.stl", "not found"});
@@ -264,10 +262,10 @@ TEST(RobotDescriptionTest, PackageUrisResolveByFolderNameOrPackageXml) {
       "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
       "endloop\nendfacet\nendsolid t\n";
   dir.Write("ws/src/arm_pkg/meshes/part.stl", stl_text);
-  const fs::path file =
-      dir.Write("ws/src/arm_pkg/urdf/r.urdf",
-                Robot("<link name=\"a\"><visual><geometry><mesh "
-                      "filename=\"package://my_arm/meshes/part.stl\"/></geometry></visual></link>"));
+  const fs::path file = dir.Write(
+      "ws/src/arm_pkg/urdf/r.urdf",
+      Robot("<link name=\"a\"><visual><geometry><mesh "
+            "filename=\"package://my_arm/meshes/part.stl\"/></geometry></visual></link>"));
   const Level level = LoadLevel(file);
   EXPECT_EQ(level.robots.at(0).num_triangles(), 1u);
   // Elsewhere, by SANDBOX_RESOURCE_PATH: a folder called after the package.
@@ -279,6 +277,35 @@ TEST(RobotDescriptionTest, PackageUrisResolveByFolderNameOrPackageXml) {
   ::setenv("SANDBOX_RESOURCE_PATH", (dir.path() / "elsewhere").c_str(), 1);
   EXPECT_EQ(LoadLevel(other).robots.at(0).num_triangles(), 1u);
   ::unsetenv("SANDBOX_RESOURCE_PATH");
+}
+
+TEST(RobotDescriptionTest, ManifestPlacesADescriptionAndMountsSensorsOnLinks) {
+  const testing::TempDir dir;
+  const std::string arm = BundledArm().string();
+  const fs::path manifest =
+      dir.Write("level.toml", "[[robot]]\nname = \"left\"\ndescription = \"" + arm +
+                                  "\"\nposition = [1, 2, 0]\n"
+                                  "[[robot.sensor]]\nname = \"probe\"\n"
+                                  "type = \"ray\"\nmount = \"wrist\"\n");
+  const Level level = LoadLevel(manifest);
+  const RobotModel& left = level.robots.at(0);
+  EXPECT_EQ(left.name, "left");
+  EXPECT_EQ(left.X_WB_spawn.translation(), Vector3d(1, 2, 0));
+  EXPECT_EQ(left.sensors.at(0).mount_node, left.FindNode("wrist"));
+  // 'description' takes descriptions only; a mount must be a link.
+  const fs::path gltf =
+      dir.Write("bad.toml", "[[robot]]\nname = \"r\"\ndescription = \"x.gltf\"\n");
+  EXPECT_THROW(LoadLevel(gltf), LevelError);
+  const fs::path mount = dir.Write("mount.toml", "[[robot]]\nname = \"r\"\ndescription = \"" + arm +
+                                                     "\"\n[[robot.sensor]]\nname = \"p\"\n"
+                                                     "type = \"ray\"\nmount = \"elbow\"\n");
+  try {
+    LoadLevel(mount);
+    ADD_FAILURE() << "mount on a joint's name loaded";
+  } catch (const LevelError& error) {
+    EXPECT_NE(std::string(error.what()).find("mount 'elbow' is not a node"), std::string::npos)
+        << error.what();
+  }
 }
 
 }  // namespace
