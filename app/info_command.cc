@@ -1,5 +1,6 @@
 #include "app/info_command.h"
 
+#include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -23,6 +24,17 @@
 
 namespace sandbox::app {
 namespace {
+
+// The link a described robot's joint moves: its bone's node, or the node
+// hanging from it (a joint turning about a point off its link's origin).
+const std::string& MovedLink(const scene::RobotModel& r, const scene::Bone& bone) {
+  const std::string& name = r.nodes[std::size_t(bone.node)].name;
+  if (std::find(r.links.begin(), r.links.end(), name) != r.links.end()) return name;
+  for (const scene::RobotNode& node : r.nodes) {
+    if (node.parent == bone.node) return node.name;
+  }
+  return name;
+}
 
 // A robot description's joint kind, from its bone.
 const char* JointType(const scene::Bone& bone) {
@@ -129,20 +141,20 @@ void PrintJson(const Level& level, const std::vector<sensors::MountedSensor>& se
         << ", \"spawn_position\": " << JsonVector(r.X_WB_spawn.translation());
     if (r.described) {
       out << ", \"links\": [";
-      for (std::size_t n = 0; n < r.nodes.size(); ++n) {
-        out << (n > 0 ? ", " : "") << JsonString(r.nodes[n].name);
+      for (std::size_t n = 0; n < r.links.size(); ++n) {
+        out << (n > 0 ? ", " : "") << JsonString(r.links[n]);
       }
       out << "], \"joints\": [";
       for (std::size_t b = 0; b < r.bones.size(); ++b) {
         const scene::Bone& bone = r.bones[b];
-        const scene::RobotNode& link = r.nodes[std::size_t(bone.node)];
+        const scene::RobotNode& moving = r.nodes[std::size_t(bone.node)];
         auto limit = [](double value) {
           return std::isfinite(value) ? std::to_string(value) : std::string("null");
         };
         out << (b > 0 ? ", " : "") << "{\"name\": " << JsonString(bone.name)
             << ", \"type\": " << JsonString(JointType(bone))
-            << ", \"link\": " << JsonString(link.name)
-            << ", \"parent\": " << JsonString(r.nodes[std::size_t(link.parent)].name)
+            << ", \"link\": " << JsonString(MovedLink(r, bone))
+            << ", \"parent\": " << JsonString(r.nodes[std::size_t(moving.parent)].name)
             << ", \"axis\": " << JsonVector(bone.axes[0]) << ", \"lower\": " << limit(bone.lower)
             << ", \"upper\": " << limit(bone.upper) << "}";
       }
@@ -228,15 +240,15 @@ void PrintText(const Level& level, const std::vector<sensors::MountedSensor>& se
         << ")\n";
     if (r.described) {
       out << "  links:";
-      for (const scene::RobotNode& node : r.nodes) out << " " << node.name;
+      for (const std::string& link : r.links) out << " " << link;
       out << "\n";
       for (std::size_t b = 0; b < r.bones.size(); ++b) {
         const scene::Bone& bone = r.bones[b];
-        const scene::RobotNode& link = r.nodes[std::size_t(bone.node)];
+        const scene::RobotNode& moving = r.nodes[std::size_t(bone.node)];
         const Eigen::Vector3d& axis = bone.axes[0];
         out << "  joint " << b << " " << bone.name << ": " << JointType(bone) << ", moves "
-            << link.name << " on " << r.nodes[std::size_t(link.parent)].name << ", axis ("
-            << axis.x() << ", " << axis.y() << ", " << axis.z() << ")";
+            << MovedLink(r, bone) << " on " << r.nodes[std::size_t(moving.parent)].name
+            << ", axis (" << axis.x() << ", " << axis.y() << ", " << axis.z() << ")";
         if (std::isfinite(bone.lower) || std::isfinite(bone.upper)) {
           out << std::setprecision(4) << ", limits " << bone.lower << " .. " << bone.upper
               << (bone.rotation == scene::BoneRotation::kSlide ? " m" : " rad")

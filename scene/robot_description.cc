@@ -71,36 +71,6 @@ std::vector<fs::path> PathList(const char* variable) {
   return out;
 }
 
-// The ignored elements of a description, one warning per kind found.
-void WarnIgnored(const fs::path& file, const std::string& xml, std::vector<std::string>* out) {
-  static const std::map<std::string, std::string> kIgnored = {
-      {"inertial", "the sandbox does not simulate dynamics"},
-      {"dynamics", "the sandbox does not simulate dynamics"},
-      {"transmission", "actuators are the publisher's business"},
-      {"gazebo", "Gazebo extensions"},
-      {"safety_controller", "joint values are only checked against <limit>"},
-      {"calibration", "joint values are taken as given"},
-      {"mimic", "every joint takes its own value"}};
-  TiXmlDocument document;
-  document.Parse(xml.c_str());
-  std::map<std::string, int> found;
-  std::vector<const TiXmlElement*> stack;
-  if (document.RootElement() != nullptr) stack.push_back(document.RootElement());
-  while (!stack.empty()) {
-    const TiXmlElement* element = stack.back();
-    stack.pop_back();
-    if (kIgnored.count(element->Value()) > 0) ++found[element->Value()];
-    for (const TiXmlElement* child = element->FirstChildElement(); child != nullptr;
-         child = child->NextSiblingElement()) {
-      stack.push_back(child);
-    }
-  }
-  for (const auto& [name, count] : found) {
-    out->push_back(file.string() + ": ignored " + std::to_string(count) + " <" + name +
-                   "> element" + (count > 1 ? "s" : "") + " (" + kIgnored.at(name) + ")");
-  }
-}
-
 LinkGeometry ConvertGeometry(const urdf::Geometry& geometry, const urdf::Pose& origin,
                              const fs::path& file, const std::string& where) {
   LinkGeometry out;
@@ -151,7 +121,42 @@ LinkGeometry ConvertGeometry(const urdf::Geometry& geometry, const urdf::Pose& o
 
 }  // namespace
 
-bool IsRobotDescription(const fs::path& file) { return LowerExtension(file) == ".urdf"; }
+bool IsRobotDescription(const fs::path& file) {
+  const std::string extension = LowerExtension(file);
+  return extension == ".urdf" || extension == ".sdf";
+}
+
+RobotDescription ReadRobotDescription(const fs::path& file) {
+  if (const std::string problem = RegularFileProblem(file); !problem.empty()) {
+    throw LevelError(file.string() + ": " + problem);
+  }
+  return LowerExtension(file) == ".sdf" ? ReadSdf(file) : ReadUrdf(file);
+}
+
+void WarnIgnoredElements(const fs::path& file, const std::string& xml,
+                         const std::vector<std::pair<std::string, std::string>>& ignored,
+                         std::vector<std::string>* out) {
+  TiXmlDocument document;
+  document.Parse(xml.c_str());
+  std::map<std::string, int> found;
+  std::vector<const TiXmlElement*> stack;
+  if (document.RootElement() != nullptr) stack.push_back(document.RootElement());
+  while (!stack.empty()) {
+    const TiXmlElement* element = stack.back();
+    stack.pop_back();
+    ++found[element->Value()];
+    for (const TiXmlElement* child = element->FirstChildElement(); child != nullptr;
+         child = child->NextSiblingElement()) {
+      stack.push_back(child);
+    }
+  }
+  for (const auto& [name, why] : ignored) {
+    const auto count = found.find(name);
+    if (count == found.end()) continue;
+    out->push_back(file.string() + ": ignored " + std::to_string(count->second) + " <" + name +
+                   "> element" + (count->second > 1 ? "s" : "") + " (" + why + ")");
+  }
+}
 
 fs::path ResolveResourceUri(const std::string& uri, const fs::path& describing_file) {
   const fs::path folder = describing_file.parent_path();
@@ -205,10 +210,7 @@ fs::path ResolveResourceUri(const std::string& uri, const fs::path& describing_f
   return path;
 }
 
-RobotDescription ReadRobotDescription(const fs::path& file) {
-  if (const std::string problem = RegularFileProblem(file); !problem.empty()) {
-    throw LevelError(file.string() + ": " + problem);
-  }
+RobotDescription ReadUrdf(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
   std::stringstream text;
   text << in.rdbuf();
@@ -239,7 +241,15 @@ RobotDescription ReadRobotDescription(const fs::path& file) {
   out.name = model->getName();
   for (const std::string& line : messages.lines)
     out.warnings.push_back(file.string() + ": " + line);
-  WarnIgnored(file, xml, &out.warnings);
+  WarnIgnoredElements(file, xml,
+                      {{"inertial", "the sandbox does not simulate dynamics"},
+                       {"dynamics", "the sandbox does not simulate dynamics"},
+                       {"transmission", "actuators are the publisher's business"},
+                       {"gazebo", "Gazebo extensions"},
+                       {"safety_controller", "joint values are only checked against <limit>"},
+                       {"calibration", "joint values are taken as given"},
+                       {"mimic", "every joint takes its own value"}},
+                      &out.warnings);
 
   // Depth first from the root: parents before children.
   std::map<std::string, int> index_of;

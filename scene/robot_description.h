@@ -1,12 +1,13 @@
 #pragma once
-// A robot description file (URDF, read with urdfdom) as links and joints:
-// what the robot model is built from (robot_model.h). Scene-internal.
+// A robot description file (URDF read with urdfdom, SDF with sdformat) as
+// links and joints: what the robot model is built from (robot_model.h).
+// Scene-internal.
 //
 // Read: links with their visual and collision geometry (meshes by URI, boxes,
 // cylinders, spheres) and material colours; joints (revolute, continuous,
-// prismatic, fixed) with origins, axes and limits. Ignored, with one warning
-// per kind of element found: inertia, transmissions, Gazebo extensions,
-// dynamics, safety controllers, calibration, mimic joints.
+// prismatic, fixed) with origins, axes and limits; SDF <include>d models.
+// Ignored, with one warning per kind of element found: inertia, dynamics,
+// transmissions, Gazebo extensions and plugins, SDF sensors, ...
 
 #include <Eigen/Geometry>
 #include <filesystem>
@@ -17,7 +18,7 @@
 
 namespace sandbox::scene {
 
-// Whether `file` is a robot description by its extension (.urdf).
+// Whether `file` is a robot description by its extension (.urdf, .sdf).
 bool IsRobotDescription(const std::filesystem::path& file);
 
 // One visual or collision shape of a link, in the link's frame.
@@ -46,9 +47,11 @@ struct DescribedJoint {
   int parent{-1}, child{-1};  // indices into RobotDescription::links
   // The child link's frame in the parent's at joint value 0; the joint moves
   // the child about (revolute) or along (prismatic) `axis`, a unit vector in
-  // the child's frame through its origin.
+  // the child's frame, through the child's point `pivot` (URDF: its origin;
+  // SDF: the joint frame's).
   Eigen::Isometry3d X_PC{Eigen::Isometry3d::Identity()};
   Eigen::Vector3d axis{1.0, 0.0, 0.0};
+  Eigen::Vector3d pivot{0.0, 0.0, 0.0};
   double lower{-std::numeric_limits<double>::infinity()};  // radians or metres
   double upper{std::numeric_limits<double>::infinity()};
   bool moves() const { return type != Type::kFixed; }
@@ -62,11 +65,18 @@ struct RobotDescription {
   std::vector<std::string> warnings;   // elements read past, one line per kind
 };
 
-// Reads a URDF file. Mesh URIs are resolved by ResolveResourceUri. Throws
-// LevelError naming the file (and the element) for malformed XML, a
-// duplicate link, a joint loop or a second root, an unresolved URI (listing
-// the paths searched), an unsupported joint type, or limits lower > upper.
+// Reads a URDF or SDF file (by its extension). Mesh URIs (and SDF includes)
+// are resolved by ResolveResourceUri. Throws LevelError naming the file (and
+// the element) for malformed XML, a duplicate link, a joint loop or a second
+// root, an unresolved URI (listing the paths searched), limits lower > upper.
 RobotDescription ReadRobotDescription(const std::filesystem::path& file);
+RobotDescription ReadUrdf(const std::filesystem::path& file);
+RobotDescription ReadSdf(const std::filesystem::path& file);  // sdf_description.cc
+
+// One warning per kind of `ignored` element (name: why) found in `xml`.
+void WarnIgnoredElements(const std::filesystem::path& file, const std::string& xml,
+                         const std::vector<std::pair<std::string, std::string>>& ignored,
+                         std::vector<std::string>* warnings);
 
 // Where `uri` (package://NAME/..., model://NAME/..., file://..., or a path
 // relative to the describing file) is, given the file that names it. A

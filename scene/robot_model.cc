@@ -194,19 +194,41 @@ class DescribedRobotBuilder {
     for (std::string& warning : description.warnings) level_->warnings.push_back(warning);
     model->described = true;
     model->X_BF = Eigen::Affine3d(Eigen::Scaling(spec_.placement.scale));  // Z up, metres
-    for (const DescribedLink& link : description.links) {
+    // A node per link; a revolute joint whose axis misses its child's origin
+    // (SDF) adds a node at the pivot that turns, the link hanging from it.
+    std::vector<int> node_of_link(description.links.size(), -1);
+    auto add_node = [&](const std::string& name, int parent, const Eigen::Isometry3d& X_PN) {
       RobotNode node;
-      node.name = link.name;
+      node.name = name;
+      node.parent = parent;
+      node.X_PN = Eigen::Affine3d(X_PN.matrix());
       model->nodes.push_back(node);
-    }
+      return int(model->nodes.size()) - 1;
+    };
+    node_of_link[0] = add_node(description.links[0].name, -1, Eigen::Isometry3d::Identity());
     for (const DescribedJoint& joint : description.joints) {
-      RobotNode& child = model->nodes[std::size_t(joint.child)];
-      child.parent = joint.parent;
-      child.X_PN = Eigen::Affine3d(joint.X_PC.matrix());
+      const int parent = node_of_link[std::size_t(joint.parent)];
+      const std::string& link = description.links[std::size_t(joint.child)].name;
+      const bool pivots = joint.moves() && joint.type != DescribedJoint::Type::kPrismatic &&
+                          joint.pivot.norm() > 1e-12;
+      int moving = -1;
+      if (pivots) {
+        const std::string name =
+            description.links.end() !=
+                    std::find_if(description.links.begin(), description.links.end(),
+                                 [&](const DescribedLink& l) { return l.name == joint.name; })
+                ? joint.name + " joint"
+                : joint.name;
+        moving = add_node(name, parent, joint.X_PC * Eigen::Translation3d(joint.pivot));
+        node_of_link[std::size_t(joint.child)] =
+            add_node(link, moving, Eigen::Isometry3d(Eigen::Translation3d(-joint.pivot)));
+      } else {
+        moving = node_of_link[std::size_t(joint.child)] = add_node(link, parent, joint.X_PC);
+      }
       if (!joint.moves()) continue;
       Bone bone;
       bone.name = joint.name;
-      bone.node = joint.child;
+      bone.node = moving;
       bone.rotation = joint.type == DescribedJoint::Type::kPrismatic ? BoneRotation::kSlide
                                                                      : BoneRotation::kAngles;
       bone.axes = {joint.axis};
@@ -216,16 +238,17 @@ class DescribedRobotBuilder {
       model->num_values += 1;
       model->bones.push_back(std::move(bone));
     }
+    for (const DescribedLink& link : description.links) model->links.push_back(link.name);
     for (std::size_t l = 0; l < description.links.size(); ++l) {
       const DescribedLink& link = description.links[l];
       for (const LinkGeometry& geometry : link.visuals) {
         for (Mesh& mesh : Meshes(geometry, link.name, true)) {
-          model->meshes.push_back(RigidOnNode(std::move(mesh), int(l), model));
+          model->meshes.push_back(RigidOnNode(std::move(mesh), node_of_link[l], model));
         }
       }
       for (const LinkGeometry& geometry : link.collisions) {
         for (Mesh& mesh : Meshes(geometry, link.name, false)) {
-          model->collision_meshes.push_back(RigidOnNode(std::move(mesh), int(l), model));
+          model->collision_meshes.push_back(RigidOnNode(std::move(mesh), node_of_link[l], model));
         }
       }
     }

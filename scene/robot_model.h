@@ -127,9 +127,12 @@ struct RobotModel {
   // What rays see, when it differs from `meshes` (a robot description's
   // collision geometry, rigid on its links); empty: `meshes`.
   std::vector<SkinnedMesh> collision_meshes;
-  // From a robot description (URDF): nodes are its links, bones its movable
-  // joints in the description's order.
+  // From a robot description (URDF, SDF): its links (nodes of those names;
+  // an SDF joint turning about a point off its child's origin adds a node
+  // named after the joint) and its movable joints as bones, in the
+  // description's order.
   bool described{false};
+  std::vector<std::string> links;
   // The robot body frame B from the file frame F: up axis, unit and scale.
   Eigen::Affine3d X_BF{Eigen::Affine3d::Identity()};
   Eigen::Isometry3d X_WB_spawn{Eigen::Isometry3d::Identity()};

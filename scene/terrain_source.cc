@@ -352,7 +352,8 @@ Eigen::Vector3d TerrainSource::SampleToWorldOf(const Raster& raster, double col,
 
 Eigen::Vector3d TerrainSource::SampleToWorld(int file, int col, int row, double height_m) const {
   const Raster* raster = elevation_.at(std::size_t(file)).get();
-  if (raster == nullptr) throw std::invalid_argument("TerrainSource::SampleToWorld(): raster left out");
+  if (raster == nullptr)
+    throw std::invalid_argument("TerrainSource::SampleToWorld(): raster left out");
   return SampleToWorldOf(*raster, col, row, height_m);
 }
 

@@ -41,7 +41,8 @@ struct TerrainStreamer::Shared {
 
 TerrainStreamer::TerrainStreamer(const Level& level)
     : level_(level), shared_(std::make_unique<Shared>()) {
-  if (!level.terrain) throw std::invalid_argument("TerrainStreamer::TerrainStreamer(): the level has no terrain");
+  if (!level.terrain)
+    throw std::invalid_argument("TerrainStreamer::TerrainStreamer(): the level has no terrain");
   worker_ = std::thread([this] { Work(); });
 }
 

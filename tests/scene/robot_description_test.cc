@@ -308,5 +308,141 @@ TEST(RobotDescriptionTest, ManifestPlacesADescriptionAndMountsSensorsOnLinks) {
   }
 }
 
+fs::path Px4(const std::string& model) {
+  return fs::path(SANDBOX_SHARED_ASSETS) / "px4-sitl-models/models" / model / (model + ".sdf");
+}
+
+// The pose of node `name` at the model's bone values after `values` (by bone name).
+Isometry3d NodePose(const RobotModel& model, const std::string& name,
+                    const std::map<std::string, double>& values) {
+  RobotState state(model);
+  for (const auto& [bone, value] : values) {
+    EXPECT_TRUE(state.SetBone(model.FindBone(bone), &value, 1)) << bone;
+  }
+  state.Update();
+  const int node = model.FindNode(name);
+  EXPECT_GE(node, 0) << name;
+  return Isometry3d(state.node_poses_B()[std::size_t(node)].matrix());
+}
+
+TEST(RobotDescriptionTest, Px4PlaneControlSurfacesTurnAboutTheAxesTheSdfGives) {
+  if (!fs::exists(Px4("plane"))) GTEST_SKIP() << "no " << Px4("plane");
+  const Level level = LoadLevel(Px4("plane"));
+  const RobotModel& plane = level.robots.at(0);
+  EXPECT_EQ(plane.links.size(), 11u);  // 9 links and the included gps and airspeed
+  EXPECT_EQ(plane.bones.size(), 8u);   // 10 joints, two of them fixed
+  TiXmlDocument document;
+  ASSERT_TRUE(document.LoadFile(Px4("plane").string()));
+  int checked = 0;
+  for (const TiXmlElement* j =
+           document.RootElement()->FirstChildElement("model")->FirstChildElement("joint");
+       j != nullptr; j = j->NextSiblingElement("joint")) {
+    const std::string name = j->Attribute("name");
+    if (name.find("elevon") == std::string::npos && name.find("flap") == std::string::npos &&
+        name != "elevator_joint" && name != "rudder_joint") {
+      continue;
+    }
+    // These children sit at the model origin with no rotation, and their joint
+    // frames have none: the hinge is the joint's <pose> point along <axis><xyz>.
+    std::istringstream pose(j->FirstChildElement("pose")->GetText());
+    Vector3d pivot;
+    pose >> pivot.x() >> pivot.y() >> pivot.z();
+    std::istringstream xyz(j->FirstChildElement("axis")->FirstChildElement("xyz")->GetText());
+    Vector3d axis;
+    xyz >> axis.x() >> axis.y() >> axis.z();
+    const std::string child = j->FirstChildElement("child")->GetText();
+    const double q = 0.3;
+    const Isometry3d expected(Eigen::Translation3d(pivot) *
+                              Eigen::AngleAxisd(q, axis.normalized()) *
+                              Eigen::Translation3d(-pivot));
+    const Isometry3d got = NodePose(plane, child, {{name, q}});
+    EXPECT_LT((got.matrix() - expected.matrix()).norm(), 1e-9) << name;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 6);  // two elevons, two flaps, the elevator and the rudder
+}
+
+TEST(RobotDescriptionTest, Px4IrisHasFourContinuousRotors) {
+  if (!fs::exists(Px4("iris"))) GTEST_SKIP() << "no " << Px4("iris");
+  const RobotModel iris = LoadLevel(Px4("iris")).robots.at(0);
+  int rotors = 0;
+  for (const Bone& bone : iris.bones) {
+    if (bone.name.rfind("rotor_", 0) != 0) continue;
+    ++rotors;
+    EXPECT_TRUE(std::isinf(bone.lower) && std::isinf(bone.upper)) << bone.name;
+    EXPECT_NEAR(std::abs(bone.axes[0].z()), 1.0, 1e-9) << bone.name;
+  }
+  EXPECT_EQ(rotors, 4);
+}
+
+// An SDF joint whose frame is rotated and off its child's origin, against
+// the SDF rule computed here: X_PC(q) = X_PC(0) * X_CJ * R(axis_J, q) * X_CJ^-1.
+TEST(RobotDescriptionTest, SdfJointFramesOffTheChildOriginTurnAboutTheirOwnAxis) {
+  const testing::TempDir dir;
+  const fs::path file = dir.Write("m.sdf", R"(<?xml version="1.0"?>
+<sdf version="1.7">
+  <model name="m">
+    <link name="a"><visual name="v"><geometry><box><size>1 1 1</size></box></geometry></visual></link>
+    <link name="b">
+      <pose>1 2 3 0.1 0.2 0.3</pose>
+      <visual name="v"><geometry><sphere><radius>0.5</radius></sphere></geometry></visual>
+    </link>
+    <joint name="j" type="revolute">
+      <parent>a</parent><child>b</child>
+      <pose>0.4 -0.2 0.1 0.5 0 -0.4</pose>
+      <axis><xyz>0 0 1</xyz><limit><lower>-1</lower><upper>1</upper></limit></axis>
+    </joint>
+  </model>
+</sdf>
+)");
+  const RobotModel m = LoadLevel(file).robots.at(0);
+  auto rpy = [](double r, double p, double y) {
+    return Isometry3d(Eigen::AngleAxisd(y, Vector3d::UnitZ()) *
+                      Eigen::AngleAxisd(p, Vector3d::UnitY()) *
+                      Eigen::AngleAxisd(r, Vector3d::UnitX()));
+  };
+  const Isometry3d X_AB = Eigen::Translation3d(1, 2, 3) * rpy(0.1, 0.2, 0.3);
+  const Isometry3d X_BJ = Eigen::Translation3d(0.4, -0.2, 0.1) * rpy(0.5, 0, -0.4);
+  for (const double q : {-0.9, 0.0, 0.35, 1.0}) {
+    const Isometry3d expected =
+        X_AB * X_BJ * Eigen::AngleAxisd(q, Vector3d::UnitZ()) * X_BJ.inverse();
+    const Isometry3d got = NodePose(m, "b", {{"j", q}});
+    EXPECT_LT((got.matrix() - expected.matrix()).norm(), 1e-9) << q;
+  }
+}
+
+TEST(RobotDescriptionTest, BadSdfIsRefusedNamingFileAndWhat) {
+  const testing::TempDir dir;
+  auto refused = [&](const std::string& body, const std::vector<std::string>& parts) {
+    const fs::path file =
+        dir.Write("bad.sdf", "<?xml version=\"1.0\"?>\n<sdf version=\"1.7\">" + body + "</sdf>\n");
+    try {
+      LoadLevel(file);
+      ADD_FAILURE() << "loaded: " << body;
+    } catch (const LevelError& error) {
+      const std::string message = error.what();
+      EXPECT_NE(message.find(file.string()), std::string::npos) << message;
+      for (const std::string& part : parts) {
+        EXPECT_NE(message.find(part), std::string::npos) << "'" << part << "' not in: " << message;
+      }
+    }
+  };
+  const std::string box =
+      "<visual name=\"v\"><geometry><box><size>1 1 1</size></box></geometry></visual>";
+  refused("<model name=\"m\"><link name=\"a\">" + box + "</link>", {"not a valid SDF"});
+  refused("<model name=\"m\"><include><uri>model://no_such_model</uri></include><link name=\"a\">" +
+              box + "</link></model>",
+          {"model://no_such_model", "searched"});
+  refused("<model name=\"m\"><link name=\"a\">" + box + "</link><link name=\"b\">" + box +
+              "</link><joint name=\"j\" type=\"revolute\"><parent>a</parent><child>c</child>"
+              "<axis><xyz>0 0 1</xyz></axis></joint></model>",
+          {"not a valid SDF", "j"});
+  refused(
+      "<model name=\"m\"><link name=\"a\"><visual "
+      "name=\"v\"><geometry><mesh><uri>meshes/none.stl</uri>"
+      "</mesh></geometry></visual></link></model>",
+      {"link 'a' visual", "meshes/none.stl", "not found"});
+}
+
 }  // namespace
 }  // namespace sandbox::scene
