@@ -44,7 +44,8 @@ const char* kUsage =
     "  --no-sensors   run no sensor (robots' STATE and STATUS are still published)\n"
     "  --frames-only  run no sensor and publish nothing: only render the cameras, beside a\n"
     "                 sandbox that scans the same pose stream (docs/how-to/distributed.md)\n"
-    "Inputs per robot: <ROBOT>/POSE, /BONES, /ACTORS, /CAMERA (trailing pan, tilt, zoom).\n"
+    "Inputs per robot: <ROBOT>/POSE, /BONES, /JOINTS, /ACTORS, /CAMERA (trailing pan, tilt,\n"
+    "zoom).\n"
     "Outputs: <ROBOT>/SCAN_FACE, /GROUND, /LIDAR, /RANGE, /STATE, /STATUS "
     "(docs/reference/bridge.md).\n";
 

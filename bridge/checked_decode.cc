@@ -5,6 +5,7 @@
 
 #include "sandbox_msgs/actor_placements_t.hpp"
 #include "sandbox_msgs/bone_values_t.hpp"
+#include "sandbox_msgs/joint_values_t.hpp"
 #include "sandbox_msgs/camera_command_t.hpp"
 #include "sandbox_msgs/ground_map_t.hpp"
 #include "sandbox_msgs/lidar_scan_t.hpp"
@@ -107,6 +108,12 @@ void Layout(const robot_pose_t*, WireReader& r) { r.Fixed(8 * 2 + 8 * 7, "the po
 
 void Layout(const bone_values_t*, WireReader& r) {
   r.Fixed(8 * 2, "utime and seq");
+  r.Array(r.Count("num_values"), 8, "values");
+}
+
+void Layout(const joint_values_t*, WireReader& r) {
+  r.Fixed(8 * 2, "utime and seq");
+  r.Strings(r.Count("num_names"), "names");
   r.Array(r.Count("num_values"), 8, "values");
 }
 
@@ -233,6 +240,7 @@ SANDBOX_CHECKED_DECODE(actor_placements_t)
 SANDBOX_CHECKED_DECODE(bone_values_t)
 SANDBOX_CHECKED_DECODE(camera_command_t)
 SANDBOX_CHECKED_DECODE(ground_map_t)
+SANDBOX_CHECKED_DECODE(joint_values_t)
 SANDBOX_CHECKED_DECODE(lidar_scan_t)
 SANDBOX_CHECKED_DECODE(range_t)
 SANDBOX_CHECKED_DECODE(robot_pose_t)

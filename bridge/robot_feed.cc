@@ -87,10 +87,14 @@ RobotFeed::Changes RobotFeed::Apply(std::int64_t now_utime, scene::RobotState* s
 
 std::vector<ChannelStatus> RobotFeed::Channels(std::int64_t now_utime) const {
   std::vector<ChannelStatus> channels;
-  for (const LatestInput* in :
-       {&inputs_.pose(), &inputs_.bones(), &inputs_.actors(), &inputs_.camera()}) {
-    // Camera commands come when someone steers: never stale.
-    const bool stale = in != &inputs_.camera() && in->Stale(now_utime, config_.stale_after_s);
+  for (const LatestInput* in : {&inputs_.pose(), &inputs_.bones(), &inputs_.joints(),
+                                &inputs_.actors(), &inputs_.camera()}) {
+    // Camera commands come when someone steers: never stale. Joint values
+    // come on BONES or JOINTS: stale when neither has brought any lately.
+    const bool joint_values = in == &inputs_.bones() || in == &inputs_.joints();
+    const bool stale = joint_values
+                           ? JointValuesStale(now_utime)
+                           : in != &inputs_.camera() && in->Stale(now_utime, config_.stale_after_s);
     channels.push_back({in->channel(), in->received(), in->superseded(), in->rejected(), stale,
                         in->last_reject_reason()});
   }
@@ -104,9 +108,14 @@ std::vector<ChannelStatus> RobotFeed::Channels(std::int64_t now_utime) const {
 }
 
 void RobotFeed::AppendStale(std::int64_t now_utime, std::vector<bool>* stale) const {
-  for (const LatestInput* in : {&inputs_.pose(), &inputs_.bones(), &inputs_.actors()}) {
-    stale->push_back(in->Stale(now_utime, config_.stale_after_s));
-  }
+  stale->push_back(inputs_.pose().Stale(now_utime, config_.stale_after_s));
+  stale->push_back(JointValuesStale(now_utime));
+  stale->push_back(inputs_.actors().Stale(now_utime, config_.stale_after_s));
+}
+
+bool RobotFeed::JointValuesStale(std::int64_t now_utime) const {
+  return inputs_.bones().Stale(now_utime, config_.stale_after_s) &&
+         inputs_.joints().Stale(now_utime, config_.stale_after_s);
 }
 
 }  // namespace sandbox::bridge

@@ -1,6 +1,6 @@
 #pragma once
 // Everything that drives one robot from outside, applied in one call: its LCM
-// inputs (<ROBOT>/POSE, /BONES, /ACTORS, /CAMERA) and its UDP adapters (net_fdm,
+// inputs (<ROBOT>/POSE, /BONES, /JOINTS, /ACTORS, /CAMERA) and its UDP adapters (net_fdm,
 // doubles). Apply() reports what changed and keeps the tag of the input the
 // robot's outputs are computed from. Threads: the loop thread.
 
@@ -55,11 +55,14 @@ class RobotFeed {
   const std::string& active_camera() const { return inputs_.active_camera(); }
   // Every input's counters: the LCM channels, then the UDP sockets.
   std::vector<ChannelStatus> Channels(std::int64_t now_utime) const;
-  // Appends whether pose, bones and actors (in that order) are stale at `now_utime`.
+  // Appends whether pose, joint values (BONES or JOINTS) and actors (in that
+  // order) are stale at `now_utime`.
   void AppendStale(std::int64_t now_utime, std::vector<bool>* stale) const;
   const RobotBridgeConfig& config() const { return config_; }
 
  private:
+  bool JointValuesStale(std::int64_t now_utime) const;
+
   RobotBridgeConfig config_;
   int robot_;
   bool lockstep_;

@@ -6,6 +6,7 @@
 #include "sandbox_msgs/actor_placements_t.hpp"
 #include "sandbox_msgs/bone_values_t.hpp"
 #include "sandbox_msgs/camera_command_t.hpp"
+#include "sandbox_msgs/joint_values_t.hpp"
 #include "sandbox_msgs/robot_pose_t.hpp"
 
 namespace sandbox::bridge {
@@ -52,6 +53,13 @@ RobotInputs::RobotInputs(LcmLink& link, const scene::Level& level, int robot,
             return ParseBones(data, size, &values);
           },
           BonesBudget(level.robots.at(std::size_t(robot)).num_values)),
+      joints_(
+          link, config.channel_prefix + "/JOINTS",
+          [this](const std::uint8_t* data, std::size_t size) {
+            std::vector<std::pair<int, double>> values;
+            return ParseJoints(data, size, &values);
+          },
+          kMaxJointsBytes),
       actors_(
           link, config.channel_prefix + "/ACTORS",
           [this](const std::uint8_t* data, std::size_t size) {
@@ -107,6 +115,42 @@ std::string RobotInputs::ParseBones(const std::uint8_t* data, std::size_t size,
   return "";
 }
 
+std::string RobotInputs::ParseJoints(const std::uint8_t* data, std::size_t size,
+                                     std::vector<std::pair<int, double>>* values) const {
+  const scene::RobotModel& model = level_.robots[std::size_t(robot_)];
+  sandbox_msgs::joint_values_t message{};
+  if (std::string problem = DecodeChecked(data, size, &message); !problem.empty()) return problem;
+  std::vector<int> bones;
+  if (message.num_names > 0) {
+    if (message.num_values != message.num_names) {
+      return std::to_string(message.num_names) + " names but " +
+             std::to_string(message.num_values) + " values";
+    }
+    for (const std::string& name : message.names) {
+      const int bone = model.FindBone(name);
+      if (bone < 0) return "unknown joint '" + Printable(name, 64) + "'";
+      bones.push_back(bone);
+    }
+  } else {
+    if (message.num_values != int(model.bones.size())) {
+      return "expected " + std::to_string(model.bones.size()) + " joint values, got " +
+             std::to_string(message.num_values);
+    }
+    for (std::size_t b = 0; b < model.bones.size(); ++b) bones.push_back(int(b));
+  }
+  for (std::size_t i = 0; i < bones.size(); ++i) {
+    const scene::Bone& bone = model.bones[std::size_t(bones[i])];
+    if (bone.num_values != 1) {
+      return "'" + bone.name + "' takes " + std::to_string(bone.num_values) +
+             " values: not a joint (use BONES)";
+    }
+    const std::string problem = scene::BoneValuesProblem(bone, &message.values[i], 1);
+    if (!problem.empty()) return problem + " ('" + bone.name + "')";
+    values->emplace_back(bones[i], message.values[i]);
+  }
+  return "";
+}
+
 std::string RobotInputs::ParsePlacements(const std::uint8_t* data, std::size_t size,
                                          Placements* placements) const {
   // All of a message or none.
@@ -157,13 +201,15 @@ RobotInputs::Applied RobotInputs::Apply(scene::RobotState* state, scene::Collisi
   Applied applied;
   if (const auto* bytes = pose_.TakeNewest()) ApplyPose(*bytes, state, &applied);
   if (const auto* bytes = bones_.TakeNewest()) ApplyBones(*bytes, state, &applied);
+  if (const auto* bytes = joints_.TakeNewest()) ApplyJoints(*bytes, state, &applied);
   if (const auto* bytes = actors_.TakeNewest()) ApplyActors(*bytes, world, &applied);
   if (const auto* bytes = camera_.TakeNewest()) ApplyCamera(*bytes, &applied);
   return applied;
 }
 
 void RobotInputs::set_lockstep(bool lockstep) {
-  pose_.set_queue(lockstep), bones_.set_queue(lockstep), actors_.set_queue(lockstep);
+  pose_.set_queue(lockstep), bones_.set_queue(lockstep), joints_.set_queue(lockstep);
+  actors_.set_queue(lockstep);
 }
 
 RobotInputs::Applied RobotInputs::ApplyNext(scene::RobotState* state,
@@ -177,6 +223,11 @@ RobotInputs::Applied RobotInputs::ApplyNext(scene::RobotState* state,
        bytes != nullptr && RawSeq(*bytes) <= seq; bytes = bones_.Peek()) {
     ApplyBones(*bytes, state, &applied);
     bones_.Pop();
+  }
+  for (const std::vector<std::uint8_t>* bytes = joints_.Peek();
+       bytes != nullptr && RawSeq(*bytes) <= seq; bytes = joints_.Peek()) {
+    ApplyJoints(*bytes, state, &applied);
+    joints_.Pop();
   }
   for (const std::vector<std::uint8_t>* bytes = actors_.Peek();
        bytes != nullptr && RawSeq(*bytes) <= seq; bytes = actors_.Peek()) {
@@ -211,6 +262,18 @@ void RobotInputs::ApplyBones(const std::vector<std::uint8_t>& bytes, scene::Robo
   }
   if (!state->SetBones(values)) return bones_.Reject(state->last_rejection());
   bones_.Accept();
+  applied->bones = true;
+}
+
+void RobotInputs::ApplyJoints(const std::vector<std::uint8_t>& bytes, scene::RobotState* state,
+                              Applied* applied) {
+  std::vector<std::pair<int, double>> values;
+  if (std::string problem = ParseJoints(bytes.data(), bytes.size(), &values); !problem.empty()) {
+    return joints_.Reject(problem);
+  }
+  // Checked above: every SetBone succeeds, so the message applies whole.
+  for (const auto& [bone, value] : values) state->SetBone(bone, &value, 1);
+  joints_.Accept();
   applied->bones = true;
 }
 

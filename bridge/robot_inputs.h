@@ -1,8 +1,9 @@
 #pragma once
 // A robot's inputs from external models: <ROBOT>/POSE (robot_pose_t),
-// <ROBOT>/BONES (bone_values_t), <ROBOT>/ACTORS (actor_placements_t) and
-// <ROBOT>/CAMERA (camera_command_t), each the newest good message of its
-// channel, translated and applied. Every message is decoded and checked when
+// <ROBOT>/BONES (bone_values_t), <ROBOT>/JOINTS (joint_values_t: one-value
+// bones by name), <ROBOT>/ACTORS (actor_placements_t) and <ROBOT>/CAMERA
+// (camera_command_t), each the newest good message of its channel,
+// translated and applied. Every message is decoded and checked when
 // it arrives (its size against the channel's budget, its layout, finite
 // values, unit quaternions, the bone count, known and movable actors): a bad
 // one is rejected, counted by reason, and never displaces the last good one.
@@ -32,8 +33,9 @@ class RobotInputs {
   // Byte budgets of the variable-size inputs (POSE and BONES have one exact size).
   static constexpr std::size_t kMaxActorsBytes = 1u << 20;
   static constexpr std::size_t kMaxCameraBytes = 4096;
+  static constexpr std::size_t kMaxJointsBytes = 1u << 16;
 
-  // Subscribes the robot's channels (<prefix>/POSE, /BONES, /ACTORS, /CAMERA)
+  // Subscribes the robot's channels (<prefix>/POSE, /BONES, /JOINTS, /ACTORS, /CAMERA)
   // on `link`; the config also says the convention its pose publisher speaks.
   // `level` must outlive this.
   RobotInputs(LcmLink& link, const scene::Level& level, int robot, const RobotBridgeConfig& config);
@@ -42,8 +44,8 @@ class RobotInputs {
 
   // What the last Apply() used.
   struct Applied {
-    bool pose{false}, bones{false}, actors{false}, camera{false};
-    std::int64_t pose_seq{-1}, pose_utime{-1};  // of the pose message applied
+    bool pose{false}, bones{false}, actors{false}, camera{false};  // bones: BONES or JOINTS
+    std::int64_t pose_seq{-1}, pose_utime{-1};                     // of the pose message applied
   };
   // After LcmLink::Drain(): applies the newest good message of each channel to
   // the robot state and, for actor placements, to the world. The caller then
@@ -60,6 +62,7 @@ class RobotInputs {
 
   const LatestInput& pose() const { return pose_; }
   const LatestInput& bones() const { return bones_; }
+  const LatestInput& joints() const { return joints_; }
   const LatestInput& actors() const { return actors_; }
   const LatestInput& camera() const { return camera_; }
   // The last good camera command: the trailing cameras' pan, tilt and zoom,
@@ -68,7 +71,8 @@ class RobotInputs {
   const std::string& active_camera() const { return active_camera_; }
   // Logs rejections of every input to `log`.
   void set_log(RejectLog* log) {
-    pose_.set_log(log), bones_.set_log(log), actors_.set_log(log), camera_.set_log(log);
+    pose_.set_log(log), bones_.set_log(log), joints_.set_log(log), actors_.set_log(log);
+    camera_.set_log(log);
   }
 
  private:
@@ -88,6 +92,9 @@ class RobotInputs {
   std::string ParsePose(const std::uint8_t* data, std::size_t size, Pose* pose) const;
   std::string ParseBones(const std::uint8_t* data, std::size_t size,
                          std::vector<double>* values) const;
+  // The joints' bone indices and values.
+  std::string ParseJoints(const std::uint8_t* data, std::size_t size,
+                          std::vector<std::pair<int, double>>* values) const;
   std::string ParsePlacements(const std::uint8_t* data, std::size_t size,
                               Placements* placements) const;
   std::string ParseCamera(const std::uint8_t* data, std::size_t size, Camera* camera) const;
@@ -96,6 +103,8 @@ class RobotInputs {
                  Applied* applied);
   void ApplyBones(const std::vector<std::uint8_t>& bytes, scene::RobotState* state,
                   Applied* applied);
+  void ApplyJoints(const std::vector<std::uint8_t>& bytes, scene::RobotState* state,
+                   Applied* applied);
   void ApplyActors(const std::vector<std::uint8_t>& bytes, scene::CollisionWorld* world,
                    Applied* applied);
   void ApplyCamera(const std::vector<std::uint8_t>& bytes, Applied* applied);
@@ -103,7 +112,7 @@ class RobotInputs {
   const scene::Level& level_;
   int robot_;
   Translation translation_;
-  LatestInput pose_, bones_, actors_, camera_;
+  LatestInput pose_, bones_, joints_, actors_, camera_;
   TrailingCommand trailing_;
   std::string active_camera_;
 };

@@ -13,6 +13,7 @@
 #include "sandbox_msgs/actor_placements_t.hpp"
 #include "sandbox_msgs/bone_values_t.hpp"
 #include "sandbox_msgs/camera_command_t.hpp"
+#include "sandbox_msgs/joint_values_t.hpp"
 #include "sandbox_msgs/robot_pose_t.hpp"
 #include "tests/test_util.h"
 
@@ -289,6 +290,60 @@ TEST(RejectLogTest, OncePerCausePerSecond) {
             "sandbox: ELAHA/POSE: rejected (non-finite pose)\n"
             "sandbox: ELAHA/POSE: rejected (non-unit quaternion)\n"
             "sandbox: ELAHA/BONES: rejected (non-finite pose)\n");
+}
+
+// JOINTS on the bundled URDF arm: by name, in the joint order, and refused
+// whole for an unknown name, a value beyond a limit or NaN.
+TEST(JointsInputTest, JointValuesByNameOrInOrderAllOrNothing) {
+  const scene::Level level =
+      scene::LoadLevel(std::filesystem::path(SANDBOX_SOURCE_DIR) / "assets/arm/arm.urdf");
+  const scene::RobotModel& arm = level.robots.at(0);
+  scene::CollisionWorld world(level);
+  scene::RobotState state(arm);
+  LcmLink link("memq://");
+  RobotInputs inputs(link, level, 0);
+  auto joints = [](std::int64_t seq, std::vector<std::string> names, std::vector<double> values) {
+    sandbox_msgs::joint_values_t message{};
+    message.seq = seq;
+    message.num_names = int(names.size());
+    message.names = std::move(names);
+    message.num_values = int(values.size());
+    message.values = std::move(values);
+    return message;
+  };
+  auto value_of = [&](const char* joint) {
+    return state
+        .bone_values()[std::size_t(arm.bones[std::size_t(arm.FindBone(joint))].first_value)];
+  };
+  auto send = [&](const sandbox_msgs::joint_values_t& message) {
+    Publish(link, "arm/JOINTS", message);
+    while (link.Drain() > 0) {
+    }
+    return inputs.Apply(&state, &world).bones;
+  };
+  EXPECT_TRUE(send(joints(1, {"elbow", "extend"}, {0.5, 0.1})));
+  EXPECT_EQ(value_of("elbow"), 0.5);
+  EXPECT_EQ(value_of("extend"), 0.1);
+  EXPECT_EQ(value_of("shoulder"), 0.0);  // not named: kept
+  // Every joint in order (sandbox info's: base_yaw, shoulder, elbow, extend, wrist_roll).
+  EXPECT_TRUE(send(joints(2, {}, {3.5, -0.2, -1.0, 0.05, 2.0})));
+  EXPECT_EQ(value_of("base_yaw"), 3.5);
+  EXPECT_EQ(value_of("wrist_roll"), 2.0);
+  // Refused whole, the last good values kept, each counted by reason.
+  EXPECT_FALSE(send(joints(3, {"shoulder", "nose"}, {0.1, 0.2})));
+  EXPECT_FALSE(send(joints(4, {"shoulder", "extend"}, {0.1, 0.2})));  // extend: 0 .. 0.15 m
+  EXPECT_FALSE(send(joints(5, {"elbow"}, {std::nan("")})));
+  EXPECT_FALSE(send(joints(6, {}, {0.0, 0.0})));
+  EXPECT_FALSE(send(joints(7, {"elbow", "shoulder"}, {0.1})));
+  EXPECT_EQ(value_of("shoulder"), -0.2);
+  EXPECT_EQ(value_of("extend"), 0.05);
+  const std::map<std::string, std::int64_t>& reasons = inputs.joints().rejected_by_reason();
+  EXPECT_EQ(reasons.at("unknown joint 'nose'"), 1);
+  EXPECT_EQ(reasons.at("joint value beyond its limits ('extend')"), 1);
+  EXPECT_EQ(reasons.at("non-finite bone value ('elbow')"), 1);
+  EXPECT_EQ(reasons.at("expected 5 joint values, got 2"), 1);
+  EXPECT_EQ(reasons.at("2 names but 1 values"), 1);
+  EXPECT_EQ(inputs.joints().rejected(), 5);
 }
 
 }  // namespace
