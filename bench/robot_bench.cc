@@ -4,6 +4,10 @@
 // collision body (its rigid pieces moved with their bones, and how far they
 // stray from the skin). The reference, run in the same process, is a plain
 // double-precision skinning loop (every vertex: sum of weighted Affine3d).
+// Robot descriptions: forward kinematics and the collision update of a
+// 7-joint arm (a generated URDF chain, and the KUKA iiwa when present) and of
+// a generated 50-link chain, against Orocos KDL's recursive FK solver on the
+// same chain (every segment's frame).
 //
 //   bench_robots [--iterations N]
 
@@ -15,7 +19,13 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <string>
 #include <vector>
+
+#ifdef SANDBOX_HAVE_KDL
+#include <kdl/chain.hpp>
+#include <kdl/chainfksolverpos_recursive.hpp>
+#endif
 
 #include "scene/collision_world.h"
 #include "scene/level.h"
@@ -82,6 +92,84 @@ void BendWing(RobotState* state, int i) {
     const double values[2] = {0.0785 * std::sin(0.01 * i + b), 0.01 * std::cos(0.02 * i)};
     state->SetBone(b, values, 2);
   }
+}
+
+// A chain of `links` boxes joined by revolute joints about y, z, x, y, ...,
+// each 0.1 to 0.3 m above the last, written as URDF.
+std::string ChainUrdf(int links) {
+  std::string xml = "<robot name=\"chain\">\n";
+  for (int l = 0; l < links; ++l) {
+    xml += "<link name=\"l" + std::to_string(l) +
+           "\"><visual><geometry><box size=\"0.05 0.05 0.1\"/></geometry></visual>"
+           "<collision><geometry><box size=\"0.05 0.05 0.1\"/></geometry></collision></link>\n";
+    if (l == 0) continue;
+    const char* axes[] = {"0 1 0", "0 0 1", "1 0 0"};
+    xml += "<joint name=\"j" + std::to_string(l) + "\" type=\"revolute\"><parent link=\"l" +
+           std::to_string(l - 1) + "\"/><child link=\"l" + std::to_string(l) +
+           "\"/><origin xyz=\"0 0 " + std::to_string(0.1 + 0.2 * ((l * 7) % 11) / 10.0) +
+           "\" rpy=\"0.1 0 0\"/><axis xyz=\"" + axes[l % 3] +
+           "\"/><limit lower=\"-3\" upper=\"3\" effort=\"1\" velocity=\"1\"/></joint>\n";
+  }
+  return xml + "</robot>\n";
+}
+
+// Per tick: new joint values, forward kinematics and the collision update;
+// the reference: KDL's FK of every segment of the same chain.
+void DescribedRobot(const std::string& name, const fs::path& file, int iterations) {
+  const Level level = LoadLevel(file);
+  const RobotModel& model = level.robots.at(0);
+  RobotState state(model);
+  CollisionWorld world(level);
+  auto set_joints = [&](int i) {
+    for (std::size_t b = 0; b < model.bones.size(); ++b) {
+      const double value = 0.5 * std::sin(0.01 * i + double(b));
+      state.SetBone(int(b), &value, 1);
+    }
+  };
+  const double ours = MicrosecondsPerCall(iterations, [&](int i) {
+    set_joints(i);
+    state.UpdateKinematics();
+    world.UpdateRobot(0, state);
+  });
+  const double skin = MicrosecondsPerCall(std::max(15, iterations / 20), [&](int i) {
+    set_joints(i);
+    state.Update();
+  });
+  double reference = 0.0;
+#ifdef SANDBOX_HAVE_KDL
+  // The chain as kdl_parser makes it from URDF: a joint about origin.R * axis
+  // through origin.p, the segment's tip at the origin.
+  KDL::Chain chain;
+  for (const Bone& bone : model.bones) {
+    const RobotNode& node = model.nodes[std::size_t(bone.node)];
+    const Eigen::Matrix3d R = node.X_PN.linear();
+    const Eigen::Vector3d p = node.X_PN.translation(), axis = R * bone.axes[0];
+    KDL::Frame tip(KDL::Rotation(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0),
+                                 R(2, 1), R(2, 2)),
+                   KDL::Vector(p.x(), p.y(), p.z()));
+    chain.addSegment(
+        KDL::Segment(node.name,
+                     KDL::Joint(bone.name, KDL::Vector(p.x(), p.y(), p.z()),
+                                KDL::Vector(axis.x(), axis.y(), axis.z()), KDL::Joint::RotAxis),
+                     tip));
+  }
+  KDL::ChainFkSolverPos_recursive fk(chain);
+  KDL::JntArray q(chain.getNrOfJoints());
+  std::vector<KDL::Frame> frames(chain.getNrOfSegments());
+  reference = MicrosecondsPerCall(iterations, [&](int i) {
+    for (unsigned j = 0; j < q.rows(); ++j) q(j) = 0.5 * std::sin(0.01 * i + double(j));
+    fk.JntToCart(q, frames);
+  });
+#endif
+  const std::string what = name + " (" + std::to_string(model.bones.size()) + " joints)";
+  if (reference > 0.0) {
+    std::printf("%-44s %12.2f %14.2f %7.2fx\n", what.c_str(), ours, reference, reference / ours);
+  } else {
+    std::printf("%-44s %12.2f %14s %8s\n", what.c_str(), ours, "(no KDL)", "-");
+  }
+  std::printf("%-44s %12.1f %14s %8s\n",
+              ("  FK + skinning, " + std::to_string(model.num_vertices()) + " vtx").c_str(), skin,
+              "-", "-");
 }
 
 }  // namespace
@@ -171,7 +259,23 @@ int main(int argc, char** argv) {
   } else {
     std::printf("RecursiveSkeletons: skipped, no %s\n", skeletons.c_str());
   }
+  const fs::path folder = fs::temp_directory_path();
+  for (const int links : {8, 50}) {
+    const fs::path file = folder / ("sandbox-bench-chain-" + std::to_string(links) + ".urdf");
+    std::ofstream(file) << ChainUrdf(links);
+    DescribedRobot(links == 8 ? "7-joint URDF arm" : "50-link URDF chain", file, iterations);
+    fs::remove(file);
+  }
+  const fs::path kuka =
+      fs::path(SANDBOX_SOURCE_DIR) / "../shared/assets/kuka-iiwa/lbr_iiwa_14_r820.urdf";
+  if (fs::exists(kuka)) {
+    DescribedRobot("KUKA iiwa", kuka, iterations);
+  } else {
+    std::printf("KUKA iiwa: skipped, no %s\n", kuka.c_str());
+  }
   std::printf(
-      "\nmedian of 15 batches, one core; targets: wing under 50 us, skeletons under 200 us\n");
+      "\nmedian of 15 batches, one core; targets: wing under 50 us, skeletons under 200 us;\n"
+      "descriptions: FK + collision update (UpdateKinematics, UpdateRobot) against KDL's FK\n"
+      "alone; targets: 7-joint arm under 10 us, 50-link chain under 50 us\n");
   return 0;
 }

@@ -112,6 +112,15 @@ bool RobotState::SetBones(const std::vector<double>& values) {
 }
 
 void RobotState::Update() {
+  UpdateKinematics();
+  for (std::size_t m = 0; m < model_->meshes.size(); ++m) {
+    const SkinnedMesh& mesh = model_->meshes[m];
+    for (const SkinRun& run : mesh.runs) SkinRunOfVertices(mesh, run, m);
+    for (const std::uint32_t v : mesh.scattered) SkinVertex(mesh, v, m);
+  }
+}
+
+void RobotState::UpdateKinematics() {
   // Forward kinematics: parents come first in the node list.
   const std::size_t num_nodes = model_->nodes.size();
   for (std::size_t n = 0; n < num_nodes; ++n) {
@@ -135,11 +144,6 @@ void RobotState::Update() {
   for (std::size_t j = 0; j < skin_.size(); ++j) {
     const Eigen::Matrix3f L = skin_[j].leftCols<3>();
     rigid_[j] = (L.transpose() * L - Eigen::Matrix3f::Identity()).cwiseAbs().maxCoeff() < 1e-5f;
-  }
-  for (std::size_t m = 0; m < model_->meshes.size(); ++m) {
-    const SkinnedMesh& mesh = model_->meshes[m];
-    for (const SkinRun& run : mesh.runs) SkinRunOfVertices(mesh, run, m);
-    for (const std::uint32_t v : mesh.scattered) SkinVertex(mesh, v, m);
   }
 }
 

@@ -35,6 +35,9 @@ class RobotState {
 
   // Forward kinematics, root to tip, then linear-blend skinning of every mesh.
   void Update();
+  // Forward kinematics alone: node poses (and what CollisionWorld::UpdateRobot
+  // needs), the posed meshes left as they were.
+  void UpdateKinematics();
 
   const RobotModel& model() const { return *model_; }
   const Eigen::Isometry3d& pose() const { return X_WB_; }

@@ -302,6 +302,25 @@ void CompactFaceSeeds(const fs::path& dir) {
   }
 }
 
+// Robot descriptions: the first byte picks the format (even URDF, odd SDF).
+void RobotDescriptionSeeds(const fs::path& dir, const fs::path& source) {
+  Write(dir / "arm.urdf", "\x00" + Read(source / "assets/arm/arm.urdf"));
+  Write(dir / "joints.sdf",
+        "\x01<?xml version=\"1.0\"?>\n<sdf version=\"1.7\"><model name=\"m\">"
+        "<link name=\"a\"><visual name=\"v\"><geometry><box><size>1 1 1</size></box>"
+        "</geometry></visual><collision name=\"c\"><geometry><sphere><radius>0.5</radius>"
+        "</sphere></geometry></collision></link>"
+        "<link name=\"b\"><pose>1 2 3 0.1 0.2 0.3</pose><visual name=\"v\"><geometry>"
+        "<cylinder><radius>0.2</radius><length>1</length></cylinder></geometry></visual></link>"
+        "<joint name=\"j\" type=\"revolute\"><parent>a</parent><child>b</child>"
+        "<pose>0.4 -0.2 0.1 0.5 0 -0.4</pose><axis><xyz>0 0 1</xyz><limit><lower>-1</lower>"
+        "<upper>1</upper></limit></axis></joint>"
+        "<link name=\"c\"><visual name=\"v\"><geometry><box><size>1 1 1</size></box>"
+        "</geometry></visual></link><joint name=\"k\" type=\"prismatic\"><parent>b</parent>"
+        "<child>c</child><axis><xyz>1 0 0</xyz><limit><lower>0</lower><upper>0.5</upper>"
+        "</limit></axis></joint></model></sdf>\n");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -318,6 +337,7 @@ int main(int argc, char** argv) {
   RasterSeeds(dir / "raster");
   TileCacheSeeds(dir / "tile_cache");
   CompactFaceSeeds(dir / "compact_face");
+  RobotDescriptionSeeds(dir / "robot_description", argv[2]);
   std::printf("make_fuzz_seeds: seeds in %s\n", dir.string().c_str());
   return 0;
 }

@@ -5,10 +5,16 @@
 #include <gtest/gtest.h>
 #include <tinyxml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <random>
 #include <sstream>
+
+#ifdef SANDBOX_HAVE_KDL
+#include <kdl/chain.hpp>
+#include <kdl/chainfksolverpos_recursive.hpp>
+#endif
 
 #include "scene/collision_world.h"
 #include "scene/level.h"
@@ -161,6 +167,77 @@ TEST(RobotDescriptionTest, KukaKinematicsAgreeWithItsXml) {
   EXPECT_EQ(level.robots.at(0).bones.size(), 7u);
   ExpectKinematicsAgree(Kuka());
 }
+
+#ifdef SANDBOX_HAVE_KDL
+// Orocos KDL's forward kinematics of the chain from the root to `tip`, built
+// from the XML as kdl_parser does: each joint about origin.R * axis through
+// origin.p, the segment's tip at the origin.
+Isometry3d KdlPose(const std::map<std::string, XmlJoint>& joints, const std::string& tip,
+                   const std::map<std::string, double>& q) {
+  std::vector<const XmlJoint*> path;  // tip to root, then reversed
+  for (auto j = joints.find(tip); j != joints.end(); j = joints.find(j->second.parent)) {
+    path.push_back(&j->second);
+  }
+  std::reverse(path.begin(), path.end());
+  KDL::Chain chain;
+  KDL::JntArray values(0);
+  std::vector<double> moving;
+  for (const XmlJoint* j : path) {
+    const Eigen::Matrix3d R = j->origin.linear();
+    const Vector3d p = j->origin.translation(), axis = R * j->axis;
+    const KDL::Frame origin(KDL::Rotation(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2),
+                                          R(2, 0), R(2, 1), R(2, 2)),
+                            KDL::Vector(p.x(), p.y(), p.z()));
+    const KDL::Joint::JointType type = j->type == "fixed"       ? KDL::Joint::None
+                                       : j->type == "prismatic" ? KDL::Joint::TransAxis
+                                                                : KDL::Joint::RotAxis;
+    const KDL::Joint joint =
+        type == KDL::Joint::None
+            ? KDL::Joint(j->name, KDL::Joint::None)
+            : KDL::Joint(j->name, origin.p, KDL::Vector(axis.x(), axis.y(), axis.z()), type);
+    chain.addSegment(KDL::Segment(j->child, joint, origin));
+    if (type != KDL::Joint::None) moving.push_back(q.count(j->name) > 0 ? q.at(j->name) : 0.0);
+  }
+  values.resize(unsigned(moving.size()));
+  for (std::size_t i = 0; i < moving.size(); ++i) values(unsigned(i)) = moving[i];
+  KDL::ChainFkSolverPos_recursive fk(chain);
+  KDL::Frame out;
+  EXPECT_GE(fk.JntToCart(values, out), 0);
+  Isometry3d X = Isometry3d::Identity();
+  for (int r = 0; r < 3; ++r) {
+    X.translation()[r] = out.p[r];
+    for (int c = 0; c < 3; ++c) X.linear()(r, c) = out.M(r, c);
+  }
+  return X;
+}
+
+TEST(RobotDescriptionTest, TipPosesAgreeWithOrocosKdl) {
+  std::vector<std::pair<fs::path, std::string>> robots = {{BundledArm(), "flange"}};
+  if (fs::exists(Kuka())) robots.emplace_back(Kuka(), "tool0");
+  for (const auto& [file, tip] : robots) {
+    const Level level = LoadLevel(file);
+    const RobotModel& model = level.robots.at(0);
+    const std::map<std::string, XmlJoint> joints = ReadJoints(file);
+    RobotState state(model);
+    std::mt19937 random(11);
+    for (int trial = 0; trial < 10; ++trial) {
+      std::map<std::string, double> q;
+      for (std::size_t b = 0; b < model.bones.size(); ++b) {
+        const XmlJoint& j = joints.at(model.nodes[std::size_t(model.bones[b].node)].name);
+        const double lower = j.type == "continuous" ? -6.0 : j.lower;
+        const double upper = j.type == "continuous" ? 6.0 : j.upper;
+        q[j.name] = std::uniform_real_distribution<double>(lower, upper)(random);
+        ASSERT_TRUE(state.SetBone(int(b), &q[j.name], 1));
+      }
+      state.UpdateKinematics();
+      const Isometry3d kdl = KdlPose(joints, tip, q);
+      const Eigen::Affine3d& ours = state.node_poses_B()[std::size_t(model.FindNode(tip))];
+      EXPECT_LT((ours.translation() - kdl.translation()).norm(), 1e-9) << file << " " << trial;
+      EXPECT_LT((ours.linear() - kdl.linear()).norm(), 1e-9) << file << " " << trial;
+    }
+  }
+}
+#endif
 
 TEST(RobotDescriptionTest, ValuesBeyondLimitsAreRejectedAndCountedNeverClamped) {
   const Level level = LoadLevel(BundledArm());
