@@ -353,11 +353,11 @@ RobotSpec ParseRobot(const fs::path& file, const toml::table& table, int index) 
   if (model && description)
     read.Fail(read.Find("description"), "give 'file' or 'description', not both");
   if (!model && !description)
-    read.Fail(nullptr, "'file' (a model) or 'description' (URDF) is required");
+    read.Fail(nullptr, "'file' (a model) or 'description' (URDF, SDF) is required");
   robot.file = AssetPath(file, model ? *model : *description);
   if (description && !IsRobotDescription(robot.file)) {
     read.Fail(read.Find("description"),
-              "'description' must be a robot description (.urdf), got '" + *description + "'");
+              "'description' must be a robot description (.urdf, .sdf), got '" + *description + "'");
   }
   robot.placement = ParsePlacement(read);
   robot.collision = read.Flag("collision").value_or(true);

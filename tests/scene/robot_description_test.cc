@@ -282,6 +282,53 @@ TEST(RobotDescriptionTest, CollisionBodyFollowsTheLinksCollisionShapes) {
   EXPECT_TRUE(world.CastRay(flange * Vector3d(0.5, 0, 0), flange * Vector3d(-0.01, 0, 0)));
 }
 
+// A grid of rays from beside the posed arm sees the robot's collision body
+// where it sees the same shapes placed as actors by the kinematics computed
+// here from the XML.
+TEST(RobotDescriptionTest, ScanOfThePosedArmMatchesItsShapesPlacedByIndependentKinematics) {
+  const Level level = LoadLevel(BundledArm());
+  const RobotModel& arm = level.robots[0];
+  const std::map<std::string, XmlJoint> joints = ReadJoints(BundledArm());
+  const std::map<std::string, double> q = {
+      {"base_yaw", -0.6}, {"shoulder", 0.7}, {"elbow", 1.1}, {"extend", 0.12}, {"wrist_roll", -2}};
+  const Isometry3d X_WB =
+      Eigen::Translation3d(0.3, -0.2, 0.1) * Eigen::AngleAxisd(0.4, Vector3d::UnitZ());
+  RobotState state(arm);
+  ASSERT_TRUE(state.SetPose(X_WB));
+  for (const auto& [name, value] : q) ASSERT_TRUE(state.SetBone(arm.FindBone(name), &value, 1));
+  state.UpdateKinematics();
+  CollisionWorld robot_world(level);
+  robot_world.UpdateRobot(0, state);
+  // The same shapes (the collision meshes, in their links' frames) as actors.
+  Level placed;
+  for (const SkinnedMesh& mesh : arm.collision_meshes) {
+    const std::string& link = arm.nodes[std::size_t(arm.joints[mesh.influence_joint[0]].node)].name;
+    Actor actor;
+    actor.name = link + std::to_string(placed.actors.size());
+    actor.X_WA = X_WB * LinkPose(joints, link, q);
+    actor.meshes.push_back(mesh.bind);
+    actor.bounds_W.setEmpty();
+    for (const Eigen::Vector3f& p : mesh.bind.positions_A) {
+      actor.bounds_W.extend(actor.X_WA * p.cast<double>());
+    }
+    placed.actors.push_back(std::move(actor));
+  }
+  CollisionWorld actor_world(placed);
+  // 81 x 81 rays along -x from x = 2, over y, z in [-1, 1] x [0, 2] about the base.
+  int hits = 0;
+  for (int r = 0; r <= 80; ++r) {
+    for (int c = 0; c <= 80; ++c) {
+      const Vector3d from(2.0, -1.0 + c / 40.0, r / 40.0), to(-2.0, from.y(), from.z());
+      const auto a = robot_world.CastRay(from, to), b = actor_world.CastRay(from, to);
+      ASSERT_EQ(a.has_value(), b.has_value()) << r << " " << c;
+      if (!a) continue;
+      ++hits;
+      EXPECT_NEAR(a->distance_m, b->distance_m, 1e-5) << r << " " << c;
+    }
+  }
+  EXPECT_GT(hits, 100);  // the arm, 5 to 30 cm thick, crosses the 2.5 cm grid
+}
+
 // A bad description: the error names the file and what is wrong.
 void ExpectRefused(const std::string& xml, const std::vector<std::string>& parts,
                    const std::string& name = "bad.urdf") {
