@@ -29,6 +29,7 @@ const char* kUsage =
     "  run [LEVEL]             the loop: LCM inputs, sensors, outputs at a fixed rate\n"
     "  render [LEVEL] --camera C --at X,Y,Z --out F  one camera frame (OSMesa)\n"
     "  topics                  the LCM channels heard: type, count, rate, size\n"
+    "LEVEL: a level manifest (.toml), a scene file, or a robot description (.urdf, .sdf)\n"
     "run 'sandbox COMMAND --help' for a command's options\n";
 
 }  // namespace
