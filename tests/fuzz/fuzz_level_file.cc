@@ -18,6 +18,7 @@
 
 #include "scene/asset_import.h"
 #include "scene/heightmap.h"
+#include "tests/fuzz/fuzz_file.h"
 
 namespace {
 
@@ -44,14 +45,7 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;
   const std::string& format = Formats()[data[0] % Formats().size()];
-  static const std::string folder = std::filesystem::is_directory("/dev/shm")
-                                        ? "/dev/shm"
-                                        : std::filesystem::temp_directory_path().string();
-  const std::string file = folder + "/sandbox-fuzz-" + std::to_string(getpid()) + "." + format;
-  {
-    std::ofstream out(file, std::ios::binary | std::ios::trunc);
-    out.write(reinterpret_cast<const char*>(data + 1), std::streamsize(size - 1));
-  }
+  const std::string file = sandbox::fuzz::WriteInputFile(data + 1, size - 1, format);
   sandbox::scene::LoadLimits limits;
   limits.max_heightmap_samples = 1u << 20;  // fuzzing needs fast executions, not big grids
   limits.max_texture_pixels = 1u << 20;
