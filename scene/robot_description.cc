@@ -71,6 +71,42 @@ std::vector<fs::path> PathList(const char* variable) {
   return out;
 }
 
+// Refuses a link that is the child of two joints, and joints that form a
+// loop, before urdfdom sees them (it reports them less clearly, and leaks the
+// links of a loop).
+void CheckJointTree(const fs::path& file, const TiXmlDocument& document) {
+  const TiXmlElement* robot = document.RootElement();
+  if (robot == nullptr) return;
+  std::map<std::string, std::pair<std::string, std::string>> parent_of;  // child: parent, joint
+  for (const TiXmlElement* joint = robot->FirstChildElement("joint"); joint != nullptr;
+       joint = joint->NextSiblingElement("joint")) {
+    const TiXmlElement* parent = joint->FirstChildElement("parent");
+    const TiXmlElement* child = joint->FirstChildElement("child");
+    const char* name = joint->Attribute("name");
+    if (parent == nullptr || child == nullptr || parent->Attribute("link") == nullptr ||
+        child->Attribute("link") == nullptr || name == nullptr) {
+      continue;  // urdfdom names what is missing
+    }
+    const auto [at, is_new] =
+        parent_of.try_emplace(child->Attribute("link"), parent->Attribute("link"), name);
+    if (!is_new) {
+      throw LevelError(file.string() + ":" + std::to_string(joint->Row()) + ": link '" + at->first +
+                       "' is the child of two joints ('" + at->second.second + "', '" + name +
+                       "')");
+    }
+  }
+  for (const auto& [start, unused] : parent_of) {
+    std::set<std::string> seen{start};
+    for (auto up = parent_of.find(start); up != parent_of.end();
+         up = parent_of.find(up->second.first)) {
+      if (!seen.insert(up->second.first).second) {
+        throw LevelError(file.string() + ": the joints form a loop through link '" +
+                         up->second.first + "' (joint '" + up->second.second + "')");
+      }
+    }
+  }
+}
+
 LinkGeometry ConvertGeometry(const urdf::Geometry& geometry, const urdf::Pose& origin,
                              const fs::path& file, const std::string& where) {
   LinkGeometry out;
@@ -223,6 +259,7 @@ RobotDescription ReadUrdf(const fs::path& file) {
       throw LevelError(file.string() + ":" + std::to_string(document.ErrorRow()) +
                        ": malformed XML: " + document.ErrorDesc());
     }
+    CheckJointTree(file, document);
   }
   urdf::ModelInterfaceSharedPtr model;
   Collect messages;

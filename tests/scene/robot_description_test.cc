@@ -359,7 +359,13 @@ TEST(RobotDescriptionTest, BadDescriptionsAreRefusedNamingFileAndElement) {
                       "</link><joint name=\"j\" type=\"fixed\"><parent link=\"a\"/><child "
                       "link=\"b\"/></joint><joint name=\"k\" type=\"fixed\"><parent "
                       "link=\"b\"/><child link=\"a\"/></joint>"),
-                {"not a valid URDF"});
+                {"the joints form a loop through link", "(joint '"});
+  ExpectRefused(Robot("<link name=\"a\">" + kBox + "</link><link name=\"b\">" + kBox +
+                      "</link><link name=\"c\">" + kBox +
+                      "</link><joint name=\"j\" type=\"fixed\"><parent link=\"a\"/><child "
+                      "link=\"c\"/></joint><joint name=\"k\" type=\"fixed\"><parent "
+                      "link=\"b\"/><child link=\"c\"/></joint>"),
+                {"link 'c' is the child of two joints ('j', 'k')"});
   ExpectRefused(Robot("<link name=\"a\">" + kBox + "</link><link name=\"b\">" + kBox +
                       "</link><joint name=\"j\" type=\"revolute\"><parent link=\"a\"/><child "
                       "link=\"b\"/><limit lower=\"1\" upper=\"-1\" effort=\"1\" "
