@@ -113,6 +113,20 @@ bool RobotState::SetBones(const std::vector<double>& values) {
 
 void RobotState::Update() {
   UpdateKinematics();
+  // One skinning matrix per joint, in float.
+  for (std::size_t j = 0; j < model_->joints.size(); ++j) {
+    const SkinJoint& joint = model_->joints[j];
+    skin_[j] = (X_BN_[static_cast<std::size_t>(joint.node)] * joint.offset)
+                   .matrix()
+                   .topRows<3>()
+                   .cast<float>();
+  }
+  // A joint's matrix is rigid when its 3x3 part is a rotation: normals then
+  // keep their length and need no normalising.
+  for (std::size_t j = 0; j < skin_.size(); ++j) {
+    const Eigen::Matrix3f L = skin_[j].leftCols<3>();
+    rigid_[j] = (L.transpose() * L - Eigen::Matrix3f::Identity()).cwiseAbs().maxCoeff() < 1e-5f;
+  }
   for (std::size_t m = 0; m < model_->meshes.size(); ++m) {
     const SkinnedMesh& mesh = model_->meshes[m];
     for (const SkinRun& run : mesh.runs) SkinRunOfVertices(mesh, run, m);
@@ -130,20 +144,6 @@ void RobotState::UpdateKinematics() {
     X_BN_[n] = X_BP * node.X_PN;
     X_BN_[n].translate(translation_[n]);
     X_BN_[n].linear() *= rotation_[n].toRotationMatrix();
-  }
-  // One skinning matrix per joint, in float.
-  for (std::size_t j = 0; j < model_->joints.size(); ++j) {
-    const SkinJoint& joint = model_->joints[j];
-    skin_[j] = (X_BN_[static_cast<std::size_t>(joint.node)] * joint.offset)
-                   .matrix()
-                   .topRows<3>()
-                   .cast<float>();
-  }
-  // A joint's matrix is rigid when its 3x3 part is a rotation: normals then
-  // keep their length and need no normalising.
-  for (std::size_t j = 0; j < skin_.size(); ++j) {
-    const Eigen::Matrix3f L = skin_[j].leftCols<3>();
-    rigid_[j] = (L.transpose() * L - Eigen::Matrix3f::Identity()).cwiseAbs().maxCoeff() < 1e-5f;
   }
 }
 
