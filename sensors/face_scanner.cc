@@ -189,7 +189,8 @@ void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
     throw std::invalid_argument("FaceScanner::Scan(): non-finite pose");
   if (scan->n != n_ || scan->normals != config_.normals) *scan = EmptyScan();
   const std::vector<Part> parts = DueAt(tick);
-  // The rays and hits keep their memory from scan to scan (no allocation a tick).
+  // The rays keep their memory from scan to scan (no allocation a tick); the
+  // hits go straight into the faces (RayGrid::into), `hits` stays empty.
   thread_local RayBatch rays;
   thread_local RayHits hits;
   hits.with_normals = config_.normals;
@@ -200,7 +201,14 @@ void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
   grids.clear();
   std::size_t total = 0;
   for (const Part& part : parts) {
-    grids.push_back(GridOf(part, X_WS, total));
+    // The caster writes the part's rows of its face directly.
+    ScanFace& face = scan->faces[std::size_t(part.face)];
+    const std::size_t k0 = std::size_t(part.row_begin) * std::size_t(n_);
+    RayGrid grid = GridOf(part, X_WS, total);
+    grid.into.distance_m = face.distance_m.data() + k0;
+    grid.into.surface = face.surface.data() + k0;
+    if (config_.normals) grid.into.normal_W = face.normal_W.data() + k0;
+    grids.push_back(grid);
     total += std::size_t(part.row_end - part.row_begin) * std::size_t(n_);
   }
   // (The jobs reach this thread's thread_local batch and grids through
@@ -220,9 +228,7 @@ void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
     FillRays(rows_of, X_WS, batch.origin_W, &batch, first, true);
   });
   caster.CastGrids(world, rays, grids, filter, &hits);
-  // Write each part's results back into its face (a part a job; through a
-  // reference, as above).
-  const RayHits& cast = hits;
+  // Each part's occupancy from its surfaces (a part a job).
   caster.RunParallel(int(parts.size()), [&](int p) {
     const Part& part = parts[std::size_t(p)];
     ScanFace& face = scan->faces[std::size_t(part.face)];
@@ -230,18 +236,10 @@ void FaceScanner::Scan(const scene::CollisionWorld& world, RayCaster& caster,
     face.X_WS = X_WS;
     face.X_WB = BoxFrame(X_WS);
     const std::size_t k0 = std::size_t(part.row_begin) * std::size_t(n_);
-    const std::size_t count = std::size_t(part.row_end - part.row_begin) * std::size_t(n_);
-    const std::size_t i0 = blocks[std::size_t(p)].first;  // the part's first ray
-    for (std::size_t j = 0; j < count; ++j) {
-      face.occupancy[k0 + j] = cast.surface[i0 + j] == RayHits::kNoHit ? kFree : kOccupied;
+    const std::size_t end = std::size_t(part.row_end) * std::size_t(n_);
+    for (std::size_t k = k0; k < end; ++k) {
+      face.occupancy[k] = face.surface[k] == RayHits::kNoHit ? kFree : kOccupied;
     }
-    auto copy = [&](const auto& from, auto& to) {
-      std::copy(from.begin() + std::ptrdiff_t(i0), from.begin() + std::ptrdiff_t(i0 + count),
-                to.begin() + std::ptrdiff_t(k0));
-    };
-    copy(cast.distance_m, face.distance_m);
-    copy(cast.surface, face.surface);
-    if (config_.normals) copy(cast.normal_W, face.normal_W);
   });
 }
 

@@ -331,7 +331,10 @@ void HitPairs(GridBand* band) {
     if (mask == 0) continue;
     alignas(16) float t_hit[4], nx[4], ny[4], nz[4];
     _mm_store_ps(t_hit, t_max);
-    _mm_store_ps(nx, n.x), _mm_store_ps(ny, n.y), _mm_store_ps(nz, n.z);
+    if (band->normal != nullptr) {
+      n = FacingUnits4(n, d);
+      _mm_store_ps(nx, n.x), _mm_store_ps(ny, n.y), _mm_store_ps(nz, n.z);
+    }
     for (int lane = 0; lane < in_packet; ++lane) {
       const auto i = std::size_t(cell[lane]);
       const bool nearer =

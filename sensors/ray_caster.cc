@@ -396,11 +396,16 @@ void CastBand(const BandJob& this_band, const RayBatch& rays, const Eigen::Vecto
   band.ox = _mm_set1_ps(origin_B.x()), band.oy = _mm_set1_ps(origin_B.y());
   band.oz = _mm_set1_ps(origin_B.z());
   band.start = rays.start.data() + first;
-  band.t_max = hits->distance_m.data() + first;
-  band.surface = hits->surface.data() + first;
+  const std::size_t offset = std::size_t(this_band.row_begin) * std::size_t(grid.cols);
+  const bool into = grid.into.distance_m != nullptr;
+  band.t_max = into ? grid.into.distance_m + offset : hits->distance_m.data() + first;
+  band.surface = into ? grid.into.surface + offset : hits->surface.data() + first;
   std::fill(band.t_max, band.t_max + count, length);
   std::fill(band.surface, band.surface + count, RayHits::kNoHit);
-  band.normal = hits->with_normals ? hits->normal_W.data() + first : nullptr;
+  band.normal = !hits->with_normals ? nullptr
+                : into              ? grid.into.normal_W + offset
+                                    : hits->normal_W.data() + first;
+  if (band.normal != nullptr) std::fill(band.normal, band.normal + count, Eigen::Vector3f::Zero());
   band.pairs.count = 0;
   for (const Target& target : targets) {
     if (!wanted(target) || (target.aabb_min.array() > area.box_max.array()).any() ||
@@ -416,7 +421,6 @@ void CastBand(const BandJob& this_band, const RayBatch& rays, const Eigen::Vecto
     });
   }
   hit_pairs(&band);
-  if (band.normal != nullptr) FacingUnits(band.surface, count, d, band.normal);
 }
 
 // The bands of rows CastGrids() casts, each a chunk of work (each band walks
@@ -455,8 +459,9 @@ std::vector<BandJob> PlanBands(const std::vector<RayGrid>& grids,
 }
 
 // Throws std::invalid_argument unless the blocks cover the batch's n rays in
-// order, each with a unit direction and a positive length.
-void CheckGrids(const std::vector<RayGrid>& grids, std::size_t n) {
+// order, each with a unit direction, a positive length and, if it has an
+// `into`, every output the call writes.
+void CheckGrids(const std::vector<RayGrid>& grids, std::size_t n, bool with_normals) {
   std::size_t next = 0;
   for (const RayGrid& grid : grids) {
     if (grid.first != next || grid.rows < 0 || grid.cols <= 0 ||
@@ -469,6 +474,15 @@ void CheckGrids(const std::vector<RayGrid>& grids, std::size_t n) {
         !(std::isfinite(grid.length_m) && grid.length_m > 0.0f)) {
       throw std::invalid_argument(
           "RayCaster::CastGrids(): a block's direction must be unit and its length positive");
+    }
+    const RayGrid::Into& into = grid.into;
+    const bool any =
+        into.distance_m != nullptr || into.surface != nullptr || into.normal_W != nullptr;
+    if (any && (into.distance_m == nullptr || into.surface == nullptr ||
+                (with_normals && into.normal_W == nullptr))) {
+      throw std::invalid_argument(
+          "RayCaster::CastGrids(): a block's `into` needs its distances, surfaces" +
+          std::string(with_normals ? " and normals" : ""));
     }
   }
   if (next != n) {
@@ -569,12 +583,15 @@ void RayCaster::CastGrids(const scene::CollisionWorld& world, const RayBatch& ra
                           const std::vector<RayGrid>& grids, const RayFilter& filter,
                           RayHits* hits) {
   const std::size_t n = rays.size();
-  CheckGrids(grids, n);
+  CheckGrids(grids, n, hits->with_normals);
   if (hits->with_reflectivity) {
     throw std::invalid_argument("RayCaster::CastGrids(): with_reflectivity is Cast()'s only");
   }
   rays_cast_ += std::int64_t(n);
-  SizeHits(n, hits);
+  const bool all_into = std::all_of(grids.begin(), grids.end(), [](const RayGrid& grid) {
+    return grid.into.distance_m != nullptr;
+  });
+  if (!all_into) SizeHits(n, hits);
   if (n == 0) return;
   const Eigen::Vector3f origin_B = (rays.origin_W - world.origin()).cast<float>();
   const std::vector<Target>& targets = TargetsOf(world).For(filter);

@@ -55,6 +55,17 @@ struct RayGrid {
   Eigen::Vector3d step_u_W{Eigen::Vector3d::UnitX()}, step_v_W{Eigen::Vector3d::UnitY()};
   Eigen::Vector3f direction{Eigen::Vector3f::UnitZ()};  // unit
   float length_m{1.0f};
+  // Where CastGrids() writes this block's results, rows * cols entries each
+  // (ray (r, c) at r * cols + c; `normal_W` read only with normals asked
+  // for), instead of into its RayHits, whose entries for the block are then
+  // left as they were (and the RayHits not even sized when every block has
+  // its own): a caller that keeps results elsewhere (the face scanner's
+  // faces) saves a copy. All null: into the RayHits.
+  struct Into {
+    float* distance_m{nullptr};
+    std::int32_t* surface{nullptr};
+    Eigen::Vector3f* normal_W{nullptr};
+  } into;
 };
 
 // What rays may see.
@@ -112,8 +123,9 @@ class RayCaster {
   // docs/reference/sensors.md for the one difference a tie can make) when the batch's
   // rays run along their block's direction for its length. Throws
   // std::invalid_argument when the blocks do not cover the batch in order,
-  // a block's direction is not unit or its length not positive, or hits ask
-  // for reflectivity.
+  // a block's direction is not unit or its length not positive, a block's
+  // `into` lacks the distances, surfaces or (with normals) normals, or hits
+  // ask for reflectivity.
   void CastGrids(const scene::CollisionWorld& world, const RayBatch& rays,
                  const std::vector<RayGrid>& grids, const RayFilter& filter, RayHits* hits);
 

@@ -42,55 +42,6 @@ static inline Eigen::Vector3f FacingUnit(const Eigen::Vector3f& normal,
   return normal * (normal.dot(direction) > 0.0f ? -scale : scale);
 }
 
-// [a[i0], a[i1], b[i2], b[i3]].
-template <int i0, int i1, int i2, int i3>
-static inline __m128 Pick(__m128 a, __m128 b) {
-  return _mm_shuffle_ps(a, b, _MM_SHUFFLE(i3, i2, i1, i0));
-}
-
-// The hits' normals of a band, unit and facing rays along `d`, in place; zero
-// where nothing was hit. Four at a time: three loads turned into x, y and z
-// by shuffles (and back for the stores), the reciprocal square root's
-// estimate and one Newton step (within 2 ulps of 1 / sqrt), a product each.
-static inline void FacingUnits(const std::int32_t* surface, std::size_t count,
-                               const Eigen::Vector3f& d, Eigen::Vector3f* normal) {
-  static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float), "packed normals");
-  const __m128 dx = _mm_set1_ps(d.x()), dy = _mm_set1_ps(d.y()), dz = _mm_set1_ps(d.z());
-  const __m128 half = _mm_set1_ps(0.5f), three = _mm_set1_ps(3.0f);
-  const __m128 sign = _mm_set1_ps(-0.0f), zero = _mm_setzero_ps();
-  std::size_t i = 0;
-  for (; i + 4 <= count; i += 4) {
-    float* p = normal[i].data();
-    // a = x0 y0 z0 x1, b = y1 z1 x2 y2, c = z2 x3 y3 z3
-    const __m128 a = _mm_loadu_ps(p), b = _mm_loadu_ps(p + 4), c = _mm_loadu_ps(p + 8);
-    const __m128 x = Pick<0, 3, 0, 2>(a, Pick<2, 2, 1, 1>(b, c));
-    const __m128 y = Pick<0, 2, 0, 2>(Pick<1, 1, 0, 0>(a, b), Pick<3, 3, 2, 2>(b, c));
-    const __m128 z = Pick<0, 2, 0, 3>(Pick<2, 2, 1, 1>(a, b), c);
-    const __m128 n2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, x), _mm_mul_ps(y, y)), _mm_mul_ps(z, z));
-    const __m128 r0 = _mm_rsqrt_ps(n2);
-    // r = r0 (3 - n2 r0^2) / 2
-    __m128 scale =
-        _mm_mul_ps(_mm_mul_ps(half, r0), _mm_sub_ps(three, _mm_mul_ps(n2, _mm_mul_ps(r0, r0))));
-    const __m128 along =
-        _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, dx), _mm_mul_ps(y, dy)), _mm_mul_ps(z, dz));
-    scale = _mm_xor_ps(scale, _mm_and_ps(_mm_cmpgt_ps(along, zero), sign));
-    const __m128i hit = _mm_xor_si128(
-        _mm_cmpeq_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(surface + i)),
-                        _mm_set1_epi32(RayHits::kNoHit)),
-        _mm_set1_epi32(-1));
-    const __m128 keep = _mm_castsi128_ps(hit);  // whatever a lane without a hit holds
-    const __m128 ux = _mm_and_ps(_mm_mul_ps(x, scale), keep);
-    const __m128 uy = _mm_and_ps(_mm_mul_ps(y, scale), keep);
-    const __m128 uz = _mm_and_ps(_mm_mul_ps(z, scale), keep);
-    _mm_storeu_ps(p, Pick<0, 2, 0, 2>(Pick<0, 0, 0, 0>(ux, uy), Pick<0, 0, 1, 1>(uz, ux)));
-    _mm_storeu_ps(p + 4, Pick<0, 2, 0, 2>(Pick<1, 1, 1, 1>(uy, uz), Pick<2, 2, 2, 2>(ux, uy)));
-    _mm_storeu_ps(p + 8, Pick<0, 2, 0, 2>(Pick<2, 2, 3, 3>(uz, ux), Pick<3, 3, 3, 3>(uy, uz)));
-  }
-  for (; i < count; ++i) {
-    normal[i] = surface[i] == RayHits::kNoHit ? Eigen::Vector3f::Zero() : FacingUnit(normal[i], d);
-  }
-}
-
 // Ray r's result: its distance, the surface hit and, when asked for, its
 // reflectivity and the unit normal facing the ray (zero without a hit).
 static inline void WriteHit(std::size_t r, float t, int surface, float reflectivity,
@@ -118,7 +69,7 @@ struct GridBand {
   const Eigen::Vector3f* start{nullptr};  // the cells' rays' starts
   float* t_max{nullptr};                  // their entries of RayHits::distance_m
   std::int32_t* surface{nullptr};         // of RayHits::surface
-  Eigen::Vector3f* normal{nullptr};       // of RayHits::normal_W, unnormalised; null: none
+  Eigen::Vector3f* normal{nullptr};       // of RayHits::normal_W (unit, facing); null: none
   // Triangle-ray pairs waiting for a test (HitPairs), in lanes' order.
   struct Pairs {
     static constexpr int kCapacity = 64;
