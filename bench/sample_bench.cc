@@ -69,9 +69,12 @@ void RunLevel(const char* name, const fs::path& file, const Eigen::Isometry3d& X
     sensors::FaceScannerConfig face_normals = face;
     face_normals.normals = true;
     const sensors::FaceScanner plain_face(face), normal_face(face_normals);
-    sensors::FaceScan scan;
+    // Each scanner its own scan, as in the loop (one scan for both would be
+    // made anew at every turn).
+    sensors::FaceScan plain_scan, normal_scan;
     Pair(name, "face 201^2 normals", threads, seconds, [&](bool normals) {
-      (normals ? normal_face : plain_face).Scan(world, caster, {}, X_WS, 0, &scan);
+      (normals ? normal_face : plain_face)
+          .Scan(world, caster, {}, X_WS, 0, normals ? &normal_scan : &plain_scan);
     });
     sensors::RayBatch rays;
     std::vector<sensors::RayGrid> grids;
