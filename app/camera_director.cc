@@ -58,7 +58,10 @@ int CameraDirector::Direct(const Shot& shot, FramePipeline* frames, bool write, 
     if (shown) job.settings.images |= render::kColorImage;  // the live view shows colour
     job.write = write;
     job.show = shown;
-    for (const scene::RobotState* r : shot.robots) job.robots.push_back(*r);
+    for (scene::RobotState* r : shot.robots) {
+      r->Skin();  // once a tick whatever the cameras due
+      job.robots.push_back(*r);
+    }
     for (std::size_t a = 0; a < level_.actors.size(); ++a) {
       job.actor_poses.push_back(shot.world->actor_pose(int(a)));
     }

@@ -31,7 +31,7 @@ class CameraDirector {
   struct Shot {
     double t_s{0.0};
     std::int64_t tick{0};
-    std::vector<const scene::RobotState*> robots;
+    std::vector<scene::RobotState*> robots;       // skinned when a frame is due
     std::vector<const bridge::RobotFeed*> feeds;  // steering and camera choice
     const scene::CollisionWorld* world{nullptr};
     const std::vector<sensors::Sensor>* sensors{nullptr};  // face scans for overlays

@@ -79,7 +79,7 @@ RobotFeed::Changes RobotFeed::Apply(std::int64_t now_utime, scene::RobotState* s
     }
   }
   if (changes.moved) {
-    state->Update();
+    state->UpdateKinematics();  // skinned when a camera draws it (RobotState::Skin)
     world->UpdateRobot(robot_, *state);
   }
   return changes;

@@ -113,6 +113,12 @@ bool RobotState::SetBones(const std::vector<double>& values) {
 
 void RobotState::Update() {
   UpdateKinematics();
+  Skin();
+}
+
+void RobotState::Skin() {
+  if (skinned_) return;
+  skinned_ = true;
   // One skinning matrix per joint, in float.
   for (std::size_t j = 0; j < model_->joints.size(); ++j) {
     const SkinJoint& joint = model_->joints[j];
@@ -145,6 +151,7 @@ void RobotState::UpdateKinematics() {
     X_BN_[n].translate(translation_[n]);
     X_BN_[n].linear() *= rotation_[n].toRotationMatrix();
   }
+  skinned_ = false;
 }
 
 // One vertex, any number of influences: blend the matrices, then apply.

@@ -35,9 +35,14 @@ class RobotState {
 
   // Forward kinematics, root to tip, then linear-blend skinning of every mesh.
   void Update();
-  // Forward kinematics alone: node poses (and what CollisionWorld::UpdateRobot
-  // needs), the posed meshes left as they were.
+  // Forward kinematics alone: node poses (all CollisionWorld::UpdateRobot and
+  // the sensors read), the posed meshes left as they were until Skin().
   void UpdateKinematics();
+  // Linear-blend skinning of every mesh for the node poses, unless they are
+  // skinned already (only a camera draws the posed meshes: the loop skins
+  // when a frame is due, not every tick).
+  void Skin();
+  bool skinned() const { return skinned_; }
 
   const RobotModel& model() const { return *model_; }
   const Eigen::Isometry3d& pose() const { return X_WB_; }
@@ -50,7 +55,8 @@ class RobotState {
   // Where a sensor or camera mounted as `spec` says is: the robot pose, its
   // mount node's rigid part (none: the body frame) and the offset X_MS.
   Eigen::Isometry3d MountPose(const SensorSpec& spec) const;
-  // The posed mesh in frame B, one array per RobotModel::meshes entry.
+  // The posed mesh in frame B, one array per RobotModel::meshes entry (as of
+  // the last Skin()).
   const std::vector<Eigen::Vector3f>& positions_B(int mesh) const;
   const std::vector<Eigen::Vector3f>& normals_B(int mesh) const;
   // Rejected updates by reason, and the reason of the latest one.
@@ -72,6 +78,7 @@ class RobotState {
   std::vector<bool> rigid_;                       // per joint: skin_ keeps lengths
   std::vector<std::vector<Eigen::Vector3f>> positions_B_;
   std::vector<std::vector<Eigen::Vector3f>> normals_B_;
+  bool skinned_{false};  // positions_B_ and normals_B_ are of X_BN_
   std::map<std::string, int> rejected_;
   std::string last_rejection_;
 };

@@ -95,6 +95,31 @@ TEST_F(RobotTest, WingBendsNinetyDegreesTipToTipAsTheAnalyticChain) {
   EXPECT_NEAR(AngleAxisd(R_right.transpose() * R_left).angle(), 90.0 * kDeg, 1e-5);
 }
 
+// The loop moves node poses every tick and skins only when a camera draws:
+// UpdateKinematics leaves the posed mesh alone, Skin catches it up to exactly
+// what Update makes.
+TEST_F(RobotTest, SkinningWaitsForSkinAndThenMatchesUpdate) {
+  const RobotModel& wing = Robot("ELAHA");
+  const RobotState rest(wing);
+  RobotState lazy(wing), eager(wing);
+  EXPECT_TRUE(lazy.skinned());
+  for (int b = 1; b <= 20; ++b) {
+    const double values[2] = {(b <= 10 ? 4.5 : -4.5) * kDeg, 0.0};
+    ASSERT_TRUE(lazy.SetBone(b, values, 2));
+    ASSERT_TRUE(eager.SetBone(b, values, 2));
+  }
+  lazy.UpdateKinematics();
+  eager.Update();
+  EXPECT_FALSE(lazy.skinned());
+  EXPECT_TRUE(lazy.node_poses_B()[std::size_t(wing.bones[10].node)].isApprox(
+      eager.node_poses_B()[std::size_t(wing.bones[10].node)]));
+  EXPECT_EQ(lazy.positions_B(0), rest.positions_B(0));  // still the old pose
+  lazy.Skin();
+  EXPECT_TRUE(lazy.skinned());
+  EXPECT_EQ(lazy.positions_B(0), eager.positions_B(0));
+  EXPECT_EQ(lazy.normals_B(0), eager.normals_B(0));
+  EXPECT_NE(lazy.positions_B(0), rest.positions_B(0));
+}
 TEST_F(RobotTest, BentWingSkinHasNoCracks) {
   const RobotModel& wing = Robot("ELAHA");
   const RobotState rest(wing);
