@@ -1,6 +1,8 @@
 // SDF robot descriptions, read with sdformat (the model of a model file, its
 // <include>d models nested under their names: "gps::link").
 
+#include <tinyxml.h>
+
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -8,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "scene/files.h"
 #include "scene/placement.h"
 #include "scene/robot_description.h"
 
@@ -53,16 +56,73 @@ double Limit(double value) {
   return std::abs(value) >= 1e15 ? std::copysign(HUGE_VAL, value) : value;
 }
 
+// What sdformat 12 would crash on, refused before it reads the file: a URDF
+// (it converts one itself), and a <world> (its 1.7-to-1.8 conversion of a
+// world's flattened models throws an exception of its own type on a joint
+// whose <parent> lies outside, and reads through a null pointer on an <axis>
+// without <xyz>; found by the robot_description fuzz target). A robot
+// description is a <model>; a world holds none the sandbox would take anyway.
+void CheckSdfformatCanReadIt(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::stringstream xml;
+  xml << in.rdbuf();
+  TiXmlDocument document;
+  document.Parse(xml.str().c_str());
+  if (document.Error()) {
+    throw LevelError(file.string() + ":" + std::to_string(document.ErrorRow()) +
+                     ": malformed XML: " + document.ErrorDesc());
+  }
+  bool sdf = false;
+  std::vector<const TiXmlElement*> stack;
+  for (const TiXmlElement* top = document.FirstChildElement(); top != nullptr;
+       top = top->NextSiblingElement()) {
+    const std::string name = top->Value();
+    if (name == "robot") {
+      throw LevelError(file.string() + ":" + std::to_string(top->Row()) +
+                       ": a URDF <robot>, not SDF: name the file .urdf");
+    }
+    sdf = sdf || name == "sdf";
+    stack.push_back(top);
+  }
+  if (!sdf) throw LevelError(file.string() + ": not a valid SDF model: it has no <sdf> element");
+  while (!stack.empty()) {
+    const TiXmlElement* element = stack.back();
+    stack.pop_back();
+    if (std::string(element->Value()) == "world") {
+      throw LevelError(file.string() + ":" + std::to_string(element->Row()) +
+                       ": an SDF <world>; a robot description is a <model> file (give the "
+                       "model's own .sdf)");
+    }
+    for (const TiXmlElement* child = element->FirstChildElement(); child != nullptr;
+         child = child->NextSiblingElement()) {
+      stack.push_back(child);
+    }
+  }
+}
+
 class SdfReader {
  public:
   explicit SdfReader(const fs::path& file) : file_(file) {}
 
   RobotDescription Read() {
+    CheckSdfformatCanReadIt(file_);
+    // sdformat's assertions throw sdf::Exception, which is no std::exception.
+    try {
+      return ReadChecked();
+    } catch (const sdf::Exception& error) {
+      throw LevelError(file_.string() + ": sdformat failed on it: " + error.GetErrorStr());
+    }
+  }
+
+ private:
+  RobotDescription ReadChecked() {
     sdf::ParserConfig config;
     std::string unresolved;
     config.SetFindCallback([&](const std::string& uri) -> std::string {
       try {
-        return ResolveResourceUri(uri, file_).string();
+        const fs::path found = ResolveResourceUri(uri, file_);
+        CheckIncluded(found);
+        return found.string();
       } catch (const LevelError& error) {
         if (unresolved.empty()) unresolved = error.what();
         return "";
@@ -112,7 +172,20 @@ class SdfReader {
     return std::move(out_);
   }
 
- private:
+  // An <include>d model folder's SDF files (or the file named) get the same
+  // check as the describing file: sdformat converts them the same way.
+  static void CheckIncluded(const fs::path& found) {
+    std::error_code error;
+    if (!fs::is_directory(found, error)) {
+      if (LowerExtension(found) == ".sdf") CheckSdfformatCanReadIt(found);
+      return;
+    }
+    for (const fs::directory_entry& entry : fs::directory_iterator(found, error)) {
+      if (entry.is_regular_file(error) && LowerExtension(entry.path()) == ".sdf")
+        CheckSdfformatCanReadIt(entry.path());
+    }
+  }
+
   struct Link {
     DescribedLink link;
     Eigen::Isometry3d X_ML;  // in the top model's frame

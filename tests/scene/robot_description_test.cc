@@ -548,7 +548,7 @@ TEST(RobotDescriptionTest, BadSdfIsRefusedNamingFileAndWhat) {
   };
   const std::string box =
       "<visual name=\"v\"><geometry><box><size>1 1 1</size></box></geometry></visual>";
-  refused("<model name=\"m\"><link name=\"a\">" + box + "</link>", {"not a valid SDF"});
+  refused("<model name=\"m\"><link name=\"a\">" + box + "</link>", {"bad.sdf:2", "malformed XML"});
   refused("<model name=\"m\"><include><uri>model://no_such_model</uri></include><link name=\"a\">" +
               box + "</link></model>",
           {"model://no_such_model", "searched"});
@@ -561,6 +561,24 @@ TEST(RobotDescriptionTest, BadSdfIsRefusedNamingFileAndWhat) {
       "name=\"v\"><geometry><mesh><uri>meshes/none.stl</uri>"
       "</mesh></geometry></visual></link></model>",
       {"link 'a' visual", "meshes/none.stl", "not found"});
+  // What sdformat 12 crashes on is refused before it reads the file: a
+  // world's flattened model whose joint's parent lies outside (an uncaught
+  // exception of sdformat's own) or whose <axis> has no <xyz> (a null
+  // pointer), and a URDF under the .sdf name.
+  refused(
+      "<world name=\"w\"><model name=\"m\"><link name=\"a\"/><link name=\"b\"/>"
+      "<joint name=\"x::j\" type=\"fixed\"><parent>a</parent><child>b</child></joint>"
+      "</model></world>",
+      {"bad.sdf:2", "<world>", "<model>"});
+  refused(
+      "<world name=\"w\"><model name=\"m\"><link name=\"x::a\"/><link name=\"x::b\"/>"
+      "<joint name=\"x::j\" type=\"revolute\"><parent>x::a</parent><child>x::b</child>"
+      "<axis><limit/></axis></joint></model></world>",
+      {"bad.sdf:2", "<world>"});
+  ExpectRefused("<?xml version=\"1.0\"?>\n<robot name=\"r\"><link name=\"a\"/></robot>\n",
+                {"bad.sdf:2", "URDF", ".urdf"}, "bad.sdf");
+  ExpectRefused("<?xml version=\"1.0\"?>\n<model name=\"m\"/>\n", {"bad.sdf", "no <sdf>"},
+                "bad.sdf");
 }
 
 }  // namespace
