@@ -57,11 +57,11 @@ double Limit(double value) {
 }
 
 // What sdformat 12 would crash on, refused before it reads the file: a URDF
-// (it converts one itself), and a <world> (its 1.7-to-1.8 conversion of a
-// world's flattened models throws an exception of its own type on a joint
-// whose <parent> lies outside, and reads through a null pointer on an <axis>
-// without <xyz>; found by the robot_description fuzz target). A robot
-// description is a <model>; a world holds none the sandbox would take anyway.
+// (it converts one itself), a version that is not digits.digits, and a <world> (its 1.7-to-1.8
+// conversion of a world's flattened models throws an exception of its own type on a joint whose
+// <parent> lies outside, and reads through a null pointer on an <axis> without <xyz>; found by the
+// robot_description fuzz target). A robot description is a <model>; a world holds none the sandbox
+// would take anyway.
 void CheckSdfformatCanReadIt(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
   std::stringstream xml;
@@ -81,7 +81,22 @@ void CheckSdfformatCanReadIt(const fs::path& file) {
       throw LevelError(file.string() + ":" + std::to_string(top->Row()) +
                        ": a URDF <robot>, not SDF: name the file .urdf");
     }
-    sdf = sdf || name == "sdf";
+    if (name == "sdf") {
+      // ignition's version parser throws std::invalid_argument on "1.(".
+      const char* version = top->Attribute("version");
+      const std::string text = version != nullptr ? version : "";
+      const std::size_t dot = text.find('.');
+      const auto digits = [](const std::string& part) {
+        return !part.empty() && part.size() <= 3 &&
+               part.find_first_not_of("0123456789") == std::string::npos;
+      };
+      if (dot == std::string::npos || !digits(text.substr(0, dot)) ||
+          !digits(text.substr(dot + 1))) {
+        throw LevelError(file.string() + ":" + std::to_string(top->Row()) + ": <sdf version=\"" +
+                         text + "\"> is not a version like 1.9");
+      }
+      sdf = true;
+    }
     stack.push_back(top);
   }
   if (!sdf) throw LevelError(file.string() + ": not a valid SDF model: it has no <sdf> element");
@@ -106,11 +121,16 @@ class SdfReader {
 
   RobotDescription Read() {
     CheckSdfformatCanReadIt(file_);
-    // sdformat's assertions throw sdf::Exception, which is no std::exception.
+    // sdformat's assertions throw sdf::Exception, which is no std::exception;
+    // the libraries under it may throw standard ones.
     try {
       return ReadChecked();
+    } catch (const LevelError&) {
+      throw;
     } catch (const sdf::Exception& error) {
       throw LevelError(file_.string() + ": sdformat failed on it: " + error.GetErrorStr());
+    } catch (const std::exception& error) {
+      throw LevelError(file_.string() + ": sdformat failed on it: " + error.what());
     }
   }
 

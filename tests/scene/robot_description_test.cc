@@ -577,6 +577,8 @@ TEST(RobotDescriptionTest, BadSdfIsRefusedNamingFileAndWhat) {
       {"bad.sdf:2", "<world>"});
   ExpectRefused("<?xml version=\"1.0\"?>\n<robot name=\"r\"><link name=\"a\"/></robot>\n",
                 {"bad.sdf:2", "URDF", ".urdf"}, "bad.sdf");
+  ExpectRefused("<?xml version=\"1.0\"?>\n<sdf version=\"1.(\"><model name=\"m\"/></sdf>\n",
+                {"bad.sdf:2", "1.(", "version"}, "bad.sdf");
   ExpectRefused("<?xml version=\"1.0\"?>\n<model name=\"m\"/>\n", {"bad.sdf", "no <sdf>"},
                 "bad.sdf");
 }
