@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <exception>
 #include <fstream>
 #include <map>
 #include <mutex>
@@ -266,7 +267,11 @@ RobotDescription ReadUrdf(const fs::path& file) {
   {
     const std::lock_guard<std::mutex> lock(urdfdom_mutex);
     console_bridge::useOutputHandler(&messages);
-    model = urdf::parseURDF(xml);
+    try {
+      model = urdf::parseURDF(xml);
+    } catch (const std::exception& error) {  // urdfdom reports by value, but to be sure
+      messages.lines.push_back(error.what());
+    }
     console_bridge::restorePreviousOutputHandler();
   }
   if (model == nullptr) {
