@@ -375,13 +375,15 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
     const std::size_t end = std::min(n, begin + kChunk);
     // The chunk's draws first, in a loop of their own (their hash chains
     // overlap there; inside the beam's long body they would not).
+    if (!noisy) {
+      for (std::size_t i = begin; i < end; ++i) beam(i, 0.0f, false);
+      return;
+    }
     float z[kChunk];
     bool dropped[kChunk];
-    if (noisy) {
-      for (std::size_t i = begin; i < end; ++i) {
-        z[i - begin] = normal(Draw(sweep_key, i, 1));
-        dropped[i - begin] = Uniform(Draw(sweep_key, i, 0)) < noise.dropout_probability;
-      }
+    for (std::size_t i = begin; i < end; ++i) {
+      z[i - begin] = normal(Draw(sweep_key, i, 1));
+      dropped[i - begin] = Uniform(Draw(sweep_key, i, 0)) < noise.dropout_probability;
     }
     for (std::size_t i = begin; i < end; ++i) beam(i, z[i - begin], dropped[i - begin]);
   });
