@@ -59,7 +59,7 @@ int CameraDirector::Direct(const Shot& shot, FramePipeline* frames, bool write, 
     job.write = write;
     job.show = shown;
     for (scene::RobotState* r : shot.robots) {
-      r->Skin();  // once a tick whatever the cameras due
+      r->Skin();  // at most once a tick, however many cameras are due
       job.robots.push_back(*r);
     }
     for (std::size_t a = 0; a < level_.actors.size(); ++a) {
