@@ -75,6 +75,10 @@ bool LidarConfig::Noise::any() const {
          dropout_below_intensity > 0.0 || range_step_m > 0.0 || min_range_m > 0.0;
 }
 
+// The per-beam lambdas below, inlined into their loops (GCC keeps them
+// out of line, each capture then read through the closure at every call).
+#define SANDBOX_INLINE __attribute__((always_inline))
+
 namespace {
 
 // SplitMix64's finaliser: a well-mixed 64-bit value of its argument.
@@ -85,14 +89,14 @@ std::uint64_t Mix(std::uint64_t x) {
   return x ^ (x >> 31);
 }
 
-// Draw k (0 to 3) of beam `beam`, given the sweep's key (Mix of the seed and
+// Draw k (0 or 1) of beam `beam`, given the sweep's key (Mix of the seed and
 // the sweep): 64 random bits, a function of its arguments alone (no generator
-// state: threads and order do not matter).
+// state: threads and order do not matter). Draw 0's top 32 bits make the first
+// return's Gaussian and its low 32 the dropout by chance; draw 1's top 32 the
+// last return's Gaussian.
 std::uint64_t Draw(std::uint64_t sweep_key, std::uint64_t beam, std::uint64_t k) {
-  return Mix(sweep_key ^ (beam << 2 | k));
+  return Mix(sweep_key ^ (beam << 1 | k));
 }
-// Those bits as a uniform number in (0, 1).
-double Uniform(std::uint64_t bits) { return (double(bits >> 11) + 0.5) * 0x1.0p-53; }
 
 // The standard normal quantile at p in (0, 1) (inverse transform sampling):
 // Acklam's rational approximation, relative error under 1.2e-9; the tails
@@ -121,26 +125,113 @@ double NormalQuantile(double p) {
          (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1.0);
 }
 
-// A standard normal draw from 64 random bits by the quantile at their uniform:
+// A standard normal draw from 32 random bits by the quantile at their uniform:
 // the quantiles at j / 4096 tabled, linear in between (the top 12 bits pick
-// the segment, the next 23 the place in it); the two outer segments, where
+// the segment, the other 20 the place in it); the two outer segments, where
 // the quantile bends fastest, exact. Five times faster than NormalQuantile.
 class NormalDraw {
  public:
   NormalDraw() {
     for (int j = 1; j < kSegments; ++j) quantile_[j] = float(NormalQuantile(double(j) / kSegments));
+    for (int j = 1; j + 1 < kSegments; ++j) slope_[j] = quantile_[j + 1] - quantile_[j];
   }
-  float operator()(std::uint64_t bits) const {
-    const std::uint32_t j = std::uint32_t(bits >> (64 - kBits));
-    if (j == 0 || j == kSegments - 1) return float(NormalQuantile(Uniform(bits)));
-    const float along = float((bits >> (64 - kBits - 23)) & ((1u << 23) - 1)) * 0x1.0p-23f;
-    return quantile_[j] + along * (quantile_[j + 1] - quantile_[j]);
+  float operator()(std::uint32_t bits) const {
+    if (Outer(bits)) return float(NormalQuantile((double(bits) + 0.5) * 0x1.0p-32));
+    return Inner(bits);
+  }
+  // Whether the bits fall in an outer segment.
+  static bool Outer(std::uint32_t bits) {
+    const std::uint32_t j = bits >> (32 - kBits);
+    return j == 0 || j == kSegments - 1;
+  }
+  // The draw where the bits are not Outer (branch-free, so loops of it vectorise).
+  float Inner(std::uint32_t bits) const {
+    const std::uint32_t j = bits >> (32 - kBits);
+    const float along = float(bits & ((1u << (32 - kBits)) - 1)) * 0x1.0p-20f;
+    return quantile_[j] + along * slope_[j];
   }
 
  private:
   static constexpr int kBits = 12, kSegments = 1 << kBits;
   float quantile_[kSegments + 1] = {};
+  float slope_[kSegments] = {};
 };
+
+// A noisy lidar's parameters in the returns' own precision (a float compared
+// with the float next above a bound compares as with the bound).
+struct RangeNoise {
+  explicit RangeNoise(const LidarConfig& config) {
+    const LidarConfig::Noise& noise = config.noise;
+    auto at_least = [](double bound) {
+      const float f = float(bound);
+      return double(f) < bound ? std::nextafter(f, HUGE_VALF) : f;
+    };
+    min_range = at_least(noise.min_range_m);
+    dimmest = at_least(noise.dropout_below_intensity);
+    sigma_0 = float(noise.range_sigma_m), sigma_per_m = float(noise.range_sigma_per_m);
+    range = float(config.range_m);
+    step = noise.range_step_m, per_step = step > 0.0 ? 1.0 / step : 0.0;
+    drop_under = std::uint64_t(std::ldexp(noise.dropout_probability, 32));
+  }
+  // Range r with its Gaussian draw z added, rounded to the step, kept within
+  // 0 .. range.
+  float Range(float r, float z) const {
+    const float noisy = Added(r, z);
+    return Clamped(step > 0.0 ? Rounded(noisy) : noisy);
+  }
+  float Added(float r, float z) const { return r + (sigma_0 + sigma_per_m * r) * z; }
+  // Adding and taking away 1.5 x 2^52 rounds a double to a whole number
+  // (ties to even; exact below 2^51 steps, far finer than a float range
+  // shows), branch-free so that loops of it vectorise.
+  float Rounded(float r) const {
+    constexpr double kWhole = 0x1.8p52;
+    return float(((double(r) * per_step + kWhole) - kWhole) * step);
+  }
+  float Clamped(float r) const { return std::min(std::max(r, 0.f), range); }
+  // Whether a return at range r (before noise) escapes the minimum range and chance.
+  bool Kept(float r, std::uint64_t chance) const {
+    return (r >= min_range) & ((chance & 0xffffffffu) >= drop_under);
+  }
+
+  float min_range, dimmest, sigma_0, sigma_per_m, range;
+  double step, per_step;
+  std::uint64_t drop_under;  // low 32 bits under this: dropped by chance (all at 1: 2^32)
+};
+
+// The first draws of beams begin .. begin + kChunk - 1: their first returns'
+// Gaussians (z) and chances (dropped when RangeNoise::Kept says so). Built for
+// AVX-512 and AVX2 too where the CPU has them: the loops over a whole chunk
+// vectorise, and integer and uncontracted float work (lidar.cc is built with
+// -ffp-contract=off) gives the same bits on each.
+constexpr std::size_t kChunk = 4096;
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void DrawBeams(
+    const NormalDraw& normal, std::uint64_t sweep_key, std::size_t begin, float* __restrict z,
+    std::uint64_t* __restrict chance) {
+  for (std::size_t k = 0; k < kChunk; ++k) chance[k] = Draw(sweep_key, begin + k, 0);
+  for (std::size_t k = 0; k < kChunk; ++k) z[k] = normal.Inner(std::uint32_t(chance[k] >> 32));
+  for (std::size_t k = 0; k < kChunk; ++k) {
+    const std::uint32_t high = std::uint32_t(chance[k] >> 32);
+    if (NormalDraw::Outer(high)) z[k] = normal(high);
+  }
+}
+
+// A chunk of single-ray beams' first returns with noise: `range` holds their
+// hit distances and gets the noisy ranges, `kept` whether each escapes the
+// minimum range and chance (built as DrawBeams).
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void PerturbBeams(
+    const RangeNoise& noise, const float* __restrict z, const std::uint64_t* __restrict chance,
+    float* __restrict range, bool* __restrict kept) {
+  for (std::size_t k = 0; k < kChunk; ++k) kept[k] = noise.Kept(range[k], chance[k]);
+  // RangeNoise::Range, a loop for each kind of step (a choice in the loop
+  // keeps it from vectorising).
+  if (noise.step > 0.0) {
+    for (std::size_t k = 0; k < kChunk; ++k) {
+      range[k] = noise.Clamped(noise.Rounded(noise.Added(range[k], z[k])));
+    }
+  } else {
+    for (std::size_t k = 0; k < kChunk; ++k) range[k] = noise.Clamped(noise.Added(range[k], z[k]));
+  }
+}
 
 }  // namespace
 
@@ -148,9 +239,16 @@ Lidar::Lidar(const LidarConfig& config) : config_(config) { config_.ValidateOrTh
 
 RayBatch Lidar::Rays(const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3d& X_WS_end,
                      RayBatch* sub_rays) const {
+  RayBatch rays;
+  FillRays(X_WS_start, X_WS_end, &rays, sub_rays, nullptr);
+  return rays;
+}
+
+void Lidar::FillRays(const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3d& X_WS_end,
+                     RayBatch* beams, RayBatch* sub_rays, RayCaster* workers) const {
   const int channels = config_.channels(), steps = config_.azimuth_steps;
   const int per_beam = sub_rays != nullptr ? config_.divergence.rays : 0;
-  RayBatch rays;
+  RayBatch& rays = *beams;
   rays.origin_W = X_WS_start.translation();
   rays.Resize(std::size_t(channels) * std::size_t(steps));
   if (per_beam > 0) {
@@ -170,35 +268,60 @@ RayBatch Lidar::Rays(const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3
     const double e = config_.elevations_rad[std::size_t(c)];
     elevation[std::size_t(c)] = {std::cos(e), std::sin(e)};
   }
+  // Each step's rotation, offset and azimuth, once a sweep; then the beams
+  // channel by channel, in the order they are stored.
   const Eigen::Quaterniond q0(X_WS_start.linear()), q1(X_WS_end.linear());
   const Eigen::Vector3d travel = X_WS_end.translation() - X_WS_start.translation();
+  // A beam at elevation e points along cos(e) level + sin(e) up, level and up
+  // being its step's rotated (cos a, sin a, 0) and (0, 0, 1).
+  struct Step {
+    Eigen::Matrix3d R;
+    Eigen::Vector3d level, up;
+    Eigen::Vector3f start;
+    double ca, sa;
+  };
+  thread_local std::vector<Step> kept_steps;  // kept between sweeps (a large block's pages)
+  std::vector<Step>& at = kept_steps;
+  at.resize(static_cast<std::size_t>(steps));
   for (int k = 0; k < steps; ++k) {
     // The pose at this step's time: position linear, rotation spherical.
     const double s = double(k) / steps;
-    const Eigen::Matrix3d R = q0.slerp(s, q1).toRotationMatrix();
-    const Eigen::Vector3f start = (s * travel).cast<float>();
     const double azimuth = 2.0 * M_PI * k / steps;
-    const double ca = std::cos(azimuth), sa = std::sin(azimuth);
-    for (int c = 0; c < channels; ++c) {
-      const double cos_e = elevation[std::size_t(c)].x(), sin_e = elevation[std::size_t(c)].y();
-      const Eigen::Vector3d d(cos_e * ca, cos_e * sa, sin_e);
+    Step& step = at[std::size_t(k)];
+    step.R = q0.slerp(s, q1).toRotationMatrix();
+    step.ca = std::cos(azimuth), step.sa = std::sin(azimuth);
+    step.level = step.R * Eigen::Vector3d(step.ca, step.sa, 0.0);
+    step.up = step.R.col(2);
+    step.start = (s * travel).cast<float>();
+  }
+  const float length = static_cast<float>(config_.range_m);
+  auto channel = [&](int c) {
+    const double cos_e = elevation[std::size_t(c)].x(), sin_e = elevation[std::size_t(c)].y();
+    for (int k = 0; k < steps; ++k) {
+      const Step& step = at[std::size_t(k)];
       const std::size_t i = std::size_t(c) * std::size_t(steps) + std::size_t(k);
-      rays.start[i] = start;
-      rays.direction[i] = (R * d).cast<float>();
-      rays.length_m[i] = static_cast<float>(config_.range_m);
+      rays.start[i] = step.start;
+      rays.direction[i] = (cos_e * step.level + sin_e * step.up).cast<float>();
+      rays.length_m[i] = length;
       if (per_beam == 0) continue;
+      const double ca = step.ca, sa = step.sa;
+      const Eigen::Vector3d d(cos_e * ca, cos_e * sa, sin_e);
       const Eigen::Vector3d up(-sin_e * ca, -sin_e * sa, cos_e), side(-sa, ca, 0);
       for (int j = 0; j < per_beam; ++j) {
         const Eigen::Vector2d& o = around[std::size_t(j)];
         const std::size_t q = i * std::size_t(per_beam) + std::size_t(j);
-        sub_rays->start[q] = start;
+        sub_rays->start[q] = step.start;
         sub_rays->direction[q] =
-            (R * (std::cos(h) * d + o.x() * up + o.y() * side)).normalized().cast<float>();
-        sub_rays->length_m[q] = rays.length_m[i];
+            (step.R * (std::cos(h) * d + o.x() * up + o.y() * side)).normalized().cast<float>();
+        sub_rays->length_m[q] = length;
       }
     }
+  };
+  if (workers != nullptr) {
+    workers->RunParallel(channels, channel);
+  } else {
+    for (int c = 0; c < channels; ++c) channel(c);
   }
-  return rays;
 }
 
 namespace {
@@ -210,6 +333,15 @@ struct Return {
   Eigen::Vector3f normal{Eigen::Vector3f::Zero()};
   float brightness{0.f};
   bool there() const { return surface != RayHits::kNoHit; }
+};
+
+// A chunk's noise (Sweep): each beam's Gaussian draw and chance and, for single
+// rays, its noisy range and whether it is kept.
+struct Noisy {
+  float z[kChunk];
+  std::uint64_t chance[kChunk];
+  float range[kChunk];
+  bool kept[kChunk];
 };
 
 }  // namespace
@@ -224,11 +356,12 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
   const int per_beam = std::max(divergence.rays, 1);
   // Kept between sweeps (this thread's); the workers below read them through
   // these references (a thread_local named in a lambda is the worker's own).
-  thread_local RayBatch kept_sub_rays;
+  thread_local RayBatch kept_beams, kept_sub_rays;
   thread_local RayHits kept_hits;
+  RayBatch& beams = kept_beams;
   RayBatch& sub_rays = kept_sub_rays;
   RayHits& hits = kept_hits;
-  const RayBatch beams = Rays(X_WS_start, X_WS_end, divergence.on() ? &sub_rays : nullptr);
+  FillRays(X_WS_start, X_WS_end, &beams, divergence.on() ? &sub_rays : nullptr, &caster);
   const RayBatch& rays = divergence.on() ? sub_rays : beams;
   const LidarConfig::Noise& noise = config_.noise;
   const bool intensity = config_.intensity || noise.dropout_below_intensity > 0.0;
@@ -255,7 +388,7 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
   const double reference2 = config_.intensity_reference_m * config_.intensity_reference_m;
 
   // Ray q's hit as a return (its brightness: "Intensity").
-  auto hit_of = [&](std::size_t q) {
+  auto hit_of = [&](std::size_t q) SANDBOX_INLINE {
     Return hit;
     hit.surface = hits.surface[q];
     hit.range_m = hits.distance_m[q];
@@ -270,7 +403,7 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
     return hit;
   };
   // A cone's sub-ray hits grouped into the first and the last return.
-  auto cone = [&](std::size_t i, Return* first, Return* last) {
+  auto cone = [&](std::size_t i, Return* first, Return* last) SANDBOX_INLINE {
     const std::size_t q0 = i * std::size_t(per_beam);
     float nearest = range, farthest = -1.f;
     for (std::size_t q = q0; q < q0 + std::size_t(per_beam); ++q) {
@@ -308,46 +441,39 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
       last->range_m = float(sum[1] / count[1]);
     }
   };
-  const double per_step = noise.range_step_m > 0.0 ? 1.0 / noise.range_step_m : 0.0;
+  const RangeNoise range_noise(config_);
   static const NormalDraw normal;
-  // The noise on return k (0 first, 1 last) of beam i: false when it is lost.
-  // Branch-free where the draws decide (a mispredicted branch costs more than
-  // the draw it skips).
-  auto perturb = [&](float z, Return* ret) {
-    float r = ret->range_m;
-    const bool kept = (r >= noise.min_range_m) & (ret->brightness >= noise.dropout_below_intensity);
-    const double sigma = noise.range_sigma_m + noise.range_sigma_per_m * r;
-    r += float(sigma * z);
-    if (noise.range_step_m > 0.0) {
-      // Nearest step, inline (std::round is a library call without SSE4.1).
-      const double steps = double(r) * per_step;
-      r = float(double(std::int64_t(steps + (steps < 0.0 ? -0.5 : 0.5))) * noise.range_step_m);
-    }
-    ret->range_m = std::clamp(r, 0.f, range);
+  // The noise on a divergent beam's return, given its Gaussian draw z: false
+  // when it is lost to the minimum range or to dimness.
+  auto perturb = [&](float z, Return* ret) SANDBOX_INLINE {
+    const bool kept = (ret->range_m >= range_noise.min_range) &
+                      (ret->brightness >= range_noise.dimmest);
+    ret->range_m = range_noise.Range(ret->range_m, z);
     return kept;
   };
-  // Beam i, given its first return's normal draw z and whether chance drops it.
-  auto beam = [&](std::size_t i, float z, bool dropped) {
+  // Beam i; with noise (with_noise true), given the chunk's draws at k (its
+  // place in the chunk) and, for a single ray, its noisy range and whether it
+  // escapes the minimum range and chance.
+  auto beam = [&](auto with_noise, std::size_t i, std::size_t k, const Noisy* noisy_chunk) SANDBOX_INLINE {
     Return first, last;
     if (divergence.on()) {
       cone(i, &first, &last);
     } else if (hits.surface[i] != RayHits::kNoHit) {
       first = hit_of(i);
     }
-    if (noisy && first.there()) {
-      if (!divergence.on()) {
-        const bool keep = perturb(z, &first) & !dropped;
-        const float on = keep ? 1.f : 0.f;
-        first.surface = keep ? first.surface : RayHits::kNoHit;
-        first.brightness *= on;
-        first.normal *= on;
-      } else if (dropped) {
+    if constexpr (decltype(with_noise)::value) {
+      if (!first.there()) {
+      } else if (!divergence.on()) {
+        first.range_m = noisy_chunk->range[k];
+        if (!(noisy_chunk->kept[k] & (first.brightness >= range_noise.dimmest))) first = Return{};
+      } else if ((noisy_chunk->chance[k] & 0xffffffffu) < range_noise.drop_under) {
         first = last = Return{};
       } else {
         const bool separate = last.range_m != first.range_m;
-        const bool keep_first = perturb(z, &first);
+        const bool keep_first = perturb(noisy_chunk->z[k], &first);
         const bool keep_last =
-            separate ? perturb(normal(Draw(sweep_key, i, 2)), &last) : keep_first;
+            separate ? perturb(normal(std::uint32_t(Draw(sweep_key, i, 1) >> 32)), &last)
+                     : keep_first;
         if (!separate) last = first;
         if (!keep_first) first = keep_last ? last : Return{};
         if (!keep_last) last = first;
@@ -369,23 +495,24 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
     scan->last_surface[i] = last.surface;
     if (config_.intensity) scan->last_intensity[i] = last.brightness;
   };
-  constexpr std::size_t kChunk = 4096;
   caster.RunParallel(int((n + kChunk - 1) / kChunk), [&](int chunk) {
     const std::size_t begin = std::size_t(chunk) * kChunk;
     const std::size_t end = std::min(n, begin + kChunk);
-    // The chunk's draws first, in a loop of their own (their hash chains
-    // overlap there; inside the beam's long body they would not).
     if (!noisy) {
-      for (std::size_t i = begin; i < end; ++i) beam(i, 0.0f, false);
+      for (std::size_t i = begin; i < end; ++i) beam(std::false_type{}, i, 0, nullptr);
       return;
     }
-    float z[kChunk];
-    bool dropped[kChunk];
-    for (std::size_t i = begin; i < end; ++i) {
-      z[i - begin] = normal(Draw(sweep_key, i, 1));
-      dropped[i - begin] = Uniform(Draw(sweep_key, i, 0)) < noise.dropout_probability;
+    // The chunk's noise first, in loops of their own (they vectorise there;
+    // inside the beam's long body they would not).
+    Noisy draws;
+    DrawBeams(normal, sweep_key, begin, draws.z, draws.chance);
+    if (!divergence.on()) {
+      std::copy(hits.distance_m.begin() + std::ptrdiff_t(begin),
+                hits.distance_m.begin() + std::ptrdiff_t(end), draws.range);
+      std::fill(draws.range + (end - begin), draws.range + kChunk, 0.f);
+      PerturbBeams(range_noise, draws.z, draws.chance, draws.range, draws.kept);
     }
-    for (std::size_t i = begin; i < end; ++i) beam(i, z[i - begin], dropped[i - begin]);
+    for (std::size_t i = begin; i < end; ++i) beam(std::true_type{}, i, i - begin, &draws);
   });
   scan->surface_ids = config_.surface_ids;
   scan->sweep_s = 1.0 / config_.rotation_hz;

@@ -126,6 +126,10 @@ class Lidar {
                 RayBatch* sub_rays = nullptr) const;
 
  private:
+  // Rays into *beams (and *sub_rays), channel by channel on the workers when given.
+  void FillRays(const Eigen::Isometry3d& X_WS_start, const Eigen::Isometry3d& X_WS_end,
+                RayBatch* beams, RayBatch* sub_rays, RayCaster* workers) const;
+
   LidarConfig config_;
 };
 
