@@ -233,6 +233,33 @@ __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) vo
   }
 }
 
+// A hit's brightness ("Intensity" in docs/reference/sensors.md): its
+// reflectivity x cos(incidence) x min(1, reference^2 / range^2), given its
+// normal n and the ray's direction d (a range of 0 divides to infinity: 1).
+inline float Brightness(float reflectivity, const Eigen::Vector3f& n, const Eigen::Vector3f& d,
+                        float range_m, double reference2) {
+  const double cosine = -double(n.x() * d.x() + n.y() * d.y() + n.z() * d.z());
+  const double near = reference2 / (double(range_m) * double(range_m));
+  const double falloff = near < 1.0 ? near : 1.0;
+  return float(double(reflectivity) * (cosine > 0.0 ? cosine : 0.0) * falloff);
+}
+
+// Rays begin .. end's Brightness into `brightness` (a chunk's, before its
+// beams: the loop vectorises; built as DrawBeams). Rays that hit nothing get
+// a number too, unused.
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void BrightnessOf(
+    const RayHits& hits, const RayBatch& rays, std::size_t begin, std::size_t end,
+    double reference2, float* __restrict brightness) {
+  const float* reflectivity = hits.reflectivity.data();
+  const Eigen::Vector3f* normal = hits.normal_W.data();
+  const Eigen::Vector3f* direction = rays.direction.data();
+  const float* distance = hits.distance_m.data();
+  for (std::size_t q = begin; q < end; ++q) {
+    brightness[q - begin] =
+        Brightness(reflectivity[q], normal[q], direction[q], distance[q], reference2);
+  }
+}
+
 }  // namespace
 
 Lidar::Lidar(const LidarConfig& config) : config_(config) { config_.ValidateOrThrow(); }
@@ -388,17 +415,15 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
   const double reference2 = config_.intensity_reference_m * config_.intensity_reference_m;
 
   // Ray q's hit as a return (its brightness: "Intensity").
-  auto hit_of = [&](std::size_t q) SANDBOX_INLINE {
+  auto hit_of = [&](std::size_t q, bool bright = true) SANDBOX_INLINE {
     Return hit;
     hit.surface = hits.surface[q];
     hit.range_m = hits.distance_m[q];
     if (!hits.with_normals || !hit.there()) return hit;
     hit.normal = hits.normal_W[q];
-    if (intensity) {
-      const double cosine = -double(hit.normal.dot(rays.direction[q]));
-      const double r = hit.range_m;
-      const double falloff = r > 0.0 ? std::min(1.0, reference2 / (r * r)) : 1.0;
-      hit.brightness = float(double(hits.reflectivity[q]) * std::max(0.0, cosine) * falloff);
+    if (intensity && bright) {
+      hit.brightness = Brightness(hits.reflectivity[q], hit.normal, rays.direction[q],
+                                  hit.range_m, reference2);
     }
     return hit;
   };
@@ -454,12 +479,14 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
   // Beam i; with noise (with_noise true), given the chunk's draws at k (its
   // place in the chunk) and, for a single ray, its noisy range and whether it
   // escapes the minimum range and chance.
-  auto beam = [&](auto with_noise, std::size_t i, std::size_t k, const Noisy* noisy_chunk) SANDBOX_INLINE {
+  auto beam = [&](auto with_noise, std::size_t i, std::size_t k, const Noisy* noisy_chunk,
+                  const float* brightness) SANDBOX_INLINE {
     Return first, last;
     if (divergence.on()) {
       cone(i, &first, &last);
     } else if (hits.surface[i] != RayHits::kNoHit) {
-      first = hit_of(i);
+      first = hit_of(i, false);
+      if (intensity) first.brightness = brightness[k];
     }
     if constexpr (decltype(with_noise)::value) {
       if (!first.there()) {
@@ -498,12 +525,18 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
   caster.RunParallel(int((n + kChunk - 1) / kChunk), [&](int chunk) {
     const std::size_t begin = std::size_t(chunk) * kChunk;
     const std::size_t end = std::min(n, begin + kChunk);
+    // The chunk's brightness and noise first, in loops of their own (they
+    // vectorise there; inside the beam's long body they would not).
+    float brightness[kChunk];
+    if (intensity && !divergence.on()) {
+      BrightnessOf(hits, rays, begin, end, reference2, brightness);
+    }
     if (!noisy) {
-      for (std::size_t i = begin; i < end; ++i) beam(std::false_type{}, i, 0, nullptr);
+      for (std::size_t i = begin; i < end; ++i) {
+        beam(std::false_type{}, i, i - begin, nullptr, brightness);
+      }
       return;
     }
-    // The chunk's noise first, in loops of their own (they vectorise there;
-    // inside the beam's long body they would not).
     Noisy draws;
     DrawBeams(normal, sweep_key, begin, draws.z, draws.chance);
     if (!divergence.on()) {
@@ -512,7 +545,9 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
       std::fill(draws.range + (end - begin), draws.range + kChunk, 0.f);
       PerturbBeams(range_noise, draws.z, draws.chance, draws.range, draws.kept);
     }
-    for (std::size_t i = begin; i < end; ++i) beam(std::true_type{}, i, i - begin, &draws);
+    for (std::size_t i = begin; i < end; ++i) {
+      beam(std::true_type{}, i, i - begin, &draws, brightness);
+    }
   });
   scan->surface_ids = config_.surface_ids;
   scan->sweep_s = 1.0 / config_.rotation_hz;
