@@ -14,6 +14,7 @@
 #include "app/scan_sheet.h"
 #include "scene/collision_world.h"
 #include "scene/level.h"
+#include "scene/manifest.h"
 #include "scene/terrain_streamer.h"
 #include "sensors/face_scanner.h"
 #include "sensors/ground_scanner.h"
@@ -26,7 +27,8 @@ namespace {
 const char* kUsage =
     "usage: sandbox scan [LEVEL] --at X,Y,Z[,ROLL,PITCH,YAW] [--sensor face|ground|lidar|ray]\n"
     "                    [--resolution R] [--half-extent E] [--aligned body|world]\n"
-    "                    [--see-robots] [--isolate] --out FILE.csv|FILE.ply|FILE.png\n"
+    "                    [--lidar SETTINGS] [--see-robots] [--isolate]\n"
+    "                    --out FILE.csv|FILE.ply|FILE.png\n"
     "  LEVEL          a level (default: the bundled sample level)\n"
     "  --isolate      read a manifest's files apart first (scene files always are)\n"
     "  --at           sensor pose: metres, roll/pitch/yaw in degrees\n"
@@ -35,9 +37,12 @@ const char* kUsage =
     "  --resolution   grid spacing of face and ground, metres (default 1)\n"
     "  --half-extent  half the box of face and ground, metres (default 25)\n"
     "  --aligned      face box with the sensor's axes (body, default) or the world's\n"
+    "  --lidar        the lidar's manifest keys as TOML, e.g. 'channels = 32,\n"
+    "                 range_noise_sigma_m = 0.02, seed = 7' (docs/reference/sensors.md)\n"
     "  --see-robots   rays see the level's robots too (default: world actors only)\n"
     "  --out          CSV (face: face,row,col,occupancy,x,y,z; lidar: "
-    "channel,step,hit,x,y,z,range;\n"
+    "channel,step,hit,x,y,z,range,\n"
+    "                 intensity, with divergence last_range,last_surface,last_intensity;\n"
     "                 ground: row,col,valid,x,y,z; ray: hit,x,y,z,range; then on every row\n"
     "                 surface,nx,ny,nz: what the sample hit and its normal) or PLY when it\n"
     "                 ends in .ply (occupied points red, free points green, with surface and\n"
@@ -108,11 +113,29 @@ double Positive(const std::string& text, const std::string& option) {
   return v[0];
 }
 
+// The lidar of `sandbox scan`: the manifest's lidar keys given on the command
+// line (their defaults without), refused naming the key.
+sensors::LidarConfig LidarSettings(const std::string& text) {
+  try {
+    const scene::SettingsTable table = scene::ParseSettingsText(text, "--lidar", "lidar");
+    scene::SettingsReader read(table);
+    sensors::LidarConfig config = sensors::LidarConfig::Read(read);
+    read.RejectUnknownKeys("lidar");
+    config.ValidateOrThrow();
+    return config;
+  } catch (const scene::LevelError& error) {
+    throw UsageError(error.what());
+  } catch (const std::invalid_argument& error) {
+    throw UsageError(std::string("--lidar: ") + error.what());
+  }
+}
+
 }  // namespace
 
 int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   const auto parsed = ParseArgs(
-      args, "scan", {"--at", "--sensor", "--resolution", "--half-extent", "--aligned", "--out"},
+      args, "scan",
+      {"--at", "--sensor", "--resolution", "--half-extent", "--aligned", "--lidar", "--out"},
       {"--see-robots", "--isolate"}, kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
@@ -148,6 +171,11 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     const Eigen::Isometry3d X_WS = ParsePose(at, "--at");
     const double res = resolution.empty() ? 1.0 : Positive(resolution, "--resolution");
     const double extent = half_extent.empty() ? 25.0 : Positive(half_extent, "--half-extent");
+    if (parsed->values.count("--lidar") > 0 && sensor != "lidar") {
+      throw UsageError("--lidar sets the lidar: give --sensor lidar");
+    }
+    // Checked before the level loads.
+    const sensors::LidarConfig lidar_config = LidarSettings(parsed->Value("--lidar"));
 
     const LoadedLevel loaded = LoadCheckedLevel(
         level_file, {},
@@ -221,17 +249,23 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
              valid, p, "", map.surface[std::size_t(k)], map.normal_W[std::size_t(k)]});
       }
     } else if (sensor == "lidar") {
-      sensors::LidarConfig config = sensors::LidarConfig::Uniform(16, -15, 15, 1024, 100.0);
+      sensors::LidarConfig config = lidar_config;
       config.normals = true;
       const sensors::Lidar lidar(config);
       sensors::LidarScan scan;
       lidar.Sweep(world, caster, filter, X_WS, X_WS, &scan);
+      const bool bright = !scan.intensity.empty(), lasts = !scan.last_range_m.empty();
       header = "channel,step,hit,x,y,z,range";
+      if (bright) header += ",intensity";
+      if (lasts) header += bright ? ",last_range,last_surface,last_intensity" : ",last_range,last_surface";
       for (std::size_t i = 0; i < scan.range_m.size(); ++i) {
         const std::size_t c = i / std::size_t(scan.azimuth_steps);
         const std::size_t k = i % std::size_t(scan.azimuth_steps);
         std::ostringstream range;
         range << "," << scan.range_m[i];
+        if (bright) range << "," << scan.intensity[i];
+        if (lasts) range << "," << scan.last_range_m[i] << "," << scan.last_surface[i];
+        if (lasts && bright) range << "," << scan.last_intensity[i];
         samples.push_back({std::to_string(c) + "," + std::to_string(k) + "," +
                                std::to_string(int(scan.hit[i])) + ",",
                            scan.hit[i] != 0, scan.points_W[i], range.str(), scan.surface[i],

@@ -550,6 +550,26 @@ LevelManifest ParseManifest(const fs::path& file) {
   return ParseManifestText(text, file);
 }
 
+SettingsTable ParseSettingsText(const std::string& text, const std::string& origin,
+                                const std::string& context) {
+  // As an inline table, whose keys TOML separates by commas on one line.
+  toml::table root;
+  try {
+    root = toml::parse("settings = {" + text + "}", origin);
+  } catch (const toml::parse_error& error) {
+    throw LevelError(origin + ": TOML syntax error: " + std::string(error.description()) +
+                     " (expected key = value, key = value)");
+  }
+  const toml::node* node = root.get("settings");
+  const toml::table* table = node != nullptr ? node->as_table() : nullptr;
+  if (table == nullptr || root.size() != 1) {
+    throw LevelError(origin + ": expected key = value, key = value");
+  }
+  const fs::path file(origin);  // TableReader keeps a reference to it
+  TableReader read(file, *table, context + ": ");
+  return ReadSettings(file, *table, read, {}, context);
+}
+
 LevelManifest ParseManifestText(std::string_view text, const fs::path& file) {
   toml::table root;
   try {

@@ -13,6 +13,7 @@
 #include "scene/load_limits.h"
 #include "scene/placement.h"
 #include "scene/robot_model.h"
+#include "scene/settings.h"
 #include "scene/terrain_tile.h"
 
 namespace sandbox::scene {
@@ -63,5 +64,13 @@ LevelManifest ParseManifest(const std::filesystem::path& file);
 // The same for manifest text that `file` would hold (asset paths resolve
 // against its folder; nothing is read).
 LevelManifest ParseManifestText(std::string_view text, const std::filesystem::path& file);
+
+// A table's keys given as TOML on one line, "key = value, key = value" (a
+// command line's sensor settings), as a manifest table's own would be kept:
+// `origin` stands for the file in messages ("--lidar"), `context` for the
+// table ("lidar"). Throws LevelError for a syntax error or a value that is not
+// a number, a string, true/false or an array.
+SettingsTable ParseSettingsText(const std::string& text, const std::string& origin,
+                                const std::string& context);
 
 }  // namespace sandbox::scene

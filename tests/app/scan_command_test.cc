@@ -77,13 +77,13 @@ TEST(ScanCommandTest, LidarCsvAndPlyColours) {
   ASSERT_EQ(RunSandbox("scan --at 0,0,30 --sensor lidar --out " + csv).exit_code, 0);
   const std::vector<std::string> lines = Lines(csv);
   ASSERT_EQ(lines.size(), 1u + 16u * 1024u);
-  EXPECT_EQ(lines[0], "channel,step,hit,x,y,z,range,surface,nx,ny,nz");
+  EXPECT_EQ(lines[0], "channel,step,hit,x,y,z,range,intensity,surface,nx,ny,nz");
   for (std::size_t i = 1; i < lines.size(); ++i) {  // a hit has an id and a unit normal
     const std::vector<double> c = Cells(lines[i]);
-    ASSERT_EQ(c.size(), 11u);
-    EXPECT_EQ(c[2] != 0, c[7] != 0) << lines[i];
+    ASSERT_EQ(c.size(), 12u);
+    EXPECT_EQ(c[2] != 0, c[8] != 0) << lines[i];
     if (c[2] != 0) {
-      EXPECT_NEAR(std::hypot(c[8], c[9], c[10]), 1.0, 1e-5) << lines[i];
+      EXPECT_NEAR(std::hypot(c[9], c[10], c[11]), 1.0, 1e-5) << lines[i];
     }
   }
   const std::string ply = (dir.path() / "face.ply").string();
@@ -102,6 +102,78 @@ TEST(ScanCommandTest, LidarCsvAndPlyColours) {
   }
   EXPECT_EQ(red + green, 6 * 51 * 51);
   EXPECT_GT(red, 51 * 51 - 100);  // nearly every down ray hits the valley
+}
+
+// The lidar's manifest keys on the command line: its size, its noise against
+// the exact sweep from the same pose, its intensity and its last returns.
+TEST(ScanCommandTest, LidarSettingsFromTheCommandLine) {
+  sandbox::testing::TempDir dir;
+  const std::string exact = (dir.path() / "exact.csv").string();
+  const std::string noisy = (dir.path() / "noisy.csv").string();
+  const std::string shape =
+      "channels = 4, min_elevation_deg = -60, max_elevation_deg = -30, azimuth_steps = 512";
+  ASSERT_EQ(RunSandbox("scan --at 0,0,30 --sensor lidar --lidar '" + shape + "' --out " + exact)
+                .exit_code,
+            0);
+  ASSERT_EQ(RunSandbox("scan --at 0,0,30 --sensor lidar --lidar '" + shape +
+                       ", range_noise_sigma_m = 0.5, seed = 3' --out " + noisy)
+                .exit_code,
+            0);
+  const std::vector<std::string> a = Lines(exact), b = Lines(noisy);
+  ASSERT_EQ(a.size(), 1u + 4u * 512u);
+  ASSERT_EQ(b.size(), a.size());
+  EXPECT_EQ(a[0], "channel,step,hit,x,y,z,range,intensity,surface,nx,ny,nz");
+  double sum = 0.0, sum2 = 0.0;
+  int hits = 0;
+  for (std::size_t i = 1; i < a.size(); ++i) {
+    const std::vector<double> p = Cells(a[i]), q = Cells(b[i]);
+    ASSERT_EQ(p.size(), 12u);
+    ASSERT_EQ(q.size(), 12u);
+    if (p[2] == 0) {
+      EXPECT_EQ(p[7], 0.0) << a[i];  // no return, no intensity
+      continue;
+    }
+    EXPECT_GT(p[7], 0.0) << a[i];  // the valley, lit at some incidence
+    EXPECT_LE(p[7], 1.0) << a[i];
+    const double d = q[6] - p[6];
+    sum += d, sum2 += d * d, ++hits;
+  }
+  ASSERT_GT(hits, 1500);  // the beams point 30-60 degrees down onto the valley
+  const double mean = sum / hits, sigma = std::sqrt(sum2 / hits - mean * mean);
+  EXPECT_NEAR(sigma, 0.5, 0.05);
+  EXPECT_NEAR(mean, 0.0, 0.05);
+
+  const std::string cone = (dir.path() / "cone.csv").string();
+  ASSERT_EQ(RunSandbox("scan --at 0,0,30 --sensor lidar --lidar '" + shape +
+                       ", divergence_deg = 0.5' --out " + cone)
+                .exit_code,
+            0);
+  const std::vector<std::string> c = Lines(cone);
+  ASSERT_EQ(c.size(), a.size());
+  EXPECT_EQ(c[0],
+            "channel,step,hit,x,y,z,range,intensity,last_range,last_surface,last_intensity,"
+            "surface,nx,ny,nz");
+  EXPECT_EQ(Cells(c[1]).size(), 15u);
+}
+
+TEST(ScanCommandTest, BadLidarSettingsNameTheKey) {
+  sandbox::testing::TempDir dir;
+  const std::string out = " --out " + (dir.path() / "x.csv").string();
+  auto run = RunSandbox("scan --at 0,0,30 --sensor lidar --lidar 'seed = -1'" + out);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_EQ(run.out, "sandbox scan: --lidar:1: lidar: 'seed' must be 0 or more\n");
+  run = RunSandbox("scan --at 0,0,30 --sensor lidar --lidar 'dropout_probability = 1.5'" + out);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.out.find("dropout_probability"), std::string::npos) << run.out;
+  run = RunSandbox("scan --at 0,0,30 --sensor lidar --lidar 'chanels = 4'" + out);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.out.find("chanels"), std::string::npos) << run.out;
+  run = RunSandbox("scan --at 0,0,30 --sensor lidar --lidar 'channels ='" + out);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.out.find("--lidar: TOML syntax error"), std::string::npos) << run.out;
+  run = RunSandbox("scan --at 0,0,30 --lidar 'channels = 4'" + out);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_EQ(run.out, "sandbox scan: --lidar sets the lidar: give --sensor lidar\n");
 }
 
 TEST(ScanCommandTest, BadArgumentsAreOneClearMessage) {

@@ -234,6 +234,10 @@ void ManifestSeeds(const fs::path& dir, const fs::path& source) {
         "range_noise_sigma_m = 0.02\ndropout_probability = 0.1\nseed = 3\n"
         "[[robot.camera]]\nname = \"c\"\ntype = \"chase\"\noverlay = true\n"
         "overlay_colour = \"surface\"\n");
+  // `sandbox scan --lidar`'s one line of settings (ParseSettingsText).
+  Write(dir / "lidar_settings.txt",
+        "channels = 32, range_noise_sigma_m = 0.02, seed = 7, elevations_deg = [-10, 0, 10], "
+        "kernel = \"general\", intensity = false");
 }
 
 // A small GeoTIFF in WGS84 near (lon 8, lat 46), as bytes: `bands` of
