@@ -5,6 +5,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "sensors/lidar_returns.h"
+
 namespace sandbox::sensors {
 
 LidarConfig LidarConfig::Uniform(int channels, double min_deg, double max_deg, int azimuth_steps,
@@ -78,189 +80,6 @@ bool LidarConfig::Noise::any() const {
 // The per-beam lambdas below, inlined into their loops (GCC keeps them
 // out of line, each capture then read through the closure at every call).
 #define SANDBOX_INLINE __attribute__((always_inline))
-
-namespace {
-
-// SplitMix64's finaliser: a well-mixed 64-bit value of its argument.
-std::uint64_t Mix(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ull;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
-}
-
-// Draw k (0 or 1) of beam `beam`, given the sweep's key (Mix of the seed and
-// the sweep): 64 random bits, a function of its arguments alone (no generator
-// state: threads and order do not matter). Draw 0's top 32 bits make the first
-// return's Gaussian and its low 32 the dropout by chance; draw 1's top 32 the
-// last return's Gaussian.
-std::uint64_t Draw(std::uint64_t sweep_key, std::uint64_t beam, std::uint64_t k) {
-  return Mix(sweep_key ^ (beam << 1 | k));
-}
-
-// The standard normal quantile at p in (0, 1) (inverse transform sampling):
-// Acklam's rational approximation, relative error under 1.2e-9; the tails
-// (p < 0.02425 or > 0.97575, 5% of draws) take a logarithm and a square root.
-double NormalQuantile(double p) {
-  static constexpr double a[] = {-3.969683028665376e+01, 2.209460984245205e+02,
-                                 -2.759285104469687e+02, 1.383577518672690e+02,
-                                 -3.066479806614716e+01, 2.506628277459239e+00};
-  static constexpr double b[] = {-5.447609879822406e+01, 1.615858368580409e+02,
-                                 -1.556989798598866e+02, 6.680131188771972e+01,
-                                 -1.328068155288572e+01};
-  static constexpr double c[] = {-7.784894002430293e-03, -3.223964580411365e-01,
-                                 -2.400758277161838e+00, -2.549732539343734e+00,
-                                 4.374664141464968e+00,  2.938163982698783e+00};
-  static constexpr double d[] = {7.784695709041462e-03, 3.224671290700398e-01,
-                                 2.445134137142996e+00, 3.754408661907416e+00};
-  constexpr double kLow = 0.02425;
-  if (p < kLow || p > 1.0 - kLow) {
-    const double q = std::sqrt(-2.0 * std::log(p < kLow ? p : 1.0 - p));
-    const double z = (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
-                     ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
-    return p < kLow ? z : -z;
-  }
-  const double q = p - 0.5, r = q * q;
-  return (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q /
-         (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1.0);
-}
-
-// A standard normal draw from 32 random bits by the quantile at their uniform:
-// the quantiles at j / 4096 tabled, linear in between (the top 12 bits pick
-// the segment, the other 20 the place in it); the two outer segments, where
-// the quantile bends fastest, exact. Five times faster than NormalQuantile.
-class NormalDraw {
- public:
-  NormalDraw() {
-    for (int j = 1; j < kSegments; ++j) quantile_[j] = float(NormalQuantile(double(j) / kSegments));
-    for (int j = 1; j + 1 < kSegments; ++j) slope_[j] = quantile_[j + 1] - quantile_[j];
-  }
-  float operator()(std::uint32_t bits) const {
-    if (Outer(bits)) return float(NormalQuantile((double(bits) + 0.5) * 0x1.0p-32));
-    return Inner(bits);
-  }
-  // Whether the bits fall in an outer segment.
-  static bool Outer(std::uint32_t bits) {
-    const std::uint32_t j = bits >> (32 - kBits);
-    return j == 0 || j == kSegments - 1;
-  }
-  // The draw where the bits are not Outer (branch-free, so loops of it vectorise).
-  float Inner(std::uint32_t bits) const {
-    const std::uint32_t j = bits >> (32 - kBits);
-    const float along = float(bits & ((1u << (32 - kBits)) - 1)) * 0x1.0p-20f;
-    return quantile_[j] + along * slope_[j];
-  }
-
- private:
-  static constexpr int kBits = 12, kSegments = 1 << kBits;
-  float quantile_[kSegments + 1] = {};
-  float slope_[kSegments] = {};
-};
-
-// A noisy lidar's parameters in the returns' own precision (a float compared
-// with the float next above a bound compares as with the bound).
-struct RangeNoise {
-  explicit RangeNoise(const LidarConfig& config) {
-    const LidarConfig::Noise& noise = config.noise;
-    auto at_least = [](double bound) {
-      const float f = float(bound);
-      return double(f) < bound ? std::nextafter(f, HUGE_VALF) : f;
-    };
-    min_range = at_least(noise.min_range_m);
-    dimmest = at_least(noise.dropout_below_intensity);
-    sigma_0 = float(noise.range_sigma_m), sigma_per_m = float(noise.range_sigma_per_m);
-    range = float(config.range_m);
-    step = noise.range_step_m, per_step = step > 0.0 ? 1.0 / step : 0.0;
-    drop_under = std::uint64_t(std::ldexp(noise.dropout_probability, 32));
-  }
-  // Range r with its Gaussian draw z added, rounded to the step, kept within
-  // 0 .. range.
-  float Range(float r, float z) const {
-    const float noisy = Added(r, z);
-    return Clamped(step > 0.0 ? Rounded(noisy) : noisy);
-  }
-  float Added(float r, float z) const { return r + (sigma_0 + sigma_per_m * r) * z; }
-  // Adding and taking away 1.5 x 2^52 rounds a double to a whole number
-  // (ties to even; exact below 2^51 steps, far finer than a float range
-  // shows), branch-free so that loops of it vectorise.
-  float Rounded(float r) const {
-    constexpr double kWhole = 0x1.8p52;
-    return float(((double(r) * per_step + kWhole) - kWhole) * step);
-  }
-  float Clamped(float r) const { return std::min(std::max(r, 0.f), range); }
-  // Whether a return at range r (before noise) escapes the minimum range and chance.
-  bool Kept(float r, std::uint64_t chance) const {
-    return (r >= min_range) & ((chance & 0xffffffffu) >= drop_under);
-  }
-
-  float min_range, dimmest, sigma_0, sigma_per_m, range;
-  double step, per_step;
-  std::uint64_t drop_under;  // low 32 bits under this: dropped by chance (all at 1: 2^32)
-};
-
-// The first draws of beams begin .. begin + kChunk - 1: their first returns'
-// Gaussians (z) and chances (dropped when RangeNoise::Kept says so). Built for
-// AVX-512 and AVX2 too where the CPU has them: the loops over a whole chunk
-// vectorise, and integer and uncontracted float work (lidar.cc is built with
-// -ffp-contract=off) gives the same bits on each.
-constexpr std::size_t kChunk = 4096;
-__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void DrawBeams(
-    const NormalDraw& normal, std::uint64_t sweep_key, std::size_t begin, float* __restrict z,
-    std::uint64_t* __restrict chance) {
-  for (std::size_t k = 0; k < kChunk; ++k) chance[k] = Draw(sweep_key, begin + k, 0);
-  for (std::size_t k = 0; k < kChunk; ++k) z[k] = normal.Inner(std::uint32_t(chance[k] >> 32));
-  for (std::size_t k = 0; k < kChunk; ++k) {
-    const std::uint32_t high = std::uint32_t(chance[k] >> 32);
-    if (NormalDraw::Outer(high)) z[k] = normal(high);
-  }
-}
-
-// A chunk of single-ray beams' first returns with noise: `range` holds their
-// hit distances and gets the noisy ranges, `kept` whether each escapes the
-// minimum range and chance (built as DrawBeams).
-__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void PerturbBeams(
-    const RangeNoise& noise, const float* __restrict z, const std::uint64_t* __restrict chance,
-    float* __restrict range, bool* __restrict kept) {
-  for (std::size_t k = 0; k < kChunk; ++k) kept[k] = noise.Kept(range[k], chance[k]);
-  // RangeNoise::Range, a loop for each kind of step (a choice in the loop
-  // keeps it from vectorising).
-  if (noise.step > 0.0) {
-    for (std::size_t k = 0; k < kChunk; ++k) {
-      range[k] = noise.Clamped(noise.Rounded(noise.Added(range[k], z[k])));
-    }
-  } else {
-    for (std::size_t k = 0; k < kChunk; ++k) range[k] = noise.Clamped(noise.Added(range[k], z[k]));
-  }
-}
-
-// A hit's brightness ("Intensity" in docs/reference/sensors.md): its
-// reflectivity x cos(incidence) x min(1, reference^2 / range^2), given its
-// normal n and the ray's direction d (a range of 0 divides to infinity: 1).
-inline float Brightness(float reflectivity, const Eigen::Vector3f& n, const Eigen::Vector3f& d,
-                        float range_m, double reference2) {
-  const double cosine = -double(n.x() * d.x() + n.y() * d.y() + n.z() * d.z());
-  const double near = reference2 / (double(range_m) * double(range_m));
-  const double falloff = near < 1.0 ? near : 1.0;
-  return float(double(reflectivity) * (cosine > 0.0 ? cosine : 0.0) * falloff);
-}
-
-// Rays begin .. end's Brightness into `brightness` (a chunk's, before its
-// beams: the loop vectorises; built as DrawBeams). Rays that hit nothing get
-// a number too, unused.
-__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void BrightnessOf(
-    const RayHits& hits, const RayBatch& rays, std::size_t begin, std::size_t end,
-    double reference2, float* __restrict brightness) {
-  const float* reflectivity = hits.reflectivity.data();
-  const Eigen::Vector3f* normal = hits.normal_W.data();
-  const Eigen::Vector3f* direction = rays.direction.data();
-  const float* distance = hits.distance_m.data();
-  for (std::size_t q = begin; q < end; ++q) {
-    brightness[q - begin] =
-        Brightness(reflectivity[q], normal[q], direction[q], distance[q], reference2);
-  }
-}
-
-}  // namespace
 
 Lidar::Lidar(const LidarConfig& config) : config_(config) { config_.ValidateOrThrow(); }
 
@@ -365,10 +184,10 @@ struct Return {
 // A chunk's noise (Sweep): each beam's Gaussian draw and chance and, for single
 // rays, its noisy range and whether it is kept.
 struct Noisy {
-  float z[kChunk];
-  std::uint64_t chance[kChunk];
-  float range[kChunk];
-  bool kept[kChunk];
+  float z[kReturnChunk];
+  std::uint64_t chance[kReturnChunk];
+  float range[kReturnChunk];
+  bool kept[kReturnChunk];
 };
 
 }  // namespace
@@ -410,7 +229,7 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
   scan->last_surface.resize(lasts);
   scan->last_intensity.resize(config_.intensity ? lasts : 0);
   const bool noisy = noise.any();
-  const std::uint64_t sweep_key = Mix(Mix(noise.seed) ^ sweep);
+  const std::uint64_t sweep_key = SweepKey(noise.seed, sweep);
   const float range = static_cast<float>(config_.range_m);
   const double reference2 = config_.intensity_reference_m * config_.intensity_reference_m;
 
@@ -467,7 +286,7 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
     }
   };
   const RangeNoise range_noise(config_);
-  static const NormalDraw normal;
+  const NormalDraw& normal = NormalDraw::Standard();
   // The noise on a divergent beam's return, given its Gaussian draw z: false
   // when it is lost to the minimum range or to dimness.
   auto perturb = [&](float z, Return* ret) SANDBOX_INLINE {
@@ -493,7 +312,7 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
       } else if (!divergence.on()) {
         first.range_m = noisy_chunk->range[k];
         if (!(noisy_chunk->kept[k] & (first.brightness >= range_noise.dimmest))) first = Return{};
-      } else if ((noisy_chunk->chance[k] & 0xffffffffu) < range_noise.drop_under) {
+      } else if (range_noise.Dropped(noisy_chunk->chance[k])) {
         first = last = Return{};
       } else {
         const bool separate = last.range_m != first.range_m;
@@ -522,12 +341,12 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
     scan->last_surface[i] = last.surface;
     if (config_.intensity) scan->last_intensity[i] = last.brightness;
   };
-  caster.RunParallel(int((n + kChunk - 1) / kChunk), [&](int chunk) {
-    const std::size_t begin = std::size_t(chunk) * kChunk;
-    const std::size_t end = std::min(n, begin + kChunk);
+  caster.RunParallel(int((n + kReturnChunk - 1) / kReturnChunk), [&](int chunk) {
+    const std::size_t begin = std::size_t(chunk) * kReturnChunk;
+    const std::size_t end = std::min(n, begin + kReturnChunk);
     // The chunk's brightness and noise first, in loops of their own (they
     // vectorise there; inside the beam's long body they would not).
-    float brightness[kChunk];
+    float brightness[kReturnChunk];
     if (intensity && !divergence.on()) {
       BrightnessOf(hits, rays, begin, end, reference2, brightness);
     }
@@ -538,11 +357,11 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
       return;
     }
     Noisy draws;
-    DrawBeams(normal, sweep_key, begin, draws.z, draws.chance);
+    DrawBeams(sweep_key, begin, draws.z, draws.chance);
     if (!divergence.on()) {
       std::copy(hits.distance_m.begin() + std::ptrdiff_t(begin),
                 hits.distance_m.begin() + std::ptrdiff_t(end), draws.range);
-      std::fill(draws.range + (end - begin), draws.range + kChunk, 0.f);
+      std::fill(draws.range + (end - begin), draws.range + kReturnChunk, 0.f);
       PerturbBeams(range_noise, draws.z, draws.chance, draws.range, draws.kept);
     }
     for (std::size_t i = begin; i < end; ++i) {
