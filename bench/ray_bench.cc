@@ -59,10 +59,13 @@ const char* Name(EmbreeMode mode) {
 // The world's collision triangles in Embree, in Bullet's frame (world minus
 // origin). `robust`: RTC_SCENE_FLAG_ROBUST, Embree's watertight mode (the
 // reference for hits); without it, its fastest mode (the reference for speed).
+// Embree's device configuration (`--isa`: "max_isa=avx2", say); empty: its defaults.
+std::string embree_config;
+
 class EmbreeScene {
  public:
   EmbreeScene(const scene::CollisionWorld& world, bool robust) {
-    device_ = rtcNewDevice(nullptr);
+    device_ = rtcNewDevice(embree_config.empty() ? nullptr : embree_config.c_str());
     scene_ = rtcNewScene(device_);
     if (robust) rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
     for (const scene::MeshObject& object : world.internals().objects) {
@@ -498,6 +501,13 @@ int main(int argc, char** argv) {
       face_case.half_extent_m = std::atof(argv[++i]);
     } else if (std::strcmp(argv[i], "--show") == 0 && more) {
       show = std::atoi(argv[++i]);
+    } else if (std::strcmp(argv[i], "--isa") == 0 && more &&
+               (std::strcmp(argv[i + 1], "avx2") == 0 || std::strcmp(argv[i + 1], "sse2") == 0)) {
+      // As on a CPU without AVX-512 (or without AVX): ours the widest kernel
+      // for it, Embree at most that set.
+      const bool avx2 = std::strcmp(argv[++i], "avx2") == 0;
+      setenv("SANDBOX_RAY_KERNEL", avx2 ? "avx2" : "sse2", 1);
+      embree_config = avx2 ? "max_isa=avx2" : "max_isa=sse2";
     } else {
       level = nullptr, posed = false, argc = -1;
       break;
@@ -506,12 +516,14 @@ int main(int argc, char** argv) {
   if (argc < 0 || (level != nullptr) != posed) {
     std::fprintf(stderr,
                  "usage: bench_rays [--seconds S] [--level FILE --at x,y,z[,yaw_deg] "
-                 "[--resolution R] [--half-extent E]] [--show N]\n"
+                 "[--resolution R] [--half-extent E]] [--show N] [--isa avx2|sse2]\n"
                  "  without --level: the sample level and a generated 1M-triangle terrain\n"
-                 "  --show N: print the first N rays that disagree with watertight Embree\n");
+                 "  --show N: print the first N rays that disagree with watertight Embree\n"
+                 "  --isa avx2|sse2: as on a CPU with no wider set (ours and Embree's kernels)\n");
     return 2;
   }
-  std::printf("%s\nray kernel: %s\n", bench::Machine().c_str(), sensors::RayCaster::kernel());
+  std::printf("%s\nray kernel: %s%s%s\n", bench::Machine().c_str(), sensors::RayCaster::kernel(),
+              embree_config.empty() ? "" : ", Embree ", embree_config.c_str());
   std::printf("%-12s %-14s %7s %2s %7s %7s %7s %11s %7s %12s %8s %14s\n", "level", "rays", "count",
               "th", "ours", "Embree1", "ratio", "Embree best", "ratio", "mismatches", "diff mm",
               "rayTest");

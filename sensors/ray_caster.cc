@@ -28,29 +28,35 @@ constexpr int kRaysPerChunk = 256;
 const RayKernel& ChosenKernel() {
   static const RayKernel chosen = [] {
     const bool fma = __builtin_cpu_supports("fma");
+    const bool avx2 = fma && __builtin_cpu_supports("avx2");
     const bool avx512 =
-        fma && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
+        avx2 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
     const struct {
       const RayKernel& kernel;
       bool runs;
-    } kernels[] = {{avx512::kKernel, avx512}, {fma::kKernel, fma}, {sse2::kKernel, true}};
+    } kernels[] = {{avx512::kKernel, avx512},
+                   {avx2::kKernel, avx2},
+                   {fma::kKernel, fma},
+                   {sse2::kKernel, true}};
     const char* asked = std::getenv("SANDBOX_RAY_KERNEL");
     if (asked != nullptr && *asked != '\0') {
+      bool known = false;
       for (const auto& k : kernels) {
         if (std::string(asked) != k.kernel.name) continue;
         if (k.runs) return k.kernel;
+        known = true;
         std::cerr << "RayCaster::kernel(): SANDBOX_RAY_KERNEL=" << asked
                   << ": this CPU cannot run that kernel; using the widest it can\n";
       }
-      if (std::string(asked) != "avx512") {
+      if (!known) {
         std::cerr << "RayCaster::kernel(): SANDBOX_RAY_KERNEL=" << asked
-                  << " is no kernel (avx512, fma, sse2); using the widest this CPU runs\n";
+                  << " is no kernel (avx512, avx2, fma, sse2); using the widest this CPU runs\n";
       }
     }
     for (const auto& k : kernels) {
       if (k.runs) return k.kernel;
     }
-    return kernels[2].kernel;
+    return kernels[3].kernel;
   }();
   return chosen;
 }

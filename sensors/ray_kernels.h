@@ -7,6 +7,7 @@
 //   packet_walk4.cc   four rays a packet: sse2 (any x86-64; fused
 //                     multiply-adds emulated where rounding could turn a
 //                     decision) and fma (fused throughout, as Embree's);
+//   packet_walk8.cc   eight rays a packet: avx2 (fused, as fma);
 //   packet_walk16.cc  sixteen rays a packet: avx512 (fused, as fma).
 // All give the same hits (docs/reference/sensors.md). RayCaster::kernel()
 // names the one in use; SANDBOX_RAY_KERNEL picks another.
@@ -135,6 +136,9 @@ namespace sse2 {
 extern const RayKernel kKernel;
 }
 namespace fma {
+extern const RayKernel kKernel;
+}
+namespace avx2 {
 extern const RayKernel kKernel;
 }
 namespace avx512 {
