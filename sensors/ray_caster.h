@@ -135,9 +135,11 @@ class RayCaster {
   static constexpr int kStackInPlace = 32;
   // The packet kernel in use: "avx512" (sixteen rays a packet in Cast(),
   // sixteen triangle-ray pairs a test in CastGrids(); the FMA kernel's
-  // arithmetic), "fma" (the CPU's fused multiply-add unit, four rays) or
-  // "sse2" (fused operations emulated where they decide). The widest the CPU
-  // runs, unless SANDBOX_RAY_KERNEL names another. All give the same hits.
+  // arithmetic), "avx2" (eight rays and pairs, the same arithmetic, on
+  // CPUs with AVX2 but not AVX-512), "fma" (the CPU's fused multiply-add
+  // unit, four rays) or "sse2" (fused operations emulated where they
+  // decide). The widest the CPU runs, unless SANDBOX_RAY_KERNEL names
+  // another. All give the same hits.
   static const char* kernel();
   // Rays cast since construction (frame statistics).
   std::int64_t rays_cast() const { return rays_cast_; }
