@@ -33,7 +33,7 @@ namespace sandbox::app {
 namespace {
 
 const char* kUsage =
-    "usage: sandbox demo [--duration S] [--out DIR] [--in-process]\n"
+    "usage: sandbox demo [--duration S] [--out DIR] [--in-process] [--web [ADDR:]PORT]\n"
     "  The sample level and the flying wing, flown by the example model (examples/fly_wing)\n"
     "  as a separate process over LCM inside a private network namespace (nothing reaches\n"
     "  the LAN). Face scanner on; chase, trailing and belly cameras write JPEG and an mp4\n"
@@ -41,7 +41,10 @@ const char* kUsage =
     "  --duration    seconds of flight (default 20)\n"
     "  --out         where everything goes (default: sandbox-demo)\n"
     "  --in-process  no namespace: the model flies in this process over memq:// (also what\n"
-    "                happens when no namespace can be made: that needs root or user namespaces)\n";
+    "                happens when no namespace can be made: that needs root or user namespaces)\n"
+    "  --web         the browser view on this port (127.0.0.1 unless an address is given; 0:\n"
+    "                any free port): the model then flies in-process, as the namespace's\n"
+    "                ports are out of the browser's reach (docs/reference/web.md)\n";
 
 bool InNamespace() {
   const char* flag = std::getenv("SANDBOX_IN_NETNS");
@@ -145,7 +148,7 @@ void WriteOverview(const std::filesystem::path& dir, const std::string& file) {
 
 int RunDemo(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   const auto parsed =
-      ParseArgs(args, "demo", {"--duration", "--out"}, {"--in-process"}, kUsage, err);
+      ParseArgs(args, "demo", {"--duration", "--out", "--web"}, {"--in-process"}, kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
     out << kUsage;
@@ -162,7 +165,8 @@ int RunDemo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     if (!(duration_s > 0.0 && duration_s <= 3600.0))
       throw UsageError("--duration must be above 0 and at most 3600 s");
     const std::string out_dir = parsed->Value("--out", "sandbox-demo");
-    bool in_process = parsed->flags.count("--in-process") > 0;
+    const bool web = parsed->values.count("--web") > 0;
+    bool in_process = parsed->flags.count("--in-process") > 0 || web;
     if (!in_process && !InNamespace()) {
       if (CanMakeNamespace()) {
         out << "sandbox demo: into a private network namespace (scripts/netns-run)\n" << std::flush;
@@ -179,6 +183,7 @@ int RunDemo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     seconds << duration_s;
     std::vector<std::string> run_args = {"--duration", seconds.str(), "--out",         out_dir,
                                          "--frames",   "jpg,mp4",     "--scans-every", "1"};
+    if (web) run_args.insert(run_args.end(), {"--web", parsed->Value("--web")});
     StatusListener status;
     RunHooks hooks;
     hooks.before_close = [&status](bridge::LcmLink&) { status.input.reset(); };

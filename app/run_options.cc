@@ -37,7 +37,7 @@ void ParseFrames(const std::string& text, FramePipelineConfig* config) {
 
 const std::set<std::string> kRunValueOptions = {
     "--rate",   "--duration", "--lcm-url",     "--replay",   "--record", "--out",
-    "--frames", "--depth",    "--scans-every", "--realtime", "--ticks"};
+    "--frames", "--depth",    "--scans-every", "--realtime", "--ticks",  "--web"};
 const std::set<std::string> kRunFlags = {"--lockstep", "--view", "--isolate", "--no-sensors",
                                          "--frames-only"};
 
@@ -113,7 +113,26 @@ RunOptions ParseRunOptions(const ParsedArgs& args) {
   if (!options.sensors && options.scans_every_s > 0.0) {
     throw UsageError("--no-sensors scans nothing: no --scans-every");
   }
+  if (args.values.count("--web")) ParseWebAddress(args.Value("--web"), &options);
   return options;
+}
+
+void ParseWebAddress(const std::string& text, RunOptions* options) {
+  const auto colon = text.rfind(':');
+  const std::string port = colon == std::string::npos ? text : text.substr(colon + 1);
+  std::string address = colon == std::string::npos ? "127.0.0.1" : text.substr(0, colon);
+  if (address.size() > 2 && address.front() == '[' && address.back() == ']') {
+    address = address.substr(1, address.size() - 2);  // [IPv6]
+  }
+  const bool digits = !port.empty() && port.size() <= 5 &&
+                      port.find_first_not_of("0123456789") == std::string::npos;
+  if (!digits || std::stoi(port) > 65535 || address.empty()) {
+    throw UsageError(
+        "--web must be PORT or ADDRESS:PORT (port 0 to 65535, 0: any free one), got '" + text +
+        "'");
+  }
+  options->web_address = address;
+  options->web_port = std::stoi(port);
 }
 
 }  // namespace sandbox::app

@@ -32,6 +32,8 @@ struct RunOptions {
   std::int64_t ticks{0};       // stop after this many ticks; 0: no limit
   bool sensors{true};          // false: no sensor runs (--no-sensors, --frames-only)
   bool publish{true};          // false: nothing published (--frames-only)
+  std::string web_address;     // the browser view's address (--web [ADDR:]PORT); empty: none
+  int web_port{-1};            // its port; -1: no browser view (0: any free port)
 
   bool free_running() const { return rate_hz == 0.0; }
   bool replay() const { return !replay_file.empty(); }
@@ -42,5 +44,8 @@ extern const std::set<std::string> kRunValueOptions, kRunFlags;
 
 // Throws UsageError for a bad value or combination.
 RunOptions ParseRunOptions(const ParsedArgs& args);
+// --web's value, [ADDRESS:]PORT (the address 127.0.0.1 when left out;
+// [IPv6]:PORT), into *options; the address is checked when the server binds.
+void ParseWebAddress(const std::string& text, RunOptions* options);
 
 }  // namespace sandbox::app

@@ -19,6 +19,7 @@
 #include "bridge/lcm_link.h"
 #include "bridge/robot_feed.h"
 #include "bridge/unknown_robots.h"
+#include "web/stream_server.h"
 
 namespace sandbox::app {
 
@@ -35,6 +36,7 @@ struct RunRecord {
   Eigen::Vector3d origin{Eigen::Vector3d::Zero()};
   const ScanFileWriter* scan_files{nullptr};
   const LiveView* live_view{nullptr};
+  const web::StreamServer* web{nullptr};  // the browser view, when served
   const CameraDirector* cameras{nullptr};
   const bridge::LcmLink* link{nullptr};
   const FramePipeline* frames{nullptr};  // null unless frames were written

@@ -15,6 +15,8 @@
 #include "app/command_line.h"
 #include "app/run_summary.h"
 #include "app/tick_pacer.h"
+#include "web/level_model.h"
+#include "web/stream_state.h"
 
 namespace sandbox::app {
 namespace {
@@ -112,6 +114,18 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
     }
     frames_ = std::make_unique<FramePipeline>(level_, config);
   }
+  if (options_.web_port >= 0) {
+    web::ServerOptions server;
+    server.address = options_.web_address;
+    server.port = options_.web_port;
+    server.page_dir = SANDBOX_WEB_PAGE_DIR;
+    try {
+      web_ = std::make_unique<web::StreamServer>(server);
+      web_->SetLevel(web::MakeLevelModel(level_).glb);
+    } catch (const std::exception& e) {
+      throw CommandError(e.what());
+    }
+  }
 }
 
 SandboxLoop::~SandboxLoop() {
@@ -143,8 +157,9 @@ int SandboxLoop::Run() {
        << (options_.publish ? "" : "publishing nothing, ")
        << (options_.replay() ? "replaying " + options_.replay_file
                              : PaceName(options_) + ", LCM " + link_.url())
-       << priority << "\n"
-       << std::flush;
+       << priority << "\n";
+  if (web_) out_ << "sandbox run: browser view at " << web_->url() << "\n";
+  out_ << std::flush;
 
   const double period_s = paced ? 1.0 / options_.rate_hz : 0.0;
   // Inputs are drained for at most a quarter of a period (a flood cannot hold the loop).
@@ -185,6 +200,7 @@ int SandboxLoop::Run() {
     bool overrun = false;
     const double next_s = pacer.Next(seconds_since_start(tick_end), &overrun);
     stats_.Add(record, overrun);
+    if (web_) PublishWebState(record);
     KeepOriginNearRobot();  // between ticks: the next tick's rays see the new origin
     if (paced && !overrun) {
       stop_.SleepUntil(at(timed ? std::min(next_s, options_.duration_s) : next_s));
@@ -201,6 +217,7 @@ void SandboxLoop::Tick(double wall_s, double drain_budget_s, TickRecord* record)
   if (hooks_.before_tick) hooks_.before_tick(link_, wall_s);
   std::int64_t now = bridge::NowUtime();
   const double t = ApplyInputs(wall_s, drain_budget_s, &now, record);  // 1-2
+  tick_time_s_ = t, tick_utime_ = now;
   if (terrain_) StreamTerrain(t);
   if (options_.sensors) RunDueSensors(t, now);  // 3, and 4: their outputs
   if (options_.publish) PublishStates(now);     // 4
@@ -416,6 +433,35 @@ void SandboxLoop::ReportRecordingFailure() {
   err_ << "sandbox run: recording stopped: " << link_.record_error() << "\n";
 }
 
+void SandboxLoop::PublishWebState(const TickRecord& record) {
+  web::StreamState state;
+  state.tick = record.tick;
+  state.time_s = tick_time_s_;
+  state.tick_ms = record.duration_ms;
+  state.late_ms = record.lateness_ms;
+  for (std::size_t r = 0; r < robots_.size(); ++r) {
+    web::StreamState::Robot robot;
+    robot.name = level_.robots[r].name;
+    const bridge::RobotFeed& feed = *robots_[r].feed;
+    robot.has_pose = feed.input().seq >= 0 || feed.input().utime >= 0;
+    const Eigen::Isometry3d& X_WB = robots_[r].state->pose();
+    robot.p_W = X_WB.translation();
+    robot.q_W = Eigen::Quaterniond(X_WB.linear());
+    for (const bridge::ChannelStatus& channel : feed.Channels(tick_utime_)) {
+      robot.rejected += channel.rejected;
+      if (channel.stale) robot.stale.push_back(channel.channel);
+    }
+    state.robots.push_back(std::move(robot));
+  }
+  for (std::size_t a = 0; a < level_.actors.size(); ++a) {
+    if (!level_.actors[a].movable) continue;
+    const Eigen::Isometry3d& X_WA = world_.actor_pose(int(a));
+    state.actors.push_back(
+        {level_.actors[a].name, X_WA.translation(), Eigen::Quaterniond(X_WA.linear())});
+  }
+  web_->Publish([state = std::move(state)] { return web::EncodeState(state); });
+}
+
 bool SandboxLoop::Report(double elapsed_s) {
   if (!options_.record_file.empty()) ReportRecordingFailure();
   RunRecord run;
@@ -430,6 +476,7 @@ bool SandboxLoop::Report(double elapsed_s) {
   run.origin = world_.origin();
   run.scan_files = &scan_files_;
   run.live_view = live_view_.get();
+  run.web = web_.get();
   run.cameras = &cameras_;
   run.link = &link_;
   run.frames = write_frames_ ? frames_.get() : nullptr;

@@ -47,6 +47,7 @@
 #include "sensors/pose_history.h"
 #include "sensors/ray_caster.h"
 #include "sensors/sensor.h"
+#include "web/stream_server.h"
 
 namespace sandbox::app {
 
@@ -105,6 +106,8 @@ class SandboxLoop {
   // The surface table on each robot's WORLD channel: at the first tick, when
   // terrain tiles come or go, and once a second.
   void PublishSurfacesIfDue(double t, std::int64_t now_utime);
+  // Between ticks: the browser view's state (--web), handed to its server.
+  void PublishWebState(const TickRecord& record);
   // Between ticks: the floating origin to the first robot when it is far from it.
   void KeepOriginNearRobot();
   // Says once that the recording (--record) could not be written.
@@ -139,8 +142,11 @@ class SandboxLoop {
   std::unique_ptr<LiveView> live_view_;  // before frames_: frames_ calls into it
   bool write_frames_{false};
   std::unique_ptr<FramePipeline> frames_;
+  std::unique_ptr<web::StreamServer> web_;  // the browser view (--web)
 
   std::int64_t tick_{0};
+  double tick_time_s_{0.0};              // the last tick's time (lock-step: its input's)
+  std::int64_t tick_utime_{0};           // and its clock, as inputs are stamped
   std::vector<bool> stale_, stale_now_;  // per robot and input: as last published, now
   CameraDirector::Shot shot_;
   bool recording_failure_reported_{false};

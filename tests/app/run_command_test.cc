@@ -339,6 +339,27 @@ TEST(RunCommandTest, AnyWaitEndsAtTheDurationOrOnASignal) {
   EXPECT_LT(std::stod(elapsed[1]), 30.0);
 }
 
+// --web: a bad value is a usage error naming it; an address that cannot be
+// bound, an error naming the address; a good one is served and counted.
+TEST(RunCommandTest, WebAddressesAreCheckedAndTheViewIsCounted) {
+  for (const char* value : {"-1", "70000", "http", "8080x", "127.0.0.1:", ":8080", "''"}) {
+    const auto run = RunSandbox("run --duration 0.1 --lcm-url memq:// --web " + std::string(value));
+    EXPECT_EQ(run.exit_code, 2) << value << ": " << run.out;
+    EXPECT_NE(run.out.find("--web must be PORT or ADDRESS:PORT"), std::string::npos) << run.out;
+  }
+  const auto bad = RunSandbox("run --duration 0.1 --lcm-url memq:// --web 1.2.3.4.5:0");
+  EXPECT_EQ(bad.exit_code, 1) << bad.out;
+  EXPECT_NE(bad.out.find("--web: '1.2.3.4.5' is no IP address"), std::string::npos) << bad.out;
+  const auto elsewhere = RunSandbox("run --duration 0.1 --lcm-url memq:// --web 192.0.2.1:0");
+  EXPECT_EQ(elsewhere.exit_code, 1) << elsewhere.out;
+  EXPECT_NE(elsewhere.out.find("--web: cannot listen on 192.0.2.1:0"), std::string::npos)
+      << elsewhere.out;
+  const auto good = RunSandbox("run --duration 0.3 --lcm-url memq:// --web 0");
+  EXPECT_EQ(good.exit_code, 0) << good.out;
+  EXPECT_NE(good.out.find("browser view at http://127.0.0.1:"), std::string::npos) << good.out;
+  EXPECT_NE(good.out.find("browser view: 0 clients"), std::string::npos) << good.out;
+}
+
 TEST(RunCommandTest, BadFrameOptionsFailClearly) {
   sandbox::testing::TempDir dir;
   const auto gif =

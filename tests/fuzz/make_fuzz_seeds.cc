@@ -107,6 +107,33 @@ void UdpSeeds(const fs::path& dir) {
   Write(dir / "doubles_rpy", rpy);
 }
 
+// Requests to the browser view's server: plain GETs, a WebSocket handshake
+// followed by masked frames (text, binary, ping, close), one from another origin.
+void WebRequestSeeds(const fs::path& dir) {
+  const Bytes handshake =
+      "GET /stream HTTP/1.1\r\nHost: 127.0.0.1:8080\r\nUpgrade: websocket\r\n"
+      "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+      "Origin: http://127.0.0.1:8080\r\nSec-WebSocket-Version: 13\r\n\r\n";
+  auto frame = [](unsigned char opcode, const Bytes& payload) {
+    const unsigned char mask[4] = {0x12, 0x34, 0x56, 0x78};
+    Bytes f;
+    f += char(0x80 | opcode);
+    f += char(0x80 | payload.size());  // under 126 bytes here
+    f.append(reinterpret_cast<const char*>(mask), 4);
+    for (std::size_t i = 0; i < payload.size(); ++i) f += char(payload[i] ^ mask[i % 4]);
+    return f;
+  };
+  Write(dir / "get_page", "GET / HTTP/1.1\r\nHost: 127.0.0.1:8080\r\n\r\n");
+  Write(dir / "get_three",
+        "GET /three/build/three.module.js?v=1 HTTP/1.1\r\nHost: localhost\r\n\r\n");
+  Write(dir / "get_outside", "GET /three/../../etc/passwd HTTP/1.1\r\nHost: [::1]:80\r\n\r\n");
+  Write(dir / "stream_frames", handshake + frame(0x1, "hello") + frame(0x2, Bytes("\0\1\2", 3)) +
+                                   frame(0x9, "ping") + frame(0x8, Bytes("\x03\xe8", 2)));
+  Bytes other = handshake;
+  other.replace(other.find("Origin: http://127.0.0.1:8080"), 29, "Origin: http://evil.example");
+  Write(dir / "stream_other_origin", other);
+}
+
 void LogSeeds(const fs::path& dir) {
   fs::create_directories(dir);
   sandbox::bridge::LogWriter log((dir / "flight").string());
@@ -342,6 +369,7 @@ int main(int argc, char** argv) {
   TileCacheSeeds(dir / "tile_cache");
   CompactFaceSeeds(dir / "compact_face");
   RobotDescriptionSeeds(dir / "robot_description", argv[2]);
+  WebRequestSeeds(dir / "web_request");
   std::printf("make_fuzz_seeds: seeds in %s\n", dir.string().c_str());
   return 0;
 }

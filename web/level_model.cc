@@ -1,0 +1,144 @@
+#include "web/level_model.h"
+
+#include <assimp/material.h>
+#include <assimp/scene.h>
+#include <meshoptimizer.h>
+
+#include <algorithm>
+#include <assimp/Exporter.hpp>
+#include <memory>
+#include <stdexcept>
+#include <vector>
+
+namespace sandbox::web {
+namespace {
+
+// The mesh's triangles, simplified to about `ratio` of them (1: as they
+// are): by edge collapse keeping the borders, and where that stops short of
+// the count (a mesh of many small parts), by clustering.
+std::vector<std::uint32_t> Simplified(const scene::Mesh& mesh, double ratio) {
+  if (ratio >= 1.0 || mesh.indices.empty()) return mesh.indices;
+  const std::size_t target =
+      std::max<std::size_t>(3, std::size_t(double(mesh.indices.size()) * ratio) / 3 * 3);
+  std::vector<std::uint32_t> out(mesh.indices.size());
+  const float* positions = mesh.positions_A[0].data();
+  out.resize(meshopt_simplify(out.data(), mesh.indices.data(), mesh.indices.size(), positions,
+                              mesh.positions_A.size(), sizeof(Eigen::Vector3f), target, 1e-2f,
+                              meshopt_SimplifyLockBorder, nullptr));
+  if (out.size() > target + target / 4) {
+    out.resize(mesh.indices.size());
+    out.resize(meshopt_simplifySloppy(out.data(), mesh.indices.data(), mesh.indices.size(),
+                                      positions, mesh.positions_A.size(), sizeof(Eigen::Vector3f),
+                                      target, 1.0f, nullptr));
+  }
+  return out;
+}
+
+aiMaterial* MakeMaterial(const scene::Material& source) {
+  auto* material = new aiMaterial;
+  const aiString name(source.name);
+  material->AddProperty(&name, AI_MATKEY_NAME);
+  const aiColor4D color(source.base_color.x(), source.base_color.y(), source.base_color.z(),
+                        source.base_color.w());
+  material->AddProperty(&color, 1, AI_MATKEY_COLOR_DIFFUSE);
+  material->AddProperty(&color, 1, AI_MATKEY_BASE_COLOR);
+  return material;
+}
+
+}  // namespace
+
+LevelModel MakeLevelModel(const scene::Level& level, std::size_t max_triangles) {
+  LevelModel model;
+  for (const scene::Actor& actor : level.actors) model.source_triangles += actor.num_triangles();
+  const double ratio = model.source_triangles > max_triangles
+                           ? double(max_triangles) / double(model.source_triangles)
+                           : 1.0;
+
+  // aiScene owns what it points to (and deletes it with new's partners).
+  auto scene = std::make_unique<aiScene>();
+  std::vector<aiMaterial*> materials;
+  for (const scene::Material& material : level.materials)
+    materials.push_back(MakeMaterial(material));
+  const int default_material = int(materials.size());
+  scene::Material fallback;
+  fallback.name = "default";
+  materials.push_back(MakeMaterial(fallback));
+  scene->mNumMaterials = unsigned(materials.size());
+  scene->mMaterials = new aiMaterial*[materials.size()];
+  std::copy(materials.begin(), materials.end(), scene->mMaterials);
+
+  std::vector<aiMesh*> meshes;
+  std::vector<aiNode*> nodes;
+  for (const scene::Actor& actor : level.actors) {
+    std::vector<unsigned> node_meshes;
+    // A static actor's vertices in the world frame; a movable one's in its
+    // own, under a node at its pose (which the stream's placements replace).
+    const Eigen::Affine3f X_WA =
+        actor.movable ? Eigen::Affine3f::Identity() : Eigen::Affine3f(actor.X_WA.cast<float>());
+    const Eigen::Matrix3f R_WA = X_WA.linear();
+    for (const scene::Mesh& source : actor.meshes) {
+      const std::vector<std::uint32_t> indices = Simplified(source, ratio);
+      if (indices.empty()) continue;
+      auto* mesh = new aiMesh;
+      meshes.push_back(mesh);  // owned by the scene from here
+      mesh->mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
+      mesh->mMaterialIndex =
+          unsigned(source.material >= 0 && source.material < default_material ? source.material
+                                                                              : default_material);
+      mesh->mNumVertices = unsigned(source.positions_A.size());
+      mesh->mVertices = new aiVector3D[mesh->mNumVertices];
+      const bool normals = source.normals_A.size() == source.positions_A.size();
+      if (normals) mesh->mNormals = new aiVector3D[mesh->mNumVertices];
+      for (std::size_t v = 0; v < source.positions_A.size(); ++v) {
+        const Eigen::Vector3f p = X_WA * source.positions_A[v];
+        mesh->mVertices[v] = aiVector3D(p.x(), p.y(), p.z());
+        if (normals) {
+          const Eigen::Vector3f n = R_WA * source.normals_A[v];
+          mesh->mNormals[v] = aiVector3D(n.x(), n.y(), n.z());
+        }
+      }
+      mesh->mNumFaces = unsigned(indices.size() / 3);
+      mesh->mFaces = new aiFace[mesh->mNumFaces];
+      for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+        aiFace& face = mesh->mFaces[f];
+        face.mNumIndices = 3;
+        face.mIndices = new unsigned[3]{indices[3 * f], indices[3 * f + 1], indices[3 * f + 2]};
+      }
+      model.triangles += mesh->mNumFaces;
+      node_meshes.push_back(unsigned(meshes.size() - 1));
+    }
+    if (node_meshes.empty()) continue;
+    auto* node = new aiNode(actor.name);
+    if (actor.movable) {
+      const Eigen::Matrix4f X = actor.X_WA.matrix().cast<float>();
+      node->mTransformation =
+          aiMatrix4x4(X(0, 0), X(0, 1), X(0, 2), X(0, 3), X(1, 0), X(1, 1), X(1, 2), X(1, 3),
+                      X(2, 0), X(2, 1), X(2, 2), X(2, 3), X(3, 0), X(3, 1), X(3, 2), X(3, 3));
+    }
+    node->mNumMeshes = unsigned(node_meshes.size());
+    node->mMeshes = new unsigned[node_meshes.size()];
+    std::copy(node_meshes.begin(), node_meshes.end(), node->mMeshes);
+    nodes.push_back(node);
+  }
+  scene->mNumMeshes = unsigned(meshes.size());
+  scene->mMeshes = new aiMesh*[std::max<std::size_t>(1, meshes.size())];
+  std::copy(meshes.begin(), meshes.end(), scene->mMeshes);
+  scene->mRootNode = new aiNode("level");
+  scene->mRootNode->mNumChildren = unsigned(nodes.size());
+  scene->mRootNode->mChildren = new aiNode*[std::max<std::size_t>(1, nodes.size())];
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    nodes[i]->mParent = scene->mRootNode;
+    scene->mRootNode->mChildren[i] = nodes[i];
+  }
+
+  Assimp::Exporter exporter;
+  const aiExportDataBlob* blob = exporter.ExportToBlob(scene.get(), "glb2");
+  if (blob == nullptr) {
+    throw std::runtime_error("the browser's level model: assimp's glTF exporter failed: " +
+                             std::string(exporter.GetErrorString()));
+  }
+  model.glb.assign(static_cast<const char*>(blob->data), blob->size);
+  return model;
+}
+
+}  // namespace sandbox::web

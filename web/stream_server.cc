@@ -1,0 +1,286 @@
+#include "web/stream_server.h"
+
+#include <chrono>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include "web/request_rules.h"
+
+// websocketpp over standalone Asio (Debian's libasio-dev), with C++11's
+// standard library for its threads and functions.
+#define ASIO_STANDALONE
+#define _WEBSOCKETPP_CPP11_STL_
+#include <websocketpp/config/asio_no_tls.hpp>
+#include <websocketpp/server.hpp>
+
+namespace sandbox::web {
+namespace {
+
+using Server = websocketpp::server<websocketpp::config::asio>;
+using Handle = websocketpp::connection_hdl;
+using Clock = std::chrono::steady_clock;
+namespace http_status = websocketpp::http::status_code;
+
+}  // namespace
+
+class StreamServer::Impl {
+ public:
+  explicit Impl(const ServerOptions& options) : options_(options) {
+    if (!std::filesystem::is_regular_file(options.page_dir / "index.html")) {
+      throw ServerError("--web: no page at " + (options.page_dir / "index.html").string());
+    }
+    server_.clear_access_channels(websocketpp::log::alevel::all);
+    server_.clear_error_channels(websocketpp::log::elevel::all);
+    server_.init_asio();
+    server_.set_reuse_addr(true);
+    server_.set_max_message_size(options.max_message_bytes);
+    server_.set_max_http_body_size(options.max_message_bytes);
+    server_.set_validate_handler([this](Handle h) { return Validate(h); });
+    server_.set_http_handler([this](Handle h) { ServeFile(h); });
+    server_.set_open_handler([this](Handle h) {
+      clients_.emplace(h, Client{});
+      ++counts_.connections;
+      counts_.clients = std::int64_t(clients_.size());
+    });
+    server_.set_close_handler([this](Handle h) { Closed(h); });
+    server_.set_fail_handler([this](Handle h) {
+      const auto code = server_.get_con_from_hdl(h)->get_response_code();
+      if (code != http_status::forbidden && code != http_status::service_unavailable &&
+          code != http_status::not_found) {
+        ++counts_.failed;
+      }
+    });
+    server_.set_message_handler(
+        [this](Handle, Server::message_ptr) { ++counts_.messages_dropped; });
+
+    asio::error_code ec;
+    const asio::ip::address address = asio::ip::make_address(options.address, ec);
+    if (ec) throw ServerError("--web: '" + options.address + "' is no IP address");
+    if (options.port < 0 || options.port > 65535) {
+      throw ServerError("--web: port " + std::to_string(options.port) + " is out of 0-65535");
+    }
+    server_.listen(asio::ip::tcp::endpoint(address, std::uint16_t(options.port)), ec);
+    if (ec) {
+      throw ServerError("--web: cannot listen on " + options.address + ":" +
+                        std::to_string(options.port) + ": " + ec.message());
+    }
+    server_.start_accept(ec);
+    if (ec) throw ServerError("--web: cannot accept on " + options.address + ": " + ec.message());
+    port_ = server_.get_local_endpoint(ec).port();
+    timer_ = std::make_unique<asio::steady_timer>(server_.get_io_service());
+    ArmTimer();
+    thread_ = std::thread([this] { server_.run(); });
+  }
+
+  ~Impl() {
+    asio::post(server_.get_io_service(), [this] {
+      asio::error_code ec;
+      server_.stop_listening(ec);
+      timer_->cancel();
+      for (auto& [handle, client] : clients_) {
+        server_.close(handle, websocketpp::close::status::going_away, "the sandbox stops", ec);
+      }
+      if (clients_.empty()) {
+        server_.stop();
+        return;
+      }
+      // Whatever has not closed in half a second is cut.
+      timer_->expires_after(std::chrono::milliseconds(500));
+      timer_->async_wait([this](const asio::error_code&) { server_.stop(); });
+    });
+    thread_.join();
+  }
+
+  int port() const { return port_; }
+
+  void SetLevel(std::string glb) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    level_ = std::make_shared<const std::string>(std::move(glb));
+  }
+
+  void Publish(Encoder encode) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending_ = std::move(encode);
+    ++counts_.states_published;
+  }
+
+  ServerCounts counts() const {
+    ServerCounts c;
+    c.clients = counts_.clients;
+    c.connections = counts_.connections;
+    c.http_requests = counts_.http_requests;
+    c.not_found = counts_.not_found;
+    c.refused_origin = counts_.refused_origin;
+    c.refused_full = counts_.refused_full;
+    c.failed = counts_.failed;
+    c.messages_dropped = counts_.messages_dropped;
+    c.closed_oversized = counts_.closed_oversized;
+    c.closed_protocol = counts_.closed_protocol;
+    c.dropped_slow = counts_.dropped_slow;
+    c.states_published = counts_.states_published;
+    c.states_sent = counts_.states_sent;
+    c.states_skipped = counts_.states_skipped;
+    c.bytes_sent = counts_.bytes_sent;
+    return c;
+  }
+
+ private:
+  struct Client {
+    bool level_sent{false};
+    bool behind{false};
+    Clock::time_point behind_since;
+  };
+  // ServerCounts, as atomics (written on the server's thread, read anywhere).
+  struct Counts {
+    std::atomic<std::int64_t> clients{0}, connections{0}, http_requests{0}, not_found{0},
+        refused_origin{0}, refused_full{0}, failed{0}, messages_dropped{0}, closed_oversized{0},
+        closed_protocol{0}, dropped_slow{0}, states_published{0}, states_sent{0}, states_skipped{0},
+        bytes_sent{0};
+  };
+
+  bool Validate(Handle h) {
+    const Server::connection_ptr con = server_.get_con_from_hdl(h);
+    if (con->get_resource() != "/stream") {
+      ++counts_.not_found;
+      con->set_status(http_status::not_found);
+      return false;
+    }
+    const std::string host = con->get_request_header("Host");
+    const std::string origin = con->get_origin();
+    if (!HostAllowed(host) || !OriginAllowed(origin, host)) {
+      ++counts_.refused_origin;
+      con->set_status(http_status::forbidden);
+      return false;
+    }
+    if (clients_.size() >= std::size_t(options_.max_clients)) {
+      ++counts_.refused_full;
+      con->set_status(http_status::service_unavailable);
+      return false;
+    }
+    return true;
+  }
+
+  void ServeFile(Handle h) {
+    const Server::connection_ptr con = server_.get_con_from_hdl(h);
+    if (!HostAllowed(con->get_request_header("Host"))) {
+      ++counts_.refused_origin;
+      con->set_status(http_status::forbidden);
+      return;
+    }
+    const std::filesystem::path file =
+        RequestedFile(con->get_resource(), options_.page_dir, options_.three_dir);
+    std::ifstream in(file, std::ios::binary);
+    if (file.empty() || !std::filesystem::is_regular_file(file) || !in) {
+      ++counts_.not_found;
+      con->set_status(http_status::not_found);
+      con->set_body("not found\n");
+      return;
+    }
+    std::ostringstream body;
+    body << in.rdbuf();
+    ++counts_.http_requests;
+    con->set_status(http_status::ok);
+    con->replace_header("Content-Type", ContentType(file));
+    con->replace_header("Cache-Control", "no-cache");
+    con->set_body(body.str());
+  }
+
+  void Closed(Handle h) {
+    const Server::connection_ptr con = server_.get_con_from_hdl(h);
+    const auto code = con->get_local_close_code();
+    if (code == websocketpp::close::status::message_too_big) ++counts_.closed_oversized;
+    if (code == websocketpp::close::status::protocol_error ||
+        code == websocketpp::close::status::invalid_payload) {
+      ++counts_.closed_protocol;
+    }
+    clients_.erase(h);
+    counts_.clients = std::int64_t(clients_.size());
+  }
+
+  void ArmTimer() {
+    const auto period = std::chrono::duration<double>(1.0 / std::max(1.0, options_.max_rate_hz));
+    timer_->expires_after(std::chrono::duration_cast<Clock::duration>(period));
+    timer_->async_wait([this](const asio::error_code& ec) {
+      if (ec) return;  // cancelled: the server stops
+      SendToClients();
+      ArmTimer();
+    });
+  }
+
+  // The level to those that have not had it, then the newest state to each
+  // that keeps up.
+  void SendToClients() {
+    Encoder encode;
+    std::shared_ptr<const std::string> level;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      encode = std::move(pending_);
+      pending_ = nullptr;
+      level = level_;
+    }
+    if (clients_.empty()) return;
+    const std::string state = encode ? encode() : std::string();
+    const Clock::time_point now = Clock::now();
+    std::vector<Handle> slow;
+    for (auto& [handle, client] : clients_) {
+      asio::error_code ec;
+      const Server::connection_ptr con = server_.get_con_from_hdl(handle, ec);
+      if (ec) continue;
+      if (!client.level_sent && level) {
+        con->send(level->data(), level->size(), websocketpp::frame::opcode::binary);
+        counts_.bytes_sent += std::int64_t(level->size());
+        client.level_sent = true;
+      }
+      if (state.empty()) continue;
+      if (con->get_buffered_amount() > options_.max_queued_bytes) {
+        ++counts_.states_skipped;
+        if (!client.behind) client.behind = true, client.behind_since = now;
+        if (std::chrono::duration<double>(now - client.behind_since).count() >
+            options_.slow_timeout_s) {
+          slow.push_back(handle);
+        }
+        continue;
+      }
+      client.behind = false;
+      con->send(state, websocketpp::frame::opcode::text);
+      ++counts_.states_sent;
+      counts_.bytes_sent += std::int64_t(state.size());
+    }
+    for (const Handle& handle : slow) {
+      asio::error_code ec;
+      ++counts_.dropped_slow;
+      server_.close(handle, websocketpp::close::status::policy_violation, "too slow", ec);
+    }
+  }
+
+  const ServerOptions options_;
+  Server server_;
+  std::unique_ptr<asio::steady_timer> timer_;
+  std::thread thread_;
+  int port_{0};
+  std::map<Handle, Client, std::owner_less<Handle>> clients_;  // server thread only
+  mutable std::mutex mutex_;
+  Encoder pending_;
+  std::shared_ptr<const std::string> level_;
+  Counts counts_;
+};
+
+StreamServer::StreamServer(const ServerOptions& options)
+    : impl_(std::make_unique<Impl>(options)), port_(impl_->port()), address_(options.address) {}
+StreamServer::~StreamServer() = default;
+
+std::string StreamServer::url() const {
+  // Bound to every address: this machine's own is one of them.
+  std::string host = address_ == "0.0.0.0" ? "127.0.0.1" : address_ == "::" ? "::1" : address_;
+  if (host.find(':') != std::string::npos) host = "[" + host + "]";
+  return "http://" + host + ":" + std::to_string(port_) + "/";
+}
+void StreamServer::SetLevel(std::string glb) { impl_->SetLevel(std::move(glb)); }
+void StreamServer::Publish(Encoder encode) { impl_->Publish(std::move(encode)); }
+ServerCounts StreamServer::counts() const { return impl_->counts(); }
+
+}  // namespace sandbox::web
