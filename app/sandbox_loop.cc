@@ -200,7 +200,7 @@ int SandboxLoop::Run() {
     bool overrun = false;
     const double next_s = pacer.Next(seconds_since_start(tick_end), &overrun);
     stats_.Add(record, overrun);
-    if (web_) PublishWebState(record);
+    if (web_ && web_->WantsState()) PublishWebState(record);
     KeepOriginNearRobot();  // between ticks: the next tick's rays see the new origin
     if (paced && !overrun) {
       stop_.SleepUntil(at(timed ? std::min(next_s, options_.duration_s) : next_s));

@@ -105,8 +105,11 @@ class StreamServer::Impl {
   void Publish(Encoder encode) {
     std::lock_guard<std::mutex> lock(mutex_);
     pending_ = std::move(encode);
+    state_pending_ = true;
     ++counts_.states_published;
   }
+
+  bool WantsState() const { return counts_.clients > 0 && !state_pending_; }
 
   ServerCounts counts() const {
     ServerCounts c;
@@ -220,6 +223,7 @@ class StreamServer::Impl {
       std::lock_guard<std::mutex> lock(mutex_);
       encode = std::move(pending_);
       pending_ = nullptr;
+      state_pending_ = false;
       level = level_;
     }
     if (clients_.empty()) return;
@@ -265,6 +269,7 @@ class StreamServer::Impl {
   std::map<Handle, Client, std::owner_less<Handle>> clients_;  // server thread only
   mutable std::mutex mutex_;
   Encoder pending_;
+  std::atomic<bool> state_pending_{false};
   std::shared_ptr<const std::string> level_;
   Counts counts_;
 };
@@ -281,6 +286,7 @@ std::string StreamServer::url() const {
 }
 void StreamServer::SetLevel(std::string glb) { impl_->SetLevel(std::move(glb)); }
 void StreamServer::Publish(Encoder encode) { impl_->Publish(std::move(encode)); }
+bool StreamServer::WantsState() const { return impl_->WantsState(); }
 ServerCounts StreamServer::counts() const { return impl_->counts(); }
 
 }  // namespace sandbox::web

@@ -84,6 +84,10 @@ class StreamServer {
   // Any thread, never waits on a client: the newest state, as a function that
   // encodes it (it owns what it encodes); replaces one not yet encoded.
   void Publish(Encoder encode);
+  // Any thread: whether a state would be sent (a client is connected and
+  // the last state published has been taken): the loop builds one only then,
+  // so a state is at most one send period old and costs nothing without clients.
+  bool WantsState() const;
 
   ServerCounts counts() const;
 
