@@ -97,6 +97,12 @@ class RawSocket {
   bool connected_{false};
 };
 
+// A WebSocket opening handshake for /stream, as a raw request.
+const char* const kHandshake =
+    "GET /stream HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\n"
+    "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+    "Sec-WebSocket-Version: 13\r\n\r\n";
+
 std::string Get(int port, const std::string& path, const std::string& host = "127.0.0.1") {
   RawSocket socket(port);
   EXPECT_TRUE(socket.connected());
@@ -305,10 +311,7 @@ TEST(StreamServerTest, MalformedRequestsAndFramesAreRefusedAndCounted) {
   ASSERT_TRUE(WaitFor([&] { return server.counts().failed == 1; }));
   // A handshake, then a frame with a reserved opcode: a protocol error.
   RawSocket socket(server.port());
-  socket.Send(
-      "GET /stream HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\n"
-      "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
-      "Sec-WebSocket-Version: 13\r\n\r\n");
+  socket.Send(kHandshake);
   EXPECT_EQ(StatusLine(socket.ReadHeaders()), "HTTP/1.1 101 Switching Protocols");
   socket.Send(std::string("\x83\x80\x00\x00\x00\x00", 6));  // FIN, opcode 3, masked, empty
   ASSERT_TRUE(WaitFor([&] { return server.counts().closed_protocol == 1; }));
@@ -321,10 +324,7 @@ TEST(StreamServerTest, AClientThatNeverReadsSkipsStatesThenIsDroppedAndOthersKee
   options.slow_timeout_s = 0.5;
   StreamServer server(options);
   RawSocket stuck(server.port());
-  stuck.Send(
-      "GET /stream HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\n"
-      "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
-      "Sec-WebSocket-Version: 13\r\n\r\n");
+  stuck.Send(kHandshake);
   EXPECT_EQ(StatusLine(stuck.ReadHeaders()), "HTTP/1.1 101 Switching Protocols");
   StreamClient reader(server.port());
   ASSERT_TRUE(WaitFor([&] { return reader.open_.load(); }));
