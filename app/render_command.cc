@@ -24,7 +24,8 @@ namespace {
 
 const char* kUsage =
     "usage: sandbox render [LEVEL] --camera chase|trailing|payload|fixed --at X,Y,Z[,R,P,Y]\n"
-    "                      [--robot NAME] [--bones LIST] [--width W] [--height H] [--fov DEG]\n"
+    "                      [--robot NAME] [--robot-at X,Y,Z[,R,P,Y]] [--bones LIST]\n"
+    "                      [--bone-values V,V,...] [--width W] [--height H] [--fov DEG]\n"
     "                      [--kind LIST] [--quality Q] [--overlay] [--stub M] [--overlay-colour "
     "C]\n"
     "                      [--isolate]\n"
@@ -34,7 +35,10 @@ const char* kUsage =
     "            millimetres); fixed: the camera itself at --at\n"
     "  --at      the robot pose (chase, trailing, payload) or the camera pose (fixed):\n"
     "            metres, roll/pitch/yaw in degrees\n"
+    "  --robot-at  the robot pose for a fixed camera (default: its spawn pose)\n"
     "  --bones   bone values as for `sandbox pose`\n"
+    "  --bone-values  every bone value at once, flat in bone-map order as <ROBOT>/BONES\n"
+    "            carries them (radians, metres, quaternions w x y z)\n"
     "  --kind    the images, a comma list of color, depth (16-bit millimetres), segmentation\n"
     "            (16-bit ids, legend in FILE_seg.csv) and normals (camera frame, 8-bit);\n"
     "            default color (payload: color,depth). Colour goes to FILE, the others to\n"
@@ -85,7 +89,7 @@ void BuildOverlay(const scene::Level& level, int robot_index, const scene::Robot
 int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   const auto parsed =
       ParseArgs(args, "render",
-                {"--camera", "--at", "--robot", "--bones", "--width", "--height", "--fov", "--out",
+                {"--camera", "--at", "--robot", "--robot-at", "--bones", "--bone-values", "--width", "--height", "--fov", "--out",
                  "--stub", "--kind", "--quality", "--overlay-colour"},
                 {"--overlay", "--isolate"}, kUsage, err);
   if (!parsed) return 2;
@@ -141,6 +145,22 @@ int RunRender(const std::vector<std::string>& args, std::ostream& out, std::ostr
       robot = std::make_unique<scene::RobotState>(level.robots[std::size_t(index)]);
       if (camera != "fixed" && !robot->SetPose(X_at)) {
         throw UsageError("--at rejected: " + robot->last_rejection());
+      }
+      if (!parsed->Value("--robot-at").empty()) {
+        if (camera != "fixed") throw UsageError("--robot-at is for a fixed camera (use --at)");
+        if (!robot->SetPose(ParsePose(parsed->Value("--robot-at"), "--robot-at")))
+          throw UsageError("--robot-at rejected: " + robot->last_rejection());
+      }
+      if (!parsed->Value("--bone-values").empty()) {
+        const std::vector<double> values =
+            ParseNumbers(parsed->Value("--bone-values"), "--bone-values");
+        if (int(values.size()) != robot->model().num_values) {
+          throw UsageError("--bone-values: robot '" + robot->model().name + "' takes " +
+                           std::to_string(robot->model().num_values) + " values, got " +
+                           std::to_string(values.size()));
+        }
+        if (!robot->SetBones(values))
+          throw UsageError("--bone-values rejected: " + robot->last_rejection());
       }
       if (!parsed->Value("--bones").empty())
         ApplyBones(parsed->Value("--bones"), robot->model(), robot.get());

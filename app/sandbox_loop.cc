@@ -15,6 +15,7 @@
 #include "app/command_line.h"
 #include "app/run_summary.h"
 #include "app/tick_pacer.h"
+#include "app/web_samples.h"
 #include "web/level_model.h"
 #include "web/stream_state.h"
 
@@ -121,7 +122,7 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
     server.page_dir = SANDBOX_WEB_PAGE_DIR;
     try {
       web_ = std::make_unique<web::StreamServer>(server);
-      web_->SetLevel(web::MakeLevelModel(level_).glb);
+      web_->SetLevel(web::LevelInfoJson(level_), web::MakeLevelModel(level_).glb);
     } catch (const std::exception& e) {
       throw CommandError(e.what());
     }
@@ -447,6 +448,16 @@ void SandboxLoop::PublishWebState(const TickRecord& record) {
     const Eigen::Isometry3d& X_WB = robots_[r].state->pose();
     robot.p_W = X_WB.translation();
     robot.q_W = Eigen::Quaterniond(X_WB.linear());
+    const scene::RobotState& robot_state = *robots_[r].state;
+    robot.bone_values = robot_state.bone_values();
+    const std::vector<scene::SkinJoint>& joints = robot_state.model().joints;
+    robot.joints.reserve(12 * joints.size());
+    for (const scene::SkinJoint& joint : joints) {
+      const Eigen::Matrix<double, 3, 4> X_BN =
+          robot_state.node_poses_B()[std::size_t(joint.node)].matrix().topRows<3>();
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 4; ++j) robot.joints.push_back(X_BN(i, j));
+    }
     for (const bridge::ChannelStatus& channel : feed.Channels(tick_utime_)) {
       robot.rejected += channel.rejected;
       if (channel.stale) robot.stale.push_back(channel.channel);
@@ -459,7 +470,20 @@ void SandboxLoop::PublishWebState(const TickRecord& record) {
     state.actors.push_back(
         {level_.actors[a].name, X_WA.translation(), Eigen::Quaterniond(X_WA.linear())});
   }
-  web_->Publish([state = std::move(state)] { return web::EncodeState(state); });
+  // The sensors' samples, a few times a second (they are most of the bytes).
+  if (tick_time_s_ >= web_samples_due_s_) {
+    web_samples_due_s_ = tick_time_s_ + 1.0 / kWebSamplesHz;
+    state.has_samples = true;
+    state.samples_origin = world_.origin();
+    for (const sensors::Sensor& sensor : sensors_) {
+      state.samples.push_back(ViewSamples(sensor,
+                                          level_.robots[std::size_t(sensor.mounted().robot)].name,
+                                          state.samples_origin, kWebSamplesPerSensor));
+    }
+  }
+  web_->Publish([state = std::move(state)] {
+    return web::EncodedState(web::EncodeState(state), web::EncodeSamples(state));
+  });
 }
 
 bool SandboxLoop::Report(double elapsed_s) {

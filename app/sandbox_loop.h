@@ -143,6 +143,9 @@ class SandboxLoop {
   bool write_frames_{false};
   std::unique_ptr<FramePipeline> frames_;
   std::unique_ptr<web::StreamServer> web_;  // the browser view (--web)
+  static constexpr double kWebSamplesHz = 5.0;                // scan samples sent so often
+  static constexpr std::size_t kWebSamplesPerSensor = 20000;  // at most so many a sensor
+  double web_samples_due_s_{0.0};
 
   std::int64_t tick_{0};
   double tick_time_s_{0.0};              // the last tick's time (lock-step: its input's)

@@ -4,8 +4,15 @@
 #include <assimp/scene.h>
 #include <meshoptimizer.h>
 
+#include <nlohmann/json.hpp>
+
+#include "scene/robot_state.h"
+#include "scene/surface_ids.h"
+
 #include <algorithm>
 #include <assimp/Exporter.hpp>
+#include <functional>
+#include <map>
 #include <memory>
 #include <stdexcept>
 #include <vector>
@@ -34,6 +41,80 @@ std::vector<std::uint32_t> Simplified(const scene::Mesh& mesh, double ratio) {
   return out;
 }
 
+aiMatrix4x4 ToAssimp(const Eigen::Affine3d& X_affine) {
+  const Eigen::Matrix4f X = X_affine.matrix().cast<float>();
+  return aiMatrix4x4(X(0, 0), X(0, 1), X(0, 2), X(0, 3), X(1, 0), X(1, 1), X(1, 2), X(1, 3),
+                     X(2, 0), X(2, 1), X(2, 2), X(2, 3), X(3, 0), X(3, 1), X(3, 2), X(3, 3));
+}
+
+aiNode* MakeParentOf(const std::string& name, const std::vector<aiNode*>& children) {
+  auto* node = new aiNode(name);
+  node->mNumChildren = unsigned(children.size());
+  node->mChildren = new aiNode*[std::max<std::size_t>(1, children.size())];
+  for (std::size_t i = 0; i < children.size(); ++i) {
+    children[i]->mParent = node;
+    node->mChildren[i] = children[i];
+  }
+  return node;
+}
+
+// One of a robot's meshes in bind space with its joints as assimp bones
+// (named as the joint nodes), at most four influences a vertex (glTF's
+// JOINTS_0), the strongest, their weights scaled to sum to 1.
+aiMesh* MakeRobotMesh(const scene::SkinnedMesh& source, const std::string& joint_prefix,
+                      const scene::RobotModel& model, unsigned material) {
+  auto* mesh = new aiMesh;
+  const scene::Mesh& bind = source.bind;
+  mesh->mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
+  mesh->mMaterialIndex = material;
+  mesh->mNumVertices = unsigned(bind.positions_A.size());
+  mesh->mVertices = new aiVector3D[mesh->mNumVertices];
+  const bool normals = bind.normals_A.size() == bind.positions_A.size();
+  if (normals) mesh->mNormals = new aiVector3D[mesh->mNumVertices];
+  for (std::size_t v = 0; v < bind.positions_A.size(); ++v) {
+    const Eigen::Vector3f& p = bind.positions_A[v];
+    mesh->mVertices[v] = aiVector3D(p.x(), p.y(), p.z());
+    if (normals) {
+      const Eigen::Vector3f& n = bind.normals_A[v];
+      mesh->mNormals[v] = aiVector3D(n.x(), n.y(), n.z());
+    }
+  }
+  mesh->mNumFaces = unsigned(bind.indices.size() / 3);
+  mesh->mFaces = new aiFace[mesh->mNumFaces];
+  for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+    aiFace& face = mesh->mFaces[f];
+    face.mNumIndices = 3;
+    face.mIndices =
+        new unsigned[3]{bind.indices[3 * f], bind.indices[3 * f + 1], bind.indices[3 * f + 2]};
+  }
+  std::map<std::uint16_t, std::vector<aiVertexWeight>> weights;  // by joint
+  std::vector<std::pair<float, std::uint16_t>> strongest;
+  for (std::uint32_t v = 0; v + 1 < source.influence_begin.size(); ++v) {
+    strongest.clear();
+    for (std::uint32_t i = source.influence_begin[v]; i < source.influence_begin[v + 1]; ++i)
+      strongest.emplace_back(source.influence_weight[i], source.influence_joint[i]);
+    std::sort(strongest.begin(), strongest.end(), std::greater<>());
+    if (strongest.size() > 4) strongest.resize(4);
+    float sum = 0.0f;
+    for (const auto& [weight, joint] : strongest) sum += weight;
+    for (const auto& [weight, joint] : strongest)
+      if (weight > 0.0f) weights[joint].emplace_back(v, weight / sum);
+  }
+  mesh->mNumBones = unsigned(weights.size());
+  mesh->mBones = new aiBone*[std::max<std::size_t>(1, weights.size())];
+  unsigned b = 0;
+  for (auto& [joint, list] : weights) {
+    auto* bone = new aiBone;
+    bone->mName = aiString(joint_prefix + std::to_string(joint));
+    bone->mOffsetMatrix = ToAssimp(model.joints[joint].offset);
+    bone->mNumWeights = unsigned(list.size());
+    bone->mWeights = new aiVertexWeight[list.size()];
+    std::copy(list.begin(), list.end(), bone->mWeights);
+    mesh->mBones[b++] = bone;
+  }
+  return mesh;
+}
+
 aiMaterial* MakeMaterial(const scene::Material& source) {
   auto* material = new aiMaterial;
   const aiString name(source.name);
@@ -46,6 +127,29 @@ aiMaterial* MakeMaterial(const scene::Material& source) {
 }
 
 }  // namespace
+
+std::string LevelInfoJson(const scene::Level& level) {
+  nlohmann::json surfaces = nlohmann::json::array(), robots = nlohmann::json::array();
+  const scene::SurfaceIds ids(level);
+  for (const scene::SurfaceEntry& entry : ids.entries())
+    surfaces.push_back({{"id", entry.id}, {"kind", entry.kind}, {"name", entry.name}});
+  for (const scene::RobotModel& robot : level.robots) {
+    nlohmann::json bones = nlohmann::json::array(), sensors = nlohmann::json::array();
+    for (const scene::Bone& bone : robot.bones)
+      bones.push_back({{"name", bone.name}, {"values", bone.num_values}});
+    for (const scene::SensorSpec& sensor : robot.sensors)
+      sensors.push_back({{"name", sensor.name}, {"type", sensor.type}});
+    robots.push_back({{"name", robot.name}, {"bones", std::move(bones)},
+                      {"sensors", std::move(sensors)}});
+  }
+  return nlohmann::json({{"type", "level"},
+                         {"name", level.name},
+                         {"surfaces", std::move(surfaces)},
+                         {"robots", std::move(robots)}})
+      .dump();
+}
+
+std::string RobotNodeName(int robot) { return "sandbox_robot" + std::to_string(robot); }
 
 LevelModel MakeLevelModel(const scene::Level& level, std::size_t max_triangles) {
   LevelModel model;
@@ -109,27 +213,46 @@ LevelModel MakeLevelModel(const scene::Level& level, std::size_t max_triangles) 
     }
     if (node_meshes.empty()) continue;
     auto* node = new aiNode(actor.name);
-    if (actor.movable) {
-      const Eigen::Matrix4f X = actor.X_WA.matrix().cast<float>();
-      node->mTransformation =
-          aiMatrix4x4(X(0, 0), X(0, 1), X(0, 2), X(0, 3), X(1, 0), X(1, 1), X(1, 2), X(1, 3),
-                      X(2, 0), X(2, 1), X(2, 2), X(2, 3), X(3, 0), X(3, 1), X(3, 2), X(3, 3));
-    }
+    if (actor.movable) node->mTransformation = ToAssimp(Eigen::Affine3d(actor.X_WA.matrix()));
     node->mNumMeshes = unsigned(node_meshes.size());
     node->mMeshes = new unsigned[node_meshes.size()];
     std::copy(node_meshes.begin(), node_meshes.end(), node->mMeshes);
     nodes.push_back(node);
   }
+  // Each robot: a node (the page places it at the robot's pose) with its
+  // joints' nodes under it, flat, at rest (the page sets them from each
+  // state), and its meshes skinned to them.
+  for (std::size_t r = 0; r < level.robots.size(); ++r) {
+    const scene::RobotModel& robot = level.robots[r];
+    const std::string name = RobotNodeName(int(r));
+    const scene::RobotState rest(robot);
+    std::vector<aiNode*> children;
+    for (std::size_t k = 0; k < robot.joints.size(); ++k) {
+      auto* joint = new aiNode(name + "_joint" + std::to_string(k));
+      joint->mTransformation =
+          ToAssimp(rest.node_poses_B()[std::size_t(robot.joints[k].node)]);
+      children.push_back(joint);
+    }
+    for (std::size_t m = 0; m < robot.meshes.size(); ++m) {
+      const scene::SkinnedMesh& source = robot.meshes[m];
+      if (source.bind.indices.empty()) continue;
+      const int material = source.bind.material;
+      meshes.push_back(MakeRobotMesh(
+          source, name + "_joint", robot,
+          unsigned(material >= 0 && material < default_material ? material : default_material)));
+      model.robot_triangles += meshes.back()->mNumFaces;
+      model.triangles += meshes.back()->mNumFaces;
+      auto* node = new aiNode(name + "_mesh" + std::to_string(m));
+      node->mNumMeshes = 1;
+      node->mMeshes = new unsigned[1]{unsigned(meshes.size() - 1)};
+      children.push_back(node);
+    }
+    nodes.push_back(MakeParentOf(name, children));
+  }
   scene->mNumMeshes = unsigned(meshes.size());
   scene->mMeshes = new aiMesh*[std::max<std::size_t>(1, meshes.size())];
   std::copy(meshes.begin(), meshes.end(), scene->mMeshes);
-  scene->mRootNode = new aiNode("level");
-  scene->mRootNode->mNumChildren = unsigned(nodes.size());
-  scene->mRootNode->mChildren = new aiNode*[std::max<std::size_t>(1, nodes.size())];
-  for (std::size_t i = 0; i < nodes.size(); ++i) {
-    nodes[i]->mParent = scene->mRootNode;
-    scene->mRootNode->mChildren[i] = nodes[i];
-  }
+  scene->mRootNode = MakeParentOf("level", nodes);
 
   Assimp::Exporter exporter;
   const aiExportDataBlob* blob = exporter.ExportToBlob(scene.get(), "glb2");

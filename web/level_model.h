@@ -7,6 +7,11 @@
 // (the page turns its camera; glTF's own convention is Y up). Over
 // `max_triangles`, every mesh is simplified by the same ratio
 // (meshoptimizer), keeping its borders.
+// Each robot is a node named RobotNodeName(index) at the origin, holding its
+// skin joints' nodes "<node>_joint<k>" (k indexing RobotModel::joints) flat
+// at their rest poses in the robot's body frame, and its meshes (not
+// simplified) as glTF skins of those joints: the page places the node at the
+// robot's pose and the joints at the poses the stream sends, and skins.
 
 #include <cstddef>
 #include <string>
@@ -19,7 +24,16 @@ struct LevelModel {
   std::string glb;                  // the file's bytes
   std::size_t triangles{0};         // in it
   std::size_t source_triangles{0};  // in the level's actors
+  std::size_t robot_triangles{0};   // the robots' (part of `triangles`)
 };
+
+// What the page is told of the level before its model (JSON text): its name,
+// its surface ids (id, kind, name: what a sample hit), and per robot its
+// bones (name, number of values) and sensors (name, type). docs/reference/web.md.
+std::string LevelInfoJson(const scene::Level& level);
+
+// The name of robot `robot`'s node ("sandbox_robot0"; three.js keeps it as is).
+std::string RobotNodeName(int robot);
 
 // Throws std::runtime_error when assimp cannot write it.
 LevelModel MakeLevelModel(const scene::Level& level, std::size_t max_triangles = 2'000'000);

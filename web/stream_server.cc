@@ -97,8 +97,9 @@ class StreamServer::Impl {
 
   int port() const { return port_; }
 
-  void SetLevel(std::string glb) {
+  void SetLevel(std::string info_json, std::string glb) {
     std::lock_guard<std::mutex> lock(mutex_);
+    level_info_ = std::make_shared<const std::string>(std::move(info_json));
     level_ = std::make_shared<const std::string>(std::move(glb));
   }
 
@@ -218,16 +219,17 @@ class StreamServer::Impl {
   // that keeps up.
   void SendToClients() {
     Encoder encode;
-    std::shared_ptr<const std::string> level;
+    std::shared_ptr<const std::string> level, level_info;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       encode = std::move(pending_);
       pending_ = nullptr;
       state_pending_ = false;
       level = level_;
+      level_info = level_info_;
     }
     if (clients_.empty()) return;
-    const std::string state = encode ? encode() : std::string();
+    const EncodedState state = encode ? encode() : EncodedState();
     const Clock::time_point now = Clock::now();
     std::vector<Handle> slow;
     for (auto& [handle, client] : clients_) {
@@ -235,11 +237,12 @@ class StreamServer::Impl {
       const Server::connection_ptr con = server_.get_con_from_hdl(handle, ec);
       if (ec) continue;
       if (!client.level_sent && level) {
+        con->send(*level_info, websocketpp::frame::opcode::text);
         con->send(level->data(), level->size(), websocketpp::frame::opcode::binary);
-        counts_.bytes_sent += std::int64_t(level->size());
+        counts_.bytes_sent += std::int64_t(level_info->size() + level->size());
         client.level_sent = true;
       }
-      if (state.empty()) continue;
+      if (state.text.empty()) continue;
       if (con->get_buffered_amount() > options_.max_queued_bytes) {
         ++counts_.states_skipped;
         if (!client.behind) client.behind = true, client.behind_since = now;
@@ -250,9 +253,12 @@ class StreamServer::Impl {
         continue;
       }
       client.behind = false;
-      con->send(state, websocketpp::frame::opcode::text);
+      con->send(state.text, websocketpp::frame::opcode::text);
+      if (!state.binary.empty()) {
+        con->send(state.binary.data(), state.binary.size(), websocketpp::frame::opcode::binary);
+      }
       ++counts_.states_sent;
-      counts_.bytes_sent += std::int64_t(state.size());
+      counts_.bytes_sent += std::int64_t(state.text.size() + state.binary.size());
     }
     for (const Handle& handle : slow) {
       asio::error_code ec;
@@ -270,7 +276,7 @@ class StreamServer::Impl {
   mutable std::mutex mutex_;
   Encoder pending_;
   std::atomic<bool> state_pending_{false};
-  std::shared_ptr<const std::string> level_;
+  std::shared_ptr<const std::string> level_, level_info_;
   Counts counts_;
 };
 
@@ -284,7 +290,9 @@ std::string StreamServer::url() const {
   if (host.find(':') != std::string::npos) host = "[" + host + "]";
   return "http://" + host + ":" + std::to_string(port_) + "/";
 }
-void StreamServer::SetLevel(std::string glb) { impl_->SetLevel(std::move(glb)); }
+void StreamServer::SetLevel(std::string info_json, std::string glb) {
+  impl_->SetLevel(std::move(info_json), std::move(glb));
+}
 void StreamServer::Publish(Encoder encode) { impl_->Publish(std::move(encode)); }
 bool StreamServer::WantsState() const { return impl_->WantsState(); }
 ServerCounts StreamServer::counts() const { return impl_->counts(); }

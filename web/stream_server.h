@@ -3,7 +3,7 @@
 // port, on a thread of its own (websocketpp over standalone Asio). It serves
 // the page (web/page), three.js from Debian's libjs-three, and at /stream a
 // WebSocket that sends each client the level's model once (a binary glTF) and
-// then the newest state (JSON text), at most `max_rate_hz` a second, at the
+// then the newest state (JSON text, and scan samples as binary), at most `max_rate_hz` a second, at the
 // client's own pace: a client whose unsent bytes pass `max_queued_bytes`
 // skips states (counted) and is dropped when it stays behind for
 // `slow_timeout_s`. The loop hands states over with Publish, which never
@@ -62,10 +62,19 @@ class ServerError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A state as sent: a text message, and a binary one after it when not empty
+// (the scan samples, docs/reference/web.md).
+struct EncodedState {
+  EncodedState(std::string text_message = {}, std::string binary_message = {})
+      : text(std::move(text_message)), binary(std::move(binary_message)) {}
+  std::string text;
+  std::string binary;
+};
+
 class StreamServer {
  public:
   // Encodes a state for the wire (on the server's thread).
-  using Encoder = std::function<std::string()>;
+  using Encoder = std::function<EncodedState()>;
 
   // Binds and starts serving. Throws ServerError naming the address when it
   // cannot (in use, not an address of this machine, no page folder).
@@ -78,9 +87,10 @@ class StreamServer {
   // "http://ADDRESS:PORT/", the page's address (127.0.0.1 when bound to all).
   std::string url() const;
 
-  // Any thread: the level's model (binary glTF), sent first to every client
-  // (to those connected now, and to each that connects later).
-  void SetLevel(std::string glb);
+  // Any thread: what every client is sent first (those connected now and
+  // each that connects later): the level's description (JSON text) and its
+  // model (binary glTF).
+  void SetLevel(std::string info_json, std::string glb);
   // Any thread, never waits on a client: the newest state, as a function that
   // encodes it (it owns what it encodes); replaces one not yet encoded.
   void Publish(Encoder encode);

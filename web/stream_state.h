@@ -22,6 +22,10 @@ struct StreamState {
     bool has_pose{false};            // a pose has arrived
     std::int64_t rejected{0};        // inputs refused so far
     std::vector<std::string> stale;  // its input channels gone quiet
+    std::vector<double> bone_values;  // flat, in bone-map order (RobotState::bone_values)
+    // Per skin joint k (RobotModel::joints): its node's pose in the body
+    // frame, the 3 x 4 matrix row by row (12 values a joint; sent to 1e-5).
+    std::vector<double> joints;
   };
   std::int64_t tick{0};
   double time_s{0.0};   // since the run started (lock-step: the inputs' time)
@@ -29,8 +33,26 @@ struct StreamState {
   double late_ms{0.0};  // how late it started
   std::vector<Robot> robots;
   std::vector<Body> actors;  // the movable actors
+
+  // A sensor's latest samples, positions relative to `samples_origin`.
+  struct Samples {
+    std::string robot, sensor, type;  // type: the [[robot.sensor]] type ("face", "lidar", ...)
+    std::vector<float> xyz;           // 3 a sample, world axes
+    std::vector<std::uint8_t> hit;    // 1: it hit something (occupied); 0: the ray's free end
+    std::vector<std::int32_t> surface;  // its surface id (0: nothing)
+  };
+  bool has_samples{false};  // samples are sent with this state (at most a few a second)
+  Eigen::Vector3d samples_origin{Eigen::Vector3d::Zero()};
+  std::vector<Samples> samples;
 };
 
+// The state's text message (JSON).
 std::string EncodeState(const StreamState& state);
+// Its samples' binary message ("" without samples): "SMPL", a little-endian
+// uint32 header length, the JSON header (padded with spaces to 4 bytes:
+// tick, origin, and per sensor robot, sensor, type and count n), then per
+// sensor in the header's order n * 3 float32 positions, n int32 surface ids
+// and n uint8 hits (padded with zeros to 4 bytes). docs/reference/web.md.
+std::string EncodeSamples(const StreamState& state);
 
 }  // namespace sandbox::web

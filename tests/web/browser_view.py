@@ -6,13 +6,19 @@ Debian's chromium through chromedriver (the WebDriver protocol, over HTTP with
 the standard library) to the printed address, and checks what a user would
 see: the level drawn (the sample level's grass covers much of the screenshot),
 states arriving with increasing ticks, the wing posed and moving, the robot's
-status. Prints the time to the first drawn frame and the page's frame rate.
+status. Then holds the page at one state and compares the robot as the browser
+skins and draws it with the sandbox's own render (OSMesa, `sandbox render`
+with the same robot pose, bone values and camera): the robot's pixels overlap
+with an intersection over union of at least 0.95. Prints the time to the
+first drawn frame, the page's frame rate and the overlap.
 
 usage: browser_view.py SANDBOX
 """
 import base64
+import csv
 import io
 import json
+import math
 import os
 import re
 import shutil
@@ -131,6 +137,14 @@ def main():
               "wing moved %.1f m, grass %.0f%% of the screenshot"
               % (later["firstFrameMs"], fps, later["states"] - first["states"], seconds, moved,
                  100 * green))
+        checked, worst, picked = sample_checks(browser)
+        print("browser view: %d of the face scanner's hits checked against the level model the "
+              "page draws: each within %.1e m of its surfaces; a click picks sample %s"
+              % (checked, worst, picked))
+        iou, tick, pixels = robot_overlap(browser, sandbox, out)
+        print("browser view: the skinned wing at tick %d overlaps OSMesa's render from the same "
+              "camera with IoU %.3f (%d robot pixels)" % (tick, iou, pixels))
+        assert iou >= 0.95, "IoU %.3f" % iou
     finally:
         if browser is not None:
             browser.quit()
@@ -142,6 +156,160 @@ def main():
     summary = re.search(r"browser view: (\d+) clients", rest)
     assert summary and int(summary.group(1)) >= 1, rest
     print("sandbox: " + summary.group(0))
+
+
+def matrix_from_quaternion(q):
+    w, x, y, z = q
+    n = math.sqrt(w * w + x * x + y * y + z * z)
+    w, x, y, z = w / n, x / n, y / n, z / n
+    return [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
+
+
+def quaternion_from_matrix(m):
+    trace = m[0][0] + m[1][1] + m[2][2]
+    if trace > 0:
+        s = 2 * math.sqrt(1 + trace)
+        return [s / 4, (m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s]
+    i = max(range(3), key=lambda k: m[k][k])
+    j, k = (i + 1) % 3, (i + 2) % 3
+    s = 2 * math.sqrt(1 + m[i][i] - m[j][j] - m[k][k])
+    q = [0.0] * 4
+    q[0] = (m[k][j] - m[j][k]) / s
+    q[1 + i] = s / 4
+    q[1 + j] = (m[j][i] + m[i][j]) / s
+    q[1 + k] = (m[k][i] + m[i][k]) / s
+    return q
+
+
+def pose_argument(p, m):
+    """X,Y,Z,ROLL,PITCH,YAW (degrees, yaw-pitch-roll about z, y, x) of a pose."""
+    roll = math.atan2(m[2][1], m[2][2])
+    pitch = math.asin(max(-1.0, min(1.0, -m[2][0])))
+    yaw = math.atan2(m[1][0], m[0][0])
+    return ",".join("%.9g" % v for v in list(p) + [math.degrees(roll), math.degrees(pitch),
+                                                   math.degrees(yaw)])
+
+
+SAMPLES_ON_SURFACES = """
+const T = window.sandboxControl.three, level = window.sandboxControl.levelModel();
+const meshes = [];
+level.traverse((o) => { if (o.isMesh && !o.isSkinnedMesh) meshes.push(o); });
+const cloud = window.sandboxControl.scene.getObjectByName('samples:ELAHA/scanner');
+const pos = cloud.geometry.getAttribute('position'), hit = cloud.userData.hit;
+const surface = cloud.userData.surface, o = cloud.position;
+const rc = new T.Raycaster();
+const dirs = [new T.Vector3(1, 0, 0), new T.Vector3(0, 1, 0), new T.Vector3(0, 0, 1)];
+let worst = 0, checked = 0, first = -1, noSurface = 0;
+for (let i = 0; i < hit.length && checked < 60; i += 1) {
+  if (!hit[i]) continue;
+  if (first < 0) first = i;
+  if (surface[i] === 0) noSurface += 1;
+  const p = new T.Vector3(pos.getX(i) + o.x, pos.getY(i) + o.y, pos.getZ(i) + o.z);
+  let best = Infinity;
+  for (const d of dirs) {
+    rc.set(p.clone().addScaledVector(d, -2), d);
+    rc.far = 4;
+    for (const h of rc.intersectObjects(meshes)) best = Math.min(best, h.point.distanceTo(p));
+  }
+  worst = Math.max(worst, best);
+  checked += 1;
+}
+// A click where a hit sample shows picks a sample there.
+const p = new T.Vector3(pos.getX(first) + o.x, pos.getY(first) + o.y, pos.getZ(first) + o.z);
+const ndc = p.clone().project(window.sandboxControl.camera);
+const picked = window.sandboxControl.pick(ndc.x, ndc.y);
+// What it says is that sample's, and the sample is under the click.
+let consistent = false, off = null;
+if (picked) {
+  const k = picked.index, q = new T.Vector3(...picked.p);
+  consistent = picked.hit === (hit[k] === 1) && picked.surface === surface[k] &&
+               q.distanceTo(new T.Vector3(pos.getX(k) + o.x, pos.getY(k) + o.y, pos.getZ(k) + o.z)) < 1e-3;
+  const r = q.clone().project(window.sandboxControl.camera);
+  off = Math.hypot(r.x - ndc.x, r.y - ndc.y);
+}
+return { checked, worst, noSurface, inView: Math.abs(ndc.x) < 1 && Math.abs(ndc.y) < 1,
+         picked, consistent, off };
+"""
+
+
+def sample_checks(browser):
+    """The face scanner's samples as the page draws them: each hit lies on the
+    level's surfaces (the page's own model of it, by three.js's ray casting:
+    independent of the sandbox's ray caster) and names a surface; a click on
+    one picks it. Returns (hits checked, farthest from a surface, picked)."""
+    view = wait_for("the face scanner's hits", lambda: _samples(browser), seconds=100.0)
+    browser.run("window.sandboxControl.hold(true)")
+    drawn = browser.run("return window.sandboxView.framesDrawn")
+    wait_for("a frame of the held state",
+             lambda: browser.run("return window.sandboxView.framesDrawn") > drawn + 1)
+    result = browser.run(SAMPLES_ON_SURFACES)
+    browser.run("window.sandboxControl.hold(false)")
+    assert result["checked"] >= 10, result
+    assert result["worst"] < 0.02, result
+    assert result["noSurface"] == 0, result
+    if result["inView"]:
+        picked = result["picked"]
+        assert picked and result["consistent"] and result["off"] < 0.05, result
+        return result["checked"], result["worst"], "#%d (%s)" % (
+            picked["index"], picked["surfaceName"] or ("hit" if picked["hit"] else "free"))
+    return result["checked"], result["worst"], "(none in view)"
+
+
+def _samples(browser):
+    view = browser.run("return window.sandboxView")
+    samples = (view.get("samples") or {}).get("ELAHA/scanner")
+    return view if samples and samples["hits"] >= 10 else None
+
+
+def robot_overlap(browser, sandbox, out):
+    """The page held at one state, the wing seen from above and behind it, drawn
+    as a mask; `sandbox render` of the same pose and bone values from the same
+    camera as a segmentation image. Returns (IoU, tick, robot pixels)."""
+    browser.run("window.sandboxControl.hold(true)")
+    drawn = browser.run("return window.sandboxView.framesDrawn")
+    wait_for("a frame of the held state",
+             lambda: browser.run("return window.sandboxView.framesDrawn") > drawn + 1)
+    view = browser.run("return window.sandboxView")
+    robot = view["robots"]["ELAHA"]
+    p, R_WB = robot["p"], matrix_from_quaternion(robot["q"])
+    # The camera 17 m up and 6 m back in the wing's frame, looking at it.
+    offset = [-6.0, 0.0, 17.0]
+    c = [p[i] + sum(R_WB[i][j] * offset[j] for j in range(3)) for i in range(3)]
+    forward = [p[i] - c[i] for i in range(3)]
+    n = math.sqrt(sum(v * v for v in forward))
+    x = [v / n for v in forward]
+    left = [-x[1], x[0], 0.0]  # world z cross x
+    n = math.sqrt(sum(v * v for v in left))
+    y = [v / n for v in left]
+    z = [x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]]
+    R_WC = [[x[i], y[i], z[i]] for i in range(3)]
+    fov = 60.0
+    browser.run("window.sandboxControl.setCamera(%s, %s, %f); window.sandboxControl.mask(true)"
+                % (json.dumps(c), json.dumps(quaternion_from_matrix(R_WC)), fov))
+    drawn = browser.run("return window.sandboxView.framesDrawn")
+    wait_for("a frame from the camera",
+             lambda: browser.run("return window.sandboxView.framesDrawn") > drawn + 1)
+    shot = browser.screenshot()
+    width, height = browser.run("const c = document.getElementById('view'); "
+                                "return [c.width, c.height]")
+    assert shot.size == (width, height), (shot.size, width, height)
+    seg = os.path.join(out, "robot.png")
+    subprocess.run([sandbox, "render", "--camera", "fixed", "--at", pose_argument(c, R_WC),
+                    "--robot-at", pose_argument(p, R_WB),
+                    "--bone-values", ",".join("%.12g" % v for v in robot["bones"]),
+                    "--kind", "segmentation", "--width", str(width), "--height", str(height),
+                    "--fov", str(fov), "--out", seg], check=True, stdout=subprocess.DEVNULL)
+    with open(os.path.join(out, "robot_seg.csv")) as legend:
+        ids = {int(row["id"]) for row in csv.DictReader(legend)
+               if row["name"].startswith("ELAHA/")}
+    theirs = [v in ids for v in Image.open(seg).getdata()]
+    ours = [r + g + b > 3 * 128 for r, g, b in shot.getdata()]
+    both = sum(1 for a, b in zip(ours, theirs) if a and b)
+    either = sum(1 for a, b in zip(ours, theirs) if a or b)
+    assert sum(theirs) > 2000, "the wing covers %d pixels of the render" % sum(theirs)
+    return both / max(1, either), view["tick"], sum(theirs)
 
 
 def _answers(port):

@@ -20,6 +20,8 @@
 #include <thread>
 
 #include "scene/level.h"
+#include "scene/robot_state.h"
+#include "scene/surface_ids.h"
 #include "web/level_model.h"
 #include "web/stream_state.h"
 
@@ -209,7 +211,8 @@ TEST(StreamServerTest, ServesThePageAndThreeJsAsTheyAreOnDisk) {
 TEST(StreamServerTest, EachClientGetsTheLevelFirstThenTheNewestState) {
   StreamServer server(TestOptions());
   const std::string level = std::string("glTF") + std::string(1000, '\x01');
-  server.SetLevel(level);
+  const std::string info = R"({"type":"level"})";
+  server.SetLevel(info, level);
   StreamClient first(server.port());
   ASSERT_TRUE(WaitFor([&] { return first.open_.load(); }));
   // Published faster than sent: a client sees increasing ticks, the last one last.
@@ -221,26 +224,29 @@ TEST(StreamServerTest, EachClientGetsTheLevelFirstThenTheNewestState) {
   }
   ASSERT_TRUE(WaitFor([&] {
     const auto text = first.Text();
-    return !text.empty() && nlohmann::json::parse(text.back())["tick"] == 200;
+    return text.size() > 1 && nlohmann::json::parse(text.back())["tick"] == 200;
   }));
   EXPECT_EQ(first.Binary(), std::vector<std::string>{level});
-  EXPECT_EQ(first.Order().front(), 'b');
+  EXPECT_EQ(first.Order().substr(0, 2), "tb");  // the level's description, then its model
+  EXPECT_EQ(first.Text().front(), info);
   std::int64_t last = 0;
-  for (const std::string& text : first.Text()) {
-    const std::int64_t tick = nlohmann::json::parse(text)["tick"];
+  for (std::size_t i = 1; i < first.Text().size(); ++i) {
+    const std::int64_t tick = nlohmann::json::parse(first.Text()[i])["tick"];
     EXPECT_GT(tick, last);
     last = tick;
   }
-  EXPECT_LE(first.Text().size(), 200u);
-  // A client that comes later gets the level too, then the next state.
+  EXPECT_LE(first.Text().size(), 201u);
+  // A client that comes later gets the level too, then the next state, its
+  // binary part after its text.
   StreamClient second(server.port());
   ASSERT_TRUE(WaitFor([&] { return second.open_.load(); }));
   StreamState state;
   state.tick = 201;
-  server.Publish([state] { return EncodeState(state); });
-  ASSERT_TRUE(WaitFor([&] { return second.Text().size() == 1; }));
-  EXPECT_EQ(second.Binary(), std::vector<std::string>{level});
-  EXPECT_EQ(nlohmann::json::parse(second.Text()[0])["tick"], 201);
+  server.Publish([state] { return EncodedState(EncodeState(state), "SMPL-samples"); });
+  ASSERT_TRUE(WaitFor([&] { return second.Binary().size() == 2; }));
+  EXPECT_EQ(second.Binary(), (std::vector<std::string>{level, "SMPL-samples"}));
+  EXPECT_EQ(second.Order(), "tbtb");
+  EXPECT_EQ(nlohmann::json::parse(second.Text()[1])["tick"], 201);
   EXPECT_EQ(server.counts().connections, 2);
   EXPECT_EQ(server.counts().states_published, 201);
 }
@@ -376,6 +382,8 @@ TEST(StreamStateTest, EncodesEveryFieldAsJson) {
   robot.has_pose = true;
   robot.rejected = 3;
   robot.stale = {"wing/BONES"};
+  robot.bone_values = {0.5, -0.25};
+  robot.joints = {1.0, 0.0, 0.0, 0.123456789, 0.0, 1.0, 0.0, -2.000004, 0.0, 0.0, 1.0, 3.0};
   state.robots.push_back(robot);
   state.actors.push_back({"door", {4, 5, 6}, Eigen::Quaterniond::Identity()});
   const nlohmann::json json = nlohmann::json::parse(EncodeState(state));
@@ -388,8 +396,76 @@ TEST(StreamStateTest, EncodesEveryFieldAsJson) {
   EXPECT_NEAR(double(json["robots"][0]["q"][3]), std::sqrt(0.5), 1e-12);  // z
   EXPECT_EQ(json["robots"][0]["stale"][0], "wing/BONES");
   EXPECT_EQ(json["robots"][0]["rejected"], 3);
+  EXPECT_EQ(json["robots"][0]["bones"], nlohmann::json({0.5, -0.25}));
+  ASSERT_EQ(json["robots"][0]["joints"].size(), 12u);
+  EXPECT_EQ(json["robots"][0]["joints"][3], 0.12346);  // to 1e-5
+  EXPECT_EQ(json["robots"][0]["joints"][7], -2.0);
   EXPECT_EQ(json["actors"][0]["name"], "door");
   EXPECT_EQ(json["actors"][0]["p"][2], 6.0);
+}
+
+// The samples' binary layout, read back field by field as the page reads it.
+TEST(StreamStateTest, EncodesSamplesAsAHeaderAndAlignedArrays) {
+  StreamState state;
+  state.tick = 7;
+  EXPECT_EQ(EncodeSamples(state), "");  // none with this state
+  state.has_samples = true;
+  state.samples_origin = {100.0, -200.0, 3.0};
+  StreamState::Samples a{"wing", "scanner", "face", {1, 2, 3, 4, 5, 6, 7, 8, 9}, {1, 0, 1}, {5, 0, 9}};
+  StreamState::Samples b{"wing", "alt", "ray", {-1.5f, 2.5f, 0.25f}, {1}, {123456}};
+  state.samples = {a, b};
+  const std::string out = EncodeSamples(state);
+  ASSERT_EQ(out.substr(0, 4), "SMPL");
+  std::uint32_t length = 0;
+  std::memcpy(&length, out.data() + 4, 4);
+  EXPECT_EQ(length % 4, 0u);
+  const nlohmann::json header = nlohmann::json::parse(out.substr(8, length));
+  EXPECT_EQ(header["tick"], 7);
+  EXPECT_EQ(header["origin"], nlohmann::json({100.0, -200.0, 3.0}));
+  ASSERT_EQ(header["sets"].size(), 2u);
+  std::size_t offset = 8 + length;
+  for (std::size_t s = 0; s < 2; ++s) {
+    const StreamState::Samples& set = state.samples[s];
+    EXPECT_EQ(header["sets"][s]["sensor"], set.sensor);
+    EXPECT_EQ(header["sets"][s]["type"], set.type);
+    const std::size_t n = header["sets"][s]["count"];
+    ASSERT_EQ(n, set.hit.size());
+    EXPECT_EQ(offset % 4, 0u);  // each array where a typed array may view it
+    std::vector<float> xyz(3 * n);
+    std::memcpy(xyz.data(), out.data() + offset, 12 * n);
+    EXPECT_EQ(xyz, set.xyz);
+    offset += 12 * n;
+    std::vector<std::int32_t> surface(n);
+    std::memcpy(surface.data(), out.data() + offset, 4 * n);
+    EXPECT_EQ(surface, set.surface);
+    offset += 4 * n;
+    EXPECT_EQ(std::vector<std::uint8_t>(out.begin() + std::ptrdiff_t(offset),
+                                        out.begin() + std::ptrdiff_t(offset + n)),
+              set.hit);
+    offset += (n + 3) / 4 * 4;
+  }
+  EXPECT_EQ(offset, out.size());
+}
+
+// What the page is told before the model: the surfaces, the robots' bones and sensors.
+TEST(LevelModelTest, TheLevelsDescriptionNamesItsSurfacesBonesAndSensors) {
+  const scene::Level level =
+      scene::LoadLevel(std::filesystem::path(SANDBOX_SOURCE_DIR) / "assets/sample/level.toml");
+  const nlohmann::json info = nlohmann::json::parse(LevelInfoJson(level));
+  EXPECT_EQ(info["type"], "level");
+  EXPECT_EQ(info["name"], "sample");
+  const scene::SurfaceIds ids(level);
+  ASSERT_EQ(info["surfaces"].size(), ids.entries().size());
+  EXPECT_EQ(info["surfaces"][0]["id"], 1);
+  EXPECT_EQ(info["surfaces"][0]["name"], level.actors[0].name);
+  const nlohmann::json& robot = info["robots"][0];
+  EXPECT_EQ(robot["name"], "ELAHA");
+  ASSERT_EQ(robot["bones"].size(), level.robots[0].bones.size());
+  int values = 0;
+  for (const auto& bone : robot["bones"]) values += int(bone["values"]);
+  EXPECT_EQ(values, level.robots[0].num_values);
+  EXPECT_EQ(robot["sensors"][0]["name"], "scanner");
+  EXPECT_EQ(robot["sensors"][0]["type"], "face");
 }
 
 TEST(LevelModelTest, TheSampleLevelAsABinaryGltfThatAssimpReadsBack) {
@@ -405,7 +481,13 @@ TEST(LevelModelTest, TheSampleLevelAsABinaryGltfThatAssimpReadsBack) {
   std::size_t actor_triangles = 0;
   for (const scene::Actor& actor : level.actors) actor_triangles += actor.num_triangles();
   EXPECT_EQ(model.source_triangles, actor_triangles);
-  EXPECT_EQ(model.triangles, model.source_triangles);  // under the budget: all of them
+  std::size_t robot_triangles = 0;
+  for (const scene::RobotModel& robot : level.robots)
+    for (const scene::SkinnedMesh& mesh : robot.meshes) robot_triangles += mesh.bind.num_triangles();
+  EXPECT_GT(robot_triangles, 0u);
+  EXPECT_EQ(model.robot_triangles, robot_triangles);
+  // Under the budget: all of them.
+  EXPECT_EQ(model.triangles, model.source_triangles + robot_triangles);
   Assimp::Importer importer;
   const aiScene* read = importer.ReadFileFromMemory(model.glb.data(), model.glb.size(), 0, "glb");
   ASSERT_NE(read, nullptr) << importer.GetErrorString();
@@ -414,8 +496,73 @@ TEST(LevelModelTest, TheSampleLevelAsABinaryGltfThatAssimpReadsBack) {
   EXPECT_EQ(faces, model.triangles);
   // Over a budget, simplified to about it.
   const LevelModel small = MakeLevelModel(level, 2000);
-  EXPECT_LT(small.triangles, 2600u);
-  EXPECT_GT(small.triangles, 100u);
+  EXPECT_EQ(small.robot_triangles, robot_triangles);  // robots are not simplified
+  EXPECT_LT(small.triangles - small.robot_triangles, 2600u);
+  EXPECT_GT(small.triangles - small.robot_triangles, 100u);
+}
+
+// The robot as the browser skins it: the model's skin joints, weights and
+// inverse bind matrices, read back by assimp and applied to the joint poses
+// of a bent robot, put each vertex where the sandbox's own skinning does.
+TEST(LevelModelTest, ARobotsSkinPutsItsVerticesWhereTheSandboxDoes) {
+  const scene::Level level =
+      scene::LoadLevel(std::filesystem::path(SANDBOX_SOURCE_DIR) / "assets/sample/level.toml");
+  ASSERT_FALSE(level.robots.empty());
+  const scene::RobotModel& robot = level.robots[0];
+  scene::RobotState state(robot);
+  std::vector<double> values = state.bone_values();
+  for (std::size_t b = 1; b < robot.bones.size(); ++b) {  // bone 0 is the root
+    const scene::Bone& bone = robot.bones[b];
+    if (bone.rotation == scene::BoneRotation::kAngles)
+      values[std::size_t(bone.first_value)] = 0.04 * double(b % 7);  // wings bent in steps
+  }
+  ASSERT_TRUE(state.SetBones(values)) << state.last_rejection();
+  state.Update();
+
+  const LevelModel model = MakeLevelModel(level);
+  Assimp::Importer importer;
+  const aiScene* read = importer.ReadFileFromMemory(model.glb.data(), model.glb.size(), 0, "glb");
+  ASSERT_NE(read, nullptr) << importer.GetErrorString();
+  const std::string prefix = RobotNodeName(0) + "_joint";
+  const aiNode* robot_node = read->mRootNode->FindNode(RobotNodeName(0).c_str());
+  ASSERT_NE(robot_node, nullptr);
+  std::size_t checked = 0;
+  double worst = 0.0;
+  for (unsigned c = 0; c < robot_node->mNumChildren; ++c) {
+    const aiNode* child = robot_node->mChildren[c];
+    for (unsigned i = 0; i < child->mNumMeshes; ++i) {
+      const aiMesh* mesh = read->mMeshes[child->mMeshes[i]];
+      const int m = std::stoi(std::string(child->mName.C_Str()).substr(RobotNodeName(0).size() + 5));
+      const std::vector<Eigen::Vector3f>& expected = state.positions_B(m);
+      ASSERT_EQ(mesh->mNumVertices, expected.size());
+      ASSERT_GT(mesh->mNumBones, 0u);
+      std::vector<Eigen::Vector3d> skinned(mesh->mNumVertices, Eigen::Vector3d::Zero());
+      for (unsigned b = 0; b < mesh->mNumBones; ++b) {
+        const aiBone* bone = mesh->mBones[b];
+        const std::string name = bone->mName.C_Str();
+        ASSERT_EQ(name.rfind(prefix, 0), 0u) << name;
+        const int k = std::stoi(name.substr(prefix.size()));
+        Eigen::Matrix4d offset;
+        for (int row = 0; row < 4; ++row)
+          for (int col = 0; col < 4; ++col) offset(row, col) = bone->mOffsetMatrix[row][col];
+        const Eigen::Matrix4d X = state.node_poses_B()[std::size_t(robot.joints[std::size_t(k)].node)].matrix() * offset;
+        for (unsigned w = 0; w < bone->mNumWeights; ++w) {
+          const aiVertexWeight& weight = bone->mWeights[w];
+          const aiVector3D& v = mesh->mVertices[weight.mVertexId];
+          skinned[weight.mVertexId] += weight.mWeight * (X * Eigen::Vector4d(v.x, v.y, v.z, 1.0)).head<3>();
+        }
+      }
+      for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
+        const std::uint32_t influences =
+            robot.meshes[std::size_t(m)].influence_begin[v + 1] - robot.meshes[std::size_t(m)].influence_begin[v];
+        if (influences > 4) continue;  // glTF's four: nearly, not exactly
+        worst = std::max(worst, (skinned[v] - expected[v].cast<double>()).norm());
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 100u);
+  EXPECT_LT(worst, 1e-4);
 }
 
 }  // namespace

@@ -21,25 +21,91 @@ const controls = new OrbitControls(camera, canvas);
 
 // What a test reads (tests/web): the state drawn last and how far along the page is.
 const view = { connected: false, levelLoaded: false, tick: -1, framesDrawn: 0, states: 0,
-               received: 0, robots: {}, firstFrameMs: null };
+               received: 0, robots: {}, firstFrameMs: null, held: false, camera: null,
+               masked: false };
 let pendingState = null;  // the newest state's text, not yet shown
 window.sandboxView = view;
+// What scripts and tests may call (apart, so that sandboxView stays plain data).
+const control = {};
+window.sandboxControl = control;
 
-const robots = new Map();  // name -> marker
-let level = null;          // the glTF scene
+// For tests and scripts: three.js, the scene and the level model.
+control.three = THREE;
+control.scene = scene;
+control.camera = camera;
+control.levelModel = () => level;
+// Stop (and resume) showing new states.
+control.hold = (on) => { view.held = on; };
+// Looks from a sandbox camera pose (x forward, y left, z up: p, q as w, x, y,
+// z) with a vertical field of view in degrees; null: the mouse's camera again.
+control.setCamera = (p, q, fovDeg) => {
+  view.camera = p ? { p, q, fovDeg } : null;
+  if (!p) return;
+  camera.position.set(p[0], p[1], p[2]);
+  // three.js looks down its -z with y up: that is the sandbox camera's x
+  // forward and z up, so its axes are (-y, z, -x) of the sandbox camera.
+  const toGl = new THREE.Quaternion().setFromRotationMatrix(new THREE.Matrix4().set(
+    0, 0, -1, 0, -1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 1));
+  camera.quaternion.set(q[1], q[2], q[3], q[0]).multiply(toGl);
+  camera.fov = fovDeg;
+  camera.updateProjectionMatrix();
+};
+// Draws the robots alone, white on black, unlit (a mask to compare with the
+// sandbox's own segmentation image); false: as before.
+const maskMaterial = new THREE.MeshBasicMaterial({ color: 0xffffff, skinning: true });
+control.mask = (on) => {
+  view.masked = on;
+  scene.background = new THREE.Color(on ? 0x000000 : 0x8fb4d8);
+  document.getElementById('panel').style.display = on ? 'none' : '';
+  for (const cloud of sampleClouds.values()) cloud.visible = !on;
+  if (!level) return;
+  level.traverse((object) => {
+    if (object.name === 'axes') object.visible = !on;
+    if (!object.isMesh) return;
+    let robot = false;
+    object.traverseAncestors((a) => { robot = robot || a.name.startsWith('sandbox_robot'); });
+    if (!robot) {
+      object.visible = !on;
+      return;
+    }
+    if (on && !object.userData.material) object.userData.material = object.material;
+    if (object.userData.material) object.material = on ? maskMaterial : object.userData.material;
+  });
+};
+
+// name -> { index, group, joints }: a robot is the level model's node
+// "sandbox_robot<index>" (its meshes skinned to the joint nodes under it,
+// which each state places), with axes at its body frame.
+const robots = new Map();
+let level = null;  // the glTF scene
 const follow = document.getElementById('follow');
 
-function robotMarker(name) {
-  const marker = new THREE.Group();
-  marker.name = 'robot:' + name;
-  marker.add(new THREE.Mesh(new THREE.BoxGeometry(1.0, 0.5, 0.25),
-                            new THREE.MeshLambertMaterial({ color: 0xf0a020 })));
-  marker.add(new THREE.AxesHelper(2.0));
-  scene.add(marker);
+function robotEntry(name, index) {
+  const entry = { index, group: null, joints: [] };
   const option = document.createElement('option');
   option.value = option.textContent = name;
   follow.appendChild(option);
-  return marker;
+  attachRobot(entry);
+  return entry;
+}
+
+// Finds the robot's node and joints in the level model (once it has come).
+function attachRobot(entry) {
+  if (!level || entry.group) return;
+  const node = level.getObjectByName('sandbox_robot' + entry.index);
+  if (!node) return;
+  entry.group = node;
+  const axes = new THREE.AxesHelper(2.0);
+  axes.name = 'axes';
+  node.add(axes);
+  node.visible = false;
+  for (let k = 0; ; ++k) {
+    const joint = node.getObjectByName('sandbox_robot' + entry.index + '_joint' + k);
+    if (!joint) break;
+    joint.matrixAutoUpdate = false;
+    entry.joints.push(joint);
+  }
+  node.traverse((object) => { if (object.isSkinnedMesh) object.frustumCulled = false; });
 }
 
 function place(object, body) {
@@ -67,13 +133,25 @@ function drawPlot() {
 function showState(state) {
   view.tick = state.tick;
   view.states += 1;
-  for (const r of state.robots) {
-    if (!robots.has(r.name)) robots.set(r.name, robotMarker(r.name));
-    const marker = robots.get(r.name);
-    marker.visible = r.has_pose;
-    place(marker, r);
-    view.robots[r.name] = { p: r.p, q: r.q, has_pose: r.has_pose, rejected: r.rejected, stale: r.stale };
-  }
+  state.robots.forEach((r, index) => {
+    if (!robots.has(r.name)) robots.set(r.name, robotEntry(r.name, index));
+    const entry = robots.get(r.name);
+    attachRobot(entry);
+    if (entry.group) {
+      entry.group.visible = r.has_pose;
+      place(entry.group, r);
+      entry.joints.forEach((joint, k) => {
+        const m = r.joints.slice(12 * k, 12 * k + 12);
+        if (m.length < 12) return;
+        joint.matrix.set(m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8], m[9], m[10], m[11],
+                         0, 0, 0, 1);
+        joint.matrixWorldNeedsUpdate = true;
+      });
+    }
+    view.robots[r.name] = { p: r.p, q: r.q, bones: r.bones, has_pose: r.has_pose,
+                            rejected: r.rejected, stale: r.stale,
+                            skinned: entry.joints.length > 0 };
+  });
   if (level) {
     for (const a of state.actors) {
       const node = level.getObjectByName(a.name);
@@ -89,8 +167,112 @@ function showState(state) {
   if (history.length > 240) history.shift();
   drawPlot();
   const followed = robots.get(follow.value);
-  if (followed) controls.target.copy(followed.position);
+  if (followed && followed.group) controls.target.copy(followed.group.position);
 }
+
+// The scan samples: a point cloud a sensor, coloured by occupancy (occupied
+// red, free green) or by what they hit (a colour a surface id).
+let pendingSamples = null;  // the newest samples message, not yet shown
+const sampleClouds = new Map();  // "robot/sensor" -> THREE.Points
+const colourBy = document.getElementById('colour');
+let surfaces = new Map();  // id -> { kind, name }
+
+function levelInfo(info) {
+  view.levelName = info.name;
+  surfaces = new Map(info.surfaces.map((s) => [s.id, s]));
+}
+
+function surfaceColour(id, colour) {
+  if (id === 0) return colour.setRGB(0.5, 0.5, 0.5);
+  // Golden-ratio hues: neighbouring ids far apart.
+  return colour.setHSL((id * 0.618034) % 1, 0.75, 0.55);
+}
+
+function colourSamples(cloud) {
+  const { hit, surface } = cloud.userData;
+  const colours = cloud.geometry.getAttribute('color');
+  const c = new THREE.Color();
+  for (let i = 0; i < hit.length; ++i) {
+    if (colourBy.value === 'surface') surfaceColour(surface[i], c);
+    else if (hit[i]) c.setRGB(0.95, 0.2, 0.15);
+    else c.setRGB(0.2, 0.85, 0.3);
+    colours.setXYZ(i, c.r, c.g, c.b);
+  }
+  colours.needsUpdate = true;
+}
+
+function showSamples(buffer) {
+  const length = new DataView(buffer).getUint32(4, true);
+  const header = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, 8, length)));
+  let offset = 8 + length;
+  const seen = new Set();
+  view.samples = {};
+  for (const set of header.sets) {
+    const n = set.count, key = set.robot + '/' + set.sensor;
+    const xyz = new Float32Array(buffer, offset, 3 * n);
+    offset += 12 * n;
+    const surface = new Int32Array(buffer, offset, n);
+    offset += 4 * n;
+    const hit = new Uint8Array(buffer, offset, n);
+    offset += (n + 3) & ~3;
+    let cloud = sampleClouds.get(key);
+    if (!cloud) {
+      cloud = new THREE.Points(new THREE.BufferGeometry(),
+                               new THREE.PointsMaterial({ size: 3, sizeAttenuation: false,
+                                                          vertexColors: THREE.VertexColors }));
+      cloud.name = 'samples:' + key;
+      cloud.frustumCulled = false;
+      sampleClouds.set(key, cloud);
+      scene.add(cloud);
+    }
+    cloud.geometry.setAttribute('position', new THREE.BufferAttribute(xyz, 3));
+    cloud.geometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
+    cloud.position.set(header.origin[0], header.origin[1], header.origin[2]);
+    cloud.userData = { hit, surface, set, tick: header.tick };
+    colourSamples(cloud);
+    seen.add(key);
+    view.samples[key] = { count: n, hits: hit.reduce((a, b) => a + b, 0), tick: header.tick };
+  }
+  for (const [key, cloud] of sampleClouds) cloud.visible = seen.has(key) && !view.masked;
+}
+colourBy.addEventListener('change', () => { for (const cloud of sampleClouds.values()) colourSamples(cloud); });
+
+// Pick: a click on a sample shows what it is.
+const picker = new THREE.Raycaster();
+picker.params.Points.threshold = 0.5;
+canvas.addEventListener('click', (event) => {
+  const rect = canvas.getBoundingClientRect();
+  const ndc = new THREE.Vector2(((event.clientX - rect.left) / rect.width) * 2 - 1,
+                                -((event.clientY - rect.top) / rect.height) * 2 + 1);
+  view.picked = pick(ndc);
+});
+
+// The sample nearest the camera under normalised device coordinates ndc,
+// or null; shown in the panel.
+function pick(ndc) {
+  picker.setFromCamera(ndc, camera);
+  const clouds = [...sampleClouds.values()].filter((c) => c.visible);
+  const hit = picker.intersectObjects(clouds)[0];
+  const out = document.getElementById('picked');
+  if (!hit) {
+    out.textContent = '';
+    return null;
+  }
+  const { userData } = hit.object, i = hit.index;
+  const p = hit.object.geometry.getAttribute('position');
+  const o = hit.object.position;
+  const sample = { robot: userData.set.robot, sensor: userData.set.sensor, type: userData.set.type,
+                   index: i, tick: userData.tick, hit: userData.hit[i] === 1,
+                   surface: userData.surface[i],
+                   p: [p.getX(i) + o.x, p.getY(i) + o.y, p.getZ(i) + o.z] };
+  const s = surfaces.get(sample.surface);
+  sample.surfaceName = s ? s.name : '';
+  out.textContent = `${sample.robot}/${sample.sensor} #${i} (tick ${sample.tick}): ` +
+    `${sample.hit ? 'hit ' + (sample.surfaceName || 'surface ' + sample.surface) : 'free'} at ` +
+    sample.p.map((v) => v.toFixed(2)).join(', ');
+  return sample;
+}
+control.pick = (x, y) => pick(new THREE.Vector2(x, y));
 
 function frameLevel(object) {
   const box = new THREE.Box3().setFromObject(object);
@@ -113,16 +295,26 @@ function connect() {
   };
   socket.onmessage = (event) => {
     if (typeof event.data === 'string') {
+      if (event.data.startsWith('{"type":"level"')) {
+        levelInfo(JSON.parse(event.data));
+        return;
+      }
       // Kept as it came: the newest is read once a drawn frame (a page drawing
       // slower than states arrive skips the ones between).
       pendingState = event.data;
       view.received += 1;
       return;
     }
+    const magic = new TextDecoder().decode(new Uint8Array(event.data, 0, 4));
+    if (magic === 'SMPL') {
+      pendingSamples = event.data;
+      return;
+    }
     new GLTFLoader().parse(event.data, '', (gltf) => {
       if (level) scene.remove(level);
       level = gltf.scene;
       scene.add(level);
+      for (const entry of robots.values()) { entry.group = null; entry.joints = []; attachRobot(entry); }
       frameLevel(level);
       view.levelLoaded = true;
     }, (error) => { document.getElementById('status').textContent = 'bad level model: ' + error; });
@@ -141,12 +333,16 @@ function resize() {
 const started = performance.now();
 function animate() {
   requestAnimationFrame(animate);
-  if (pendingState !== null) {
+  if (pendingState !== null && !view.held) {
     showState(JSON.parse(pendingState));
     pendingState = null;
   }
+  if (pendingSamples !== null && !view.held) {
+    showSamples(pendingSamples);
+    pendingSamples = null;
+  }
   resize();
-  controls.update();
+  if (!view.camera) controls.update();
   renderer.render(scene, camera);
   view.framesDrawn += 1;
   if (view.firstFrameMs === null && view.levelLoaded) view.firstFrameMs = performance.now() - started;
