@@ -13,6 +13,7 @@
 #include "app/run_command.h"
 #include "app/scan_command.h"
 #include "app/topics_command.h"
+#include "app/view_command.h"
 
 namespace {
 
@@ -29,6 +30,7 @@ const char* kUsage =
     "  run [LEVEL]             the loop: LCM inputs, sensors, outputs at a fixed rate\n"
     "  render [LEVEL] --camera C --at X,Y,Z --out F  one camera frame (OSMesa)\n"
     "  topics                  the LCM channels heard: type, count, rate, size\n"
+    "  view LOG                a recorded flight in the browser: replayed, then played back\n"
     "LEVEL: a level manifest (.toml), a scene file, or a robot description (.urdf, .sdf)\n"
     "run 'sandbox COMMAND --help' for a command's options\n";
 
@@ -50,6 +52,7 @@ int main(int argc, char** argv) {
     if (args[0] == "run") return sandbox::app::RunLoop(rest, std::cout, std::cerr);
     if (args[0] == "render") return sandbox::app::RunRender(rest, std::cout, std::cerr);
     if (args[0] == "topics") return sandbox::app::RunTopics(rest, std::cout, std::cerr);
+    if (args[0] == "view") return sandbox::app::RunView(rest, std::cout, std::cerr);
     // The child of an isolated load (--isolate); not for users.
     if (args[0] == "__load-level") return sandbox::app::RunLoadLevelChild(rest, std::cout);
   } catch (const std::exception& error) {

@@ -1,11 +1,13 @@
 #pragma once
 // In-process additions to `sandbox run`'s loop: the demo's fallback pilot and
-// its heartbeat listener, and test aids (a slow tick). All run on the loop thread.
+// its heartbeat listener, `sandbox view`'s recording of states, and test aids
+// (a slow tick). All run on the loop thread.
 
 #include <cstdint>
 #include <functional>
 
 #include "bridge/lcm_link.h"
+#include "web/stream_state.h"
 
 namespace sandbox::app {
 
@@ -16,6 +18,9 @@ struct RunHooks {
   // Called at the end of each tick's work, inside its measured duration (a
   // test slows given ticks here).
   std::function<void(std::int64_t tick)> end_of_tick;
+  // Called after each tick with the browser view's state of it (`sandbox view`
+  // keeps them).
+  std::function<void(web::StreamState&& state)> web_state;
   // Called before the link closes: let go of what before_tick subscribed.
   std::function<void(bridge::LcmLink& link)> before_close;
 };

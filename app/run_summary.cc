@@ -103,15 +103,7 @@ bool ReportRun(const RunRecord& run, std::ostream& out, std::ostream& err) {
           << (dir / "scans").string() << "\n";
     }
   }
-  if (run.web != nullptr) {
-    const web::ServerCounts c = run.web->counts();
-    out << "  browser view: " << c.connections << " clients (" << c.clients << " at the end), "
-        << c.states_sent << " states sent, " << c.states_skipped << " skipped for slow clients, "
-        << c.bytes_sent / 1024 << " KiB; refused: " << c.refused_origin << " other origin, "
-        << c.refused_full << " over the limit, " << c.failed
-        << " bad handshakes; closed: " << c.closed_oversized << " oversized messages, "
-        << c.closed_protocol << " bad frames, " << c.dropped_slow << " too slow\n";
-  }
+  if (run.web != nullptr) PrintWebCounts(run.web->counts(), out);
   if (run.live_view != nullptr) {
     out << "  live view: " << run.live_view->shown() << " frames shown, last camera "
         << run.cameras->live_camera()
@@ -152,6 +144,19 @@ bool ReportRun(const RunRecord& run, std::ostream& out, std::ostream& err) {
     }
   }
   return !output_lost;
+}
+
+void PrintWebCounts(const web::ServerCounts& c, std::ostream& out) {
+  out << "  browser view: " << c.connections << " clients (" << c.clients << " at the end), "
+      << c.states_sent << " states sent, " << c.states_skipped << " skipped for slow clients, "
+      << c.bytes_sent / 1024 << " KiB; refused: " << c.refused_origin << " other origin, "
+      << c.refused_full << " over the limit, " << c.failed
+      << " bad handshakes; closed: " << c.closed_oversized << " oversized messages, "
+      << c.closed_protocol << " bad frames, " << c.dropped_slow << " too slow";
+  if (c.commands + c.commands_refused > 0) {
+    out << "; player commands: " << c.commands << " taken, " << c.commands_refused << " refused";
+  }
+  out << "\n";
 }
 
 }  // namespace sandbox::app

@@ -47,6 +47,9 @@ struct RunRecord {
 };
 
 // A replay's progress bar, on one line of `err`: read, ticks, ticks/s, time left.
+// The browser view's line of the summary: clients, states, bytes, refusals.
+void PrintWebCounts(const web::ServerCounts& counts, std::ostream& out);
+
 void PrintReplayProgress(const bridge::LogReader& replay, std::int64_t ticks, double wall_s,
                          std::ostream& err);
 

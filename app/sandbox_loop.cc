@@ -202,6 +202,7 @@ int SandboxLoop::Run() {
     const double next_s = pacer.Next(seconds_since_start(tick_end), &overrun);
     stats_.Add(record, overrun);
     if (web_ && web_->WantsState()) PublishWebState(record);
+    if (hooks_.web_state) hooks_.web_state(WebState(record));
     KeepOriginNearRobot();  // between ticks: the next tick's rays see the new origin
     if (paced && !overrun) {
       stop_.SleepUntil(at(timed ? std::min(next_s, options_.duration_s) : next_s));
@@ -435,6 +436,12 @@ void SandboxLoop::ReportRecordingFailure() {
 }
 
 void SandboxLoop::PublishWebState(const TickRecord& record) {
+  web_->Publish([state = WebState(record)] {
+    return web::EncodedState(web::EncodeState(state), web::EncodeSamples(state));
+  });
+}
+
+web::StreamState SandboxLoop::WebState(const TickRecord& record) {
   web::StreamState state;
   state.tick = record.tick;
   state.time_s = tick_time_s_;
@@ -474,6 +481,7 @@ void SandboxLoop::PublishWebState(const TickRecord& record) {
   if (tick_time_s_ >= web_samples_due_s_) {
     web_samples_due_s_ = tick_time_s_ + 1.0 / kWebSamplesHz;
     state.has_samples = true;
+    state.samples_tick = state.tick;
     state.samples_origin = world_.origin();
     for (const sensors::Sensor& sensor : sensors_) {
       state.samples.push_back(ViewSamples(sensor,
@@ -481,9 +489,7 @@ void SandboxLoop::PublishWebState(const TickRecord& record) {
                                           state.samples_origin, kWebSamplesPerSensor));
     }
   }
-  web_->Publish([state = std::move(state)] {
-    return web::EncodedState(web::EncodeState(state), web::EncodeSamples(state));
-  });
+  return state;
 }
 
 bool SandboxLoop::Report(double elapsed_s) {

@@ -77,6 +77,7 @@ class SandboxLoop {
   void RequestStop() { stop_.Request(); }
   // The live view when asked for (its window is the caller's to run), or null.
   LiveView* live_view() { return live_view_.get(); }
+  const scene::Level& level() const { return level_; }
 
  private:
   // A robot: its state, what drives it and what it publishes.
@@ -108,6 +109,9 @@ class SandboxLoop {
   void PublishSurfacesIfDue(double t, std::int64_t now_utime);
   // Between ticks: the browser view's state (--web), handed to its server.
   void PublishWebState(const TickRecord& record);
+  // The browser view's state after a tick, with the sensors' samples when
+  // they are due (kWebSamplesHz of the run's time).
+  web::StreamState WebState(const TickRecord& record);
   // Between ticks: the floating origin to the first robot when it is far from it.
   void KeepOriginNearRobot();
   // Says once that the recording (--record) could not be written.

@@ -128,7 +128,7 @@ aiMaterial* MakeMaterial(const scene::Material& source) {
 
 }  // namespace
 
-std::string LevelInfoJson(const scene::Level& level) {
+std::string LevelInfoJson(const scene::Level& level, const RecordedRun* recorded) {
   nlohmann::json surfaces = nlohmann::json::array(), robots = nlohmann::json::array();
   const scene::SurfaceIds ids(level);
   for (const scene::SurfaceEntry& entry : ids.entries())
@@ -142,11 +142,16 @@ std::string LevelInfoJson(const scene::Level& level) {
     robots.push_back({{"name", robot.name}, {"bones", std::move(bones)},
                       {"sensors", std::move(sensors)}});
   }
-  return nlohmann::json({{"type", "level"},
+  nlohmann::json info = {{"type", "level"},
                          {"name", level.name},
                          {"surfaces", std::move(surfaces)},
-                         {"robots", std::move(robots)}})
-      .dump();
+                         {"robots", std::move(robots)}};
+  if (recorded != nullptr) {
+    info["recorded"] = {{"log", recorded->log},
+                        {"ticks", recorded->ticks},
+                        {"duration_s", recorded->duration_s}};
+  }
+  return info.dump();
 }
 
 std::string RobotNodeName(int robot) { return "sandbox_robot" + std::to_string(robot); }

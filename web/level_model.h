@@ -14,6 +14,7 @@
 // robot's pose and the joints at the poses the stream sends, and skins.
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 
 #include "scene/level.h"
@@ -29,8 +30,15 @@ struct LevelModel {
 
 // What the page is told of the level before its model (JSON text): its name,
 // its surface ids (id, kind, name: what a sample hit), and per robot its
-// bones (name, number of values) and sensors (name, type). docs/reference/web.md.
-std::string LevelInfoJson(const scene::Level& level);
+// bones (name, number of values) and sensors (name, type); for a recorded
+// run (`sandbox view`), the log, its ticks and its duration, which show the
+// page's player. docs/reference/web.md.
+struct RecordedRun {
+  std::string log;
+  std::int64_t ticks{0};
+  double duration_s{0.0};
+};
+std::string LevelInfoJson(const scene::Level& level, const RecordedRun* recorded = nullptr);
 
 // The name of robot `robot`'s node ("sandbox_robot0"; three.js keeps it as is).
 std::string RobotNodeName(int robot);

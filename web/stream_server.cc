@@ -54,8 +54,15 @@ class StreamServer::Impl {
         ++counts_.failed;
       }
     });
-    server_.set_message_handler(
-        [this](Handle, Server::message_ptr) { ++counts_.messages_dropped; });
+    server_.set_message_handler([this](Handle, Server::message_ptr message) {
+      if (!options_.on_text || message->get_opcode() != websocketpp::frame::opcode::text) {
+        ++counts_.messages_dropped;
+      } else if (options_.on_text(message->get_payload()).empty()) {
+        ++counts_.commands;
+      } else {
+        ++counts_.commands_refused;
+      }
+    });
 
     asio::error_code ec;
     const asio::ip::address address = asio::ip::make_address(options.address, ec);
@@ -122,6 +129,8 @@ class StreamServer::Impl {
     c.refused_full = counts_.refused_full;
     c.failed = counts_.failed;
     c.messages_dropped = counts_.messages_dropped;
+    c.commands = counts_.commands;
+    c.commands_refused = counts_.commands_refused;
     c.closed_oversized = counts_.closed_oversized;
     c.closed_protocol = counts_.closed_protocol;
     c.dropped_slow = counts_.dropped_slow;
@@ -141,7 +150,8 @@ class StreamServer::Impl {
   // ServerCounts, as atomics (written on the server's thread, read anywhere).
   struct Counts {
     std::atomic<std::int64_t> clients{0}, connections{0}, http_requests{0}, not_found{0},
-        refused_origin{0}, refused_full{0}, failed{0}, messages_dropped{0}, closed_oversized{0},
+        refused_origin{0}, refused_full{0}, failed{0}, messages_dropped{0}, commands{0},
+        commands_refused{0}, closed_oversized{0},
         closed_protocol{0}, dropped_slow{0}, states_published{0}, states_sent{0}, states_skipped{0},
         bytes_sent{0};
   };

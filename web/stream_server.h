@@ -8,7 +8,8 @@
 // skips states (counted) and is dropped when it stays behind for
 // `slow_timeout_s`. The loop hands states over with Publish, which never
 // waits on a client: the newest replaces one not yet sent, and the server's
-// thread encodes it. Read-only: what a client sends is counted and dropped.
+// thread encodes it. Read-only: what a client sends is counted and dropped,
+// unless `on_text` takes it (`sandbox view`'s player commands).
 //
 // Safe by default: bound to 127.0.0.1 unless an address is given; a
 // WebSocket's Origin, when the client sends one (browsers do), must be the
@@ -36,6 +37,10 @@ struct ServerOptions {
   double max_rate_hz{60.0};                  // states a second to a client
   std::filesystem::path page_dir;            // the page's files (web/page)
   std::filesystem::path three_dir{"/usr/share/javascript/three"};  // libjs-three
+  // What is done with a client's text message (on the server's thread);
+  // empty: nothing (read-only; counted as dropped). It returns "" when the
+  // message is taken, else why not (counted as refused).
+  std::function<std::string(const std::string&)> on_text;
 };
 
 // What the server has done, by reason (any thread).
@@ -48,6 +53,8 @@ struct ServerCounts {
   std::int64_t refused_full{0};      // a WebSocket over max_clients (503)
   std::int64_t failed{0};            // handshakes that failed (bad HTTP, bad upgrade)
   std::int64_t messages_dropped{0};  // messages from clients (read-only)
+  std::int64_t commands{0};          // messages on_text took
+  std::int64_t commands_refused{0};  // messages on_text refused
   std::int64_t closed_oversized{0};  // closed for a message over max_message_bytes
   std::int64_t closed_protocol{0};   // closed for a bad frame
   std::int64_t dropped_slow{0};      // closed for staying behind

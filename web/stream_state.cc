@@ -31,13 +31,14 @@ std::string EncodeState(const StreamState& state) {
     robots.push_back(std::move(r));
   }
   for (const StreamState::Body& actor : state.actors) actors.push_back(BodyJson(actor));
-  const nlohmann::json message = {{"type", "state"},
+  nlohmann::json message = {{"type", "state"},
                                   {"tick", state.tick},
                                   {"t", state.time_s},
                                   {"tick_ms", state.tick_ms},
                                   {"late_ms", state.late_ms},
                                   {"robots", std::move(robots)},
                                   {"actors", std::move(actors)}};
+  if (state.has_player) message["player"] = {{"playing", state.playing}, {"speed", state.speed}};
   return message.dump();
 }
 
@@ -59,7 +60,7 @@ std::string EncodeSamples(const StreamState& state) {
                     {"type", set.type},
                     {"count", set.hit.size()}});
   }
-  std::string header = nlohmann::json({{"tick", state.tick},
+  std::string header = nlohmann::json({{"tick", state.samples_tick},
                                        {"origin",
                                         {state.samples_origin.x(), state.samples_origin.y(),
                                          state.samples_origin.z()}},

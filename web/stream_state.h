@@ -33,6 +33,10 @@ struct StreamState {
   double late_ms{0.0};  // how late it started
   std::vector<Robot> robots;
   std::vector<Body> actors;  // the movable actors
+  // A recorded run (`sandbox view`): whether its playhead moves, and how fast.
+  bool has_player{false};
+  bool playing{false};
+  double speed{1.0};
 
   // A sensor's latest samples, positions relative to `samples_origin`.
   struct Samples {
@@ -42,6 +46,7 @@ struct StreamState {
     std::vector<std::int32_t> surface;  // its surface id (0: nothing)
   };
   bool has_samples{false};  // samples are sent with this state (at most a few a second)
+  std::int64_t samples_tick{0};  // the tick they were taken at
   Eigen::Vector3d samples_origin{Eigen::Vector3d::Zero()};
   std::vector<Samples> samples;
 };

@@ -2,7 +2,8 @@
 // server: an HTTP request, a WebSocket handshake and frames, parsed by
 // websocketpp (as `sandbox run --web` does, here over its in-memory
 // transport) with the server's own rules for files, hosts and origins
-// (web/request_rules.h) and its limits on message size.
+// (web/request_rules.h), its limits on message size and, for text messages,
+// `sandbox view`'s player commands (web/player.h).
 
 #include <cstdint>
 #include <sstream>
@@ -10,6 +11,7 @@
 #include <websocketpp/config/core.hpp>
 #include <websocketpp/server.hpp>
 
+#include "web/player.h"
 #include "web/request_rules.h"
 
 namespace {
@@ -37,8 +39,12 @@ Server& TheServer() {
                                    : websocketpp::http::status_code::ok);
       con->set_body(sandbox::web::ContentType(file));
     });
+    // What `sandbox view` does with a text message: a player command.
     s->set_message_handler([](websocketpp::connection_hdl, Server::message_ptr message) {
-      (void)message->get_payload().size();
+      try {
+        (void)sandbox::web::ParsePlayerCommand(message->get_payload());
+      } catch (const std::invalid_argument&) {
+      }
     });
     return s;
   }();

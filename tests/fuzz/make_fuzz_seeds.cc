@@ -129,6 +129,9 @@ void WebRequestSeeds(const fs::path& dir) {
   Write(dir / "get_outside", "GET /three/../../etc/passwd HTTP/1.1\r\nHost: [::1]:80\r\n\r\n");
   Write(dir / "stream_frames", handshake + frame(0x1, "hello") + frame(0x2, Bytes("\0\1\2", 3)) +
                                    frame(0x9, "ping") + frame(0x8, Bytes("\x03\xe8", 2)));
+  Write(dir / "stream_player", handshake + frame(0x1, R"({"type":"player","play":true})") +
+                                   frame(0x1, R"({"type":"player","speed":4,"seek":120})") +
+                                   frame(0x1, R"({"type":"player","seek":-1})"));
   Bytes other = handshake;
   other.replace(other.find("Origin: http://127.0.0.1:8080"), 29, "Origin: http://evil.example");
   Write(dir / "stream_other_origin", other);

@@ -82,6 +82,11 @@ class WebDriver:
         png = base64.b64decode(self.call("GET", "/session/%s/screenshot" % self.session))
         return Image.open(io.BytesIO(png)).convert("RGB")
 
+    def script_errors(self):
+        """The page's uncaught errors and failed loads so far (Chrome's log)."""
+        entries = self.call("POST", "/session/%s/se/log" % self.session, {"type": "browser"})
+        return [e["message"] for e in entries if e["level"] == "SEVERE"]
+
     def quit(self):
         self.call("DELETE", "/session/%s" % self.session)
 
@@ -142,6 +147,8 @@ def main():
               "page draws: each within %.1e m of its surfaces; a click picks sample %s"
               % (checked, worst, picked))
         iou, tick, pixels = robot_overlap(browser, sandbox, out)
+        errors = browser.script_errors()
+        assert not errors, errors
         print("browser view: the skinned wing at tick %d overlaps OSMesa's render from the same "
               "camera with IoU %.3f (%d robot pixels)" % (tick, iou, pixels))
         assert iou >= 0.95, "IoU %.3f" % iou

@@ -410,6 +410,7 @@ TEST(StreamStateTest, EncodesSamplesAsAHeaderAndAlignedArrays) {
   state.tick = 7;
   EXPECT_EQ(EncodeSamples(state), "");  // none with this state
   state.has_samples = true;
+  state.samples_tick = 5;
   state.samples_origin = {100.0, -200.0, 3.0};
   StreamState::Samples a{"wing", "scanner", "face", {1, 2, 3, 4, 5, 6, 7, 8, 9}, {1, 0, 1}, {5, 0, 9}};
   StreamState::Samples b{"wing", "alt", "ray", {-1.5f, 2.5f, 0.25f}, {1}, {123456}};
@@ -420,7 +421,7 @@ TEST(StreamStateTest, EncodesSamplesAsAHeaderAndAlignedArrays) {
   std::memcpy(&length, out.data() + 4, 4);
   EXPECT_EQ(length % 4, 0u);
   const nlohmann::json header = nlohmann::json::parse(out.substr(8, length));
-  EXPECT_EQ(header["tick"], 7);
+  EXPECT_EQ(header["tick"], 5);  // the tick they were taken at
   EXPECT_EQ(header["origin"], nlohmann::json({100.0, -200.0, 3.0}));
   ASSERT_EQ(header["sets"].size(), 2u);
   std::size_t offset = 8 + length;

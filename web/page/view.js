@@ -23,7 +23,7 @@ const controls = new OrbitControls(camera, canvas);
 const view = { connected: false, levelLoaded: false, tick: -1, framesDrawn: 0, states: 0,
                received: 0, robots: {}, firstFrameMs: null, held: false, camera: null,
                masked: false };
-let pendingState = null;  // the newest state's text, not yet shown
+let pendingState = null;  // the newest state, not yet shown
 window.sandboxView = view;
 // What scripts and tests may call (apart, so that sandboxView stays plain data).
 const control = {};
@@ -132,6 +132,7 @@ function drawPlot() {
 
 function showState(state) {
   view.tick = state.tick;
+  if (state.player) showPlayer(state.player, state.tick);
   view.states += 1;
   state.robots.forEach((r, index) => {
     if (!robots.has(r.name)) robots.set(r.name, robotEntry(r.name, index));
@@ -180,6 +181,38 @@ let surfaces = new Map();  // id -> { kind, name }
 function levelInfo(info) {
   view.levelName = info.name;
   surfaces = new Map(info.surfaces.map((s) => [s.id, s]));
+  if (info.recorded) {
+    view.recordedTicks = info.recorded.ticks;
+    slider.max = tickInput.max = info.recorded.ticks - 1;
+    document.getElementById('recorded').textContent =
+      `${info.recorded.ticks} ticks, ${info.recorded.duration_s.toFixed(1)} s: ${info.recorded.log}`;
+    document.getElementById('player').hidden = false;
+  }
+}
+
+// A recorded run's player (sandbox view): its commands go to the sandbox,
+// which moves one playhead for every page; the states say where it is.
+const slider = document.getElementById('slider'), tickInput = document.getElementById('tick');
+const playButton = document.getElementById('play'), speedSelect = document.getElementById('speed');
+let socket = null, sliding = false;
+function command(fields) {
+  if (socket && socket.readyState === WebSocket.OPEN) {
+    socket.send(JSON.stringify(Object.assign({ type: 'player' }, fields)));
+  }
+}
+control.player = command;
+playButton.addEventListener('click', () => command({ play: !view.playing }));
+speedSelect.addEventListener('change', () => command({ speed: Number(speedSelect.value) }));
+slider.addEventListener('input', () => { sliding = true; tickInput.value = slider.value; });
+slider.addEventListener('change', () => { sliding = false; command({ seek: Number(slider.value) }); });
+tickInput.addEventListener('change', () => command({ seek: Math.max(0, Math.floor(Number(tickInput.value))) }));
+
+function showPlayer(player, tick) {
+  view.playing = player.playing;
+  playButton.textContent = player.playing ? 'pause' : 'play';
+  if (!sliding) slider.value = tick;
+  if (document.activeElement !== tickInput) tickInput.value = tick;
+  if (document.activeElement !== speedSelect) speedSelect.value = String(player.speed);
 }
 
 function surfaceColour(id, colour) {
@@ -285,7 +318,7 @@ function frameLevel(object) {
 }
 
 function connect() {
-  const socket = new WebSocket(`ws://${location.host}/stream`);
+  socket = new WebSocket(`ws://${location.host}/stream`);
   socket.binaryType = 'arraybuffer';
   socket.onopen = () => { view.connected = true; };
   socket.onclose = () => {
@@ -295,13 +328,14 @@ function connect() {
   };
   socket.onmessage = (event) => {
     if (typeof event.data === 'string') {
-      if (event.data.startsWith('{"type":"level"')) {
-        levelInfo(JSON.parse(event.data));
+      const message = JSON.parse(event.data);
+      if (message.type === 'level') {
+        levelInfo(message);
         return;
       }
-      // Kept as it came: the newest is read once a drawn frame (a page drawing
+      // Kept as it came: the newest is shown once a drawn frame (a page drawing
       // slower than states arrive skips the ones between).
-      pendingState = event.data;
+      pendingState = message;
       view.received += 1;
       return;
     }
@@ -334,7 +368,7 @@ const started = performance.now();
 function animate() {
   requestAnimationFrame(animate);
   if (pendingState !== null && !view.held) {
-    showState(JSON.parse(pendingState));
+    showState(pendingState);
     pendingState = null;
   }
   if (pendingSamples !== null && !view.held) {

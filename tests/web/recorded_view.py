@@ -1,0 +1,134 @@
+#!/usr/bin/python3
+"""A recorded flight in the browser (sandbox view LOG) in a real headless Chromium.
+
+Writes a 20 s flight's inputs with fly_wing --write-log, starts `sandbox view`
+on it, opens the page through chromedriver and drives its player: a jump to a
+tick shows that tick's pose (the log's own POSE message of that index, read
+here from the file: lock-step, tick N is the N-th pose), the slider moved by
+hand jumps there too, play moves the ticks on at about the chosen speed, pause
+holds them; a bad command is refused and counted.
+
+usage: recorded_view.py SANDBOX FLY_WING
+"""
+import os
+import re
+import shutil
+import signal
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from browser_view import WebDriver, free_port, wait_for, _answers  # noqa: E402
+
+
+def poses(log):
+    """The positions of the log's POSE messages, in order (robot_pose_t:
+    fingerprint, utime, seq, position[3], orientation[4], big-endian)."""
+    out = []
+    with open(log, "rb") as f:
+        data = f.read()
+    at = 0
+    while at + 28 <= len(data):
+        sync, _, _, channel_len, data_len = struct.unpack_from(">IqqII", data, at)
+        assert sync == 0xEDA1DA01, "not an LCM log event at byte %d" % at
+        at += 28
+        channel = data[at:at + channel_len].decode()
+        message = data[at + channel_len:at + channel_len + data_len]
+        at += channel_len + data_len
+        if channel.endswith("/POSE"):
+            out.append(struct.unpack_from(">3d", message, 8 + 16))
+    return out
+
+
+def main():
+    sandbox, fly_wing = sys.argv[1], sys.argv[2]
+    work = tempfile.mkdtemp(prefix="sandbox-recorded-")
+    log = os.path.join(work, "flight.lcmlog")
+    subprocess.run([fly_wing, "--write-log", log, "--duration", "20", "--rate", "100"],
+                   check=True, stdout=subprocess.DEVNULL)
+    expected = poses(log)
+    assert len(expected) == 2000, len(expected)
+    view = subprocess.Popen([sandbox, "view", log, "--web", "0"], stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True)
+    lines, url = [], None
+    while url is None:
+        line = view.stdout.readline()
+        if not line:
+            raise AssertionError("sandbox view ended before serving:\n" + "".join(lines))
+        lines.append(line)
+        match = re.search(r"(\d+) ticks of .* at (http://\S+)", line)
+        url = match.group(2) if match else None
+    assert int(match.group(1)) == len(expected), line
+    driver_port = free_port()
+    driver = subprocess.Popen(["/usr/bin/chromedriver", "--port=%d" % driver_port],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                              start_new_session=True)
+    browser = None
+    try:
+        wait_for("chromedriver", lambda: _answers(driver_port))
+        browser = WebDriver(driver_port)
+        browser.go(url)
+        wait_for("the level and the player", lambda: browser.run(
+            "const v = window.sandboxView; return v.levelLoaded && v.recordedTicks && v.tick >= 0"))
+
+        def shown():
+            return browser.run("const v = window.sandboxView; return [v.tick, v.robots.ELAHA.p, "
+                               "Number(document.getElementById('slider').value)]")
+
+        def seek_to(tick, by_hand):
+            if by_hand:  # the slider dragged and let go
+                browser.run("const s = document.getElementById('slider'); s.value = %d; "
+                            "s.dispatchEvent(new Event('input')); "
+                            "s.dispatchEvent(new Event('change'))" % tick)
+            else:
+                browser.run("window.sandboxControl.player({seek: %d})" % tick)
+            return wait_for("tick %d shown" % tick, lambda: (lambda s: s if s[0] == tick else None)(
+                shown()))
+
+        checked = 0
+        for tick, by_hand in ((1234, False), (17, True), (1999, False), (0, True), (977, True)):
+            at, p, slider = seek_to(tick, by_hand)
+            error = max(abs(a - b) for a, b in zip(p, expected[tick]))
+            assert error < 1e-6, (tick, p, expected[tick])
+            assert slider == tick, (tick, slider)
+            checked += 1
+        # Play at 4x: about 400 ticks a second of wall time (100 Hz log).
+        browser.run("window.sandboxControl.player({speed: 4, play: true})")
+        start = time.monotonic()
+        wait_for("playing", lambda: browser.run("return window.sandboxView.playing"))
+        first = shown()[0]
+        time.sleep(2.0)
+        second = shown()[0]
+        elapsed = time.monotonic() - start
+        assert second > first + 100, (first, second)
+        assert second - 977 <= 4 * 100 * elapsed + 50, (second, elapsed)
+        browser.run("window.sandboxControl.player({play: false})")
+        wait_for("paused", lambda: not browser.run("return window.sandboxView.playing"))
+        time.sleep(0.3)
+        held = shown()[0]
+        time.sleep(1.0)
+        assert shown()[0] == held, "paused, yet moved on"
+        browser.run("window.sandboxControl.player({seek: -5})")  # refused, counted
+        errors = browser.script_errors()
+        assert not errors, errors
+        print("recorded view: %d jumps (2 by command, 3 by the slider) showed the log's pose "
+              "at each tick; 4x play moved %d ticks in %.1f s; pause held tick %d"
+              % (checked, second - first, elapsed, held))
+    finally:
+        if browser is not None:
+            browser.quit()
+        os.killpg(driver.pid, signal.SIGKILL)
+        driver.wait()
+        view.send_signal(signal.SIGINT)
+        rest, _ = view.communicate(timeout=60)
+        shutil.rmtree(work, ignore_errors=True)
+    match = re.search(r"player commands: (\d+) taken, (\d+) refused", rest)
+    assert match and int(match.group(1)) == 7 and int(match.group(2)) == 1, rest
+    print("sandbox view: " + match.group(0))
+
+
+if __name__ == "__main__":
+    main()
