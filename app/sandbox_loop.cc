@@ -201,8 +201,12 @@ int SandboxLoop::Run() {
     bool overrun = false;
     const double next_s = pacer.Next(seconds_since_start(tick_end), &overrun);
     stats_.Add(record, overrun);
-    if (web_ && web_->WantsState()) PublishWebState(record);
-    if (hooks_.web_state) hooks_.web_state(WebState(record));
+    if (web_ && web_->WantsState()) PublishWebState(record, seconds_since_start(Clock::now()));
+    if (hooks_.web_state) {
+      const bool due = tick_time_s_ >= recorded_samples_due_s_;
+      if (due) recorded_samples_due_s_ = tick_time_s_ + 1.0 / kWebSamplesHz;
+      hooks_.web_state(WebState(record, due));
+    }
     KeepOriginNearRobot();  // between ticks: the next tick's rays see the new origin
     if (paced && !overrun) {
       stop_.SleepUntil(at(timed ? std::min(next_s, options_.duration_s) : next_s));
@@ -435,13 +439,20 @@ void SandboxLoop::ReportRecordingFailure() {
   err_ << "sandbox run: recording stopped: " << link_.record_error() << "\n";
 }
 
-void SandboxLoop::PublishWebState(const TickRecord& record) {
-  web_->Publish([state = WebState(record)] {
+void SandboxLoop::PublishWebState(const TickRecord& record, double wall_s) {
+  // Samples a few times a second of the run's time and of the wall's (a
+  // replay runs faster than its clock: they are most of the bytes).
+  const bool due = tick_time_s_ >= web_samples_due_s_ && wall_s >= web_samples_wall_due_s_;
+  if (due) {
+    web_samples_due_s_ = tick_time_s_ + 1.0 / kWebSamplesHz;
+    web_samples_wall_due_s_ = wall_s + 1.0 / kWebSamplesHz;
+  }
+  web_->Publish([state = WebState(record, due)] {
     return web::EncodedState(web::EncodeState(state), web::EncodeSamples(state));
   });
 }
 
-web::StreamState SandboxLoop::WebState(const TickRecord& record) {
+web::StreamState SandboxLoop::WebState(const TickRecord& record, bool with_samples) {
   web::StreamState state;
   state.tick = record.tick;
   state.time_s = tick_time_s_;
@@ -477,9 +488,7 @@ web::StreamState SandboxLoop::WebState(const TickRecord& record) {
     state.actors.push_back(
         {level_.actors[a].name, X_WA.translation(), Eigen::Quaterniond(X_WA.linear())});
   }
-  // The sensors' samples, a few times a second (they are most of the bytes).
-  if (tick_time_s_ >= web_samples_due_s_) {
-    web_samples_due_s_ = tick_time_s_ + 1.0 / kWebSamplesHz;
+  if (with_samples) {
     state.has_samples = true;
     state.samples_tick = state.tick;
     state.samples_origin = world_.origin();

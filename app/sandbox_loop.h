@@ -108,10 +108,9 @@ class SandboxLoop {
   // terrain tiles come or go, and once a second.
   void PublishSurfacesIfDue(double t, std::int64_t now_utime);
   // Between ticks: the browser view's state (--web), handed to its server.
-  void PublishWebState(const TickRecord& record);
-  // The browser view's state after a tick, with the sensors' samples when
-  // they are due (kWebSamplesHz of the run's time).
-  web::StreamState WebState(const TickRecord& record);
+  void PublishWebState(const TickRecord& record, double wall_s);
+  // The browser view's state after a tick, with the sensors' samples or without.
+  web::StreamState WebState(const TickRecord& record, bool with_samples);
   // Between ticks: the floating origin to the first robot when it is far from it.
   void KeepOriginNearRobot();
   // Says once that the recording (--record) could not be written.
@@ -149,7 +148,8 @@ class SandboxLoop {
   std::unique_ptr<web::StreamServer> web_;  // the browser view (--web)
   static constexpr double kWebSamplesHz = 5.0;                // scan samples sent so often
   static constexpr std::size_t kWebSamplesPerSensor = 20000;  // at most so many a sensor
-  double web_samples_due_s_{0.0};
+  double web_samples_due_s_{0.0}, web_samples_wall_due_s_{0.0};  // --web's next samples
+  double recorded_samples_due_s_{0.0};                            // RunHooks::web_state's
 
   std::int64_t tick_{0};
   double tick_time_s_{0.0};              // the last tick's time (lock-step: its input's)
