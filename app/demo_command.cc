@@ -34,6 +34,7 @@ namespace {
 
 const char* kUsage =
     "usage: sandbox demo [--duration S] [--out DIR] [--in-process] [--web [ADDR:]PORT]\n"
+    "                    [--web-control]\n"
     "  The sample level and the flying wing, flown by the example model (examples/fly_wing)\n"
     "  as a separate process over LCM inside a private network namespace (nothing reaches\n"
     "  the LAN). Face scanner on; chase, trailing and belly cameras write JPEG and an mp4\n"
@@ -44,7 +45,8 @@ const char* kUsage =
     "                happens when no namespace can be made: that needs root or user namespaces)\n"
     "  --web         the browser view on this port (127.0.0.1 unless an address is given; 0:\n"
     "                any free port): the model then flies in-process, as the namespace's\n"
-    "                ports are out of the browser's reach (docs/reference/web.md)\n";
+    "                ports are out of the browser's reach (docs/reference/web.md)\n"
+    "  --web-control the page may steer the cameras (pan, tilt, zoom, overlay)\n";
 
 bool InNamespace() {
   const char* flag = std::getenv("SANDBOX_IN_NETNS");
@@ -148,7 +150,8 @@ void WriteOverview(const std::filesystem::path& dir, const std::string& file) {
 
 int RunDemo(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   const auto parsed =
-      ParseArgs(args, "demo", {"--duration", "--out", "--web"}, {"--in-process"}, kUsage, err);
+      ParseArgs(args, "demo", {"--duration", "--out", "--web"}, {"--in-process", "--web-control"},
+                kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
     out << kUsage;
@@ -184,6 +187,7 @@ int RunDemo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     std::vector<std::string> run_args = {"--duration", seconds.str(), "--out",         out_dir,
                                          "--frames",   "jpg,mp4",     "--scans-every", "1"};
     if (web) run_args.insert(run_args.end(), {"--web", parsed->Value("--web")});
+    if (parsed->flags.count("--web-control")) run_args.push_back("--web-control");
     StatusListener status;
     RunHooks hooks;
     hooks.before_close = [&status](bridge::LcmLink&) { status.input.reset(); };

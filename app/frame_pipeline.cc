@@ -282,6 +282,12 @@ void FramePipeline::Write(const Encoded& item) {
     index->Add(row.str());
     if (!index->Flush()) throw std::runtime_error(index->error());
     ++written_;
+    if (config_.written) {
+      const bool color = !config_.image_format.empty() && (kinds & render::kColorImage);
+      config_.written(item.camera, item.tick, item.view, item.frame,
+                      color ? dir / (name.str() + "." + config_.image_format)
+                            : std::filesystem::path());
+    }
   } catch (const std::exception& e) {
     Fail(e.what());
     retry_after_ = now + std::chrono::seconds(1);

@@ -23,6 +23,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -52,6 +53,11 @@ struct FramePipelineConfig {
   bool lossless{false};
   // Called on the render thread with each frame of a job marked `show`.
   std::function<void(const std::string& camera, const render::Frame& frame)> show;
+  // Called on the encoder thread after each frame is written, with its
+  // colour image's file (empty when none was written: a video only).
+  std::function<void(const std::string& camera, std::int64_t tick, const render::CameraView& view,
+                     const render::Frame& frame, const std::filesystem::path& color_file)>
+      written;
 };
 
 // What the loop hands over: a camera view and copies of the robot states.

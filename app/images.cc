@@ -131,6 +131,16 @@ void WriteColor(const render::Frame& frame, const std::string& path) {
   Write(bgr, path);
 }
 
+std::string EncodeJpeg(const render::Frame& frame, int quality) {
+  cv::Mat rgb(frame.height, frame.width, CV_8UC3, const_cast<std::uint8_t*>(frame.rgb.data()));
+  cv::Mat bgr;
+  cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+  std::vector<std::uint8_t> bytes;
+  if (!cv::imencode(".jpg", bgr, bytes, {cv::IMWRITE_JPEG_QUALITY, quality}))
+    throw std::runtime_error("cannot encode a JPEG");
+  return std::string(bytes.begin(), bytes.end());
+}
+
 void WriteDepthMillimetres(const render::Frame& frame, const std::string& path) {
   cv::Mat depth(frame.height, frame.width, CV_16U);
   for (int i = 0; i < frame.width * frame.height; ++i) {

@@ -23,6 +23,8 @@ bool ImageHeaderSize(const std::uint8_t* data, std::size_t size, std::uint32_t* 
 // Writes a frame's colour; the format follows the file's extension (.jpg,
 // .png, ...). Throws std::runtime_error naming the file when it cannot.
 void WriteColor(const render::Frame& frame, const std::string& path);
+// The colour image as a JPEG file's bytes (OpenCV's encoder), in memory.
+std::string EncodeJpeg(const render::Frame& frame, int quality = 85);
 // Writes depth as a 16-bit PNG in millimetres (0: nothing within range).
 void WriteDepthMillimetres(const render::Frame& frame, const std::string& path);
 // Writes depth as a NumPy .npy file: float32 metres, shape (height, width),

@@ -38,8 +38,8 @@ void ParseFrames(const std::string& text, FramePipelineConfig* config) {
 const std::set<std::string> kRunValueOptions = {
     "--rate",   "--duration", "--lcm-url",     "--replay",   "--record", "--out",
     "--frames", "--depth",    "--scans-every", "--realtime", "--ticks",  "--web"};
-const std::set<std::string> kRunFlags = {"--lockstep", "--view", "--isolate", "--no-sensors",
-                                         "--frames-only"};
+const std::set<std::string> kRunFlags = {"--lockstep",    "--view",        "--isolate",
+                                         "--no-sensors",  "--frames-only", "--web-control"};
 
 RunOptions ParseRunOptions(const ParsedArgs& args) {
   RunOptions options;
@@ -114,6 +114,9 @@ RunOptions ParseRunOptions(const ParsedArgs& args) {
     throw UsageError("--no-sensors scans nothing: no --scans-every");
   }
   if (args.values.count("--web")) ParseWebAddress(args.Value("--web"), &options);
+  options.web_control = args.flags.count("--web-control") > 0;
+  if (options.web_control && options.web_port < 0)
+    throw UsageError("--web-control steers the cameras from the browser view: it needs --web");
   return options;
 }
 

@@ -34,6 +34,7 @@ struct RunOptions {
   bool publish{true};          // false: nothing published (--frames-only)
   std::string web_address;     // the browser view's address (--web [ADDR:]PORT); empty: none
   int web_port{-1};            // its port; -1: no browser view (0: any free port)
+  bool web_control{false};     // the page may steer the cameras (--web-control)
 
   bool free_running() const { return rate_hz == 0.0; }
   bool replay() const { return !replay_file.empty(); }

@@ -154,7 +154,7 @@ void PrintWebCounts(const web::ServerCounts& c, std::ostream& out) {
       << " bad handshakes; closed: " << c.closed_oversized << " oversized messages, "
       << c.closed_protocol << " bad frames, " << c.dropped_slow << " too slow";
   if (c.commands + c.commands_refused > 0) {
-    out << "; player commands: " << c.commands << " taken, " << c.commands_refused << " refused";
+    out << "; commands: " << c.commands << " taken, " << c.commands_refused << " refused";
   }
   out << "\n";
 }

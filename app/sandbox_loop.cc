@@ -9,13 +9,16 @@
 #include <filesystem>
 #include <iomanip>
 #include <mutex>
+#include <fstream>
 #include <sstream>
 #include <string>
 
 #include "app/command_line.h"
+#include "app/images.h"
 #include "app/run_summary.h"
 #include "app/tick_pacer.h"
 #include "app/web_samples.h"
+#include "web/commands.h"
 #include "web/level_model.h"
 #include "web/stream_state.h"
 
@@ -113,6 +116,13 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
         live_view_->Show(frame, camera);
       };
     }
+    if (options_.web_port >= 0) {
+      config.written = [this](const std::string& camera, std::int64_t tick,
+                              const render::CameraView& view, const render::Frame& frame,
+                              const std::filesystem::path& color_file) {
+        ShowCameraFrame(camera, tick, view, frame, color_file);
+      };
+    }
     frames_ = std::make_unique<FramePipeline>(level_, config);
   }
   if (options_.web_port >= 0) {
@@ -120,9 +130,27 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
     server.address = options_.web_address;
     server.port = options_.web_port;
     server.page_dir = SANDBOX_WEB_PAGE_DIR;
+    if (options_.web_control) {  // camera commands, applied by the loop as keys
+      server.on_text = [this](const std::string& text) -> std::string {
+        try {
+          const std::string key = web::ParseCameraCommand(text);
+          const std::map<std::string, ViewKey> keys = {
+              {"next_camera", ViewKey::kNextCamera}, {"pan_left", ViewKey::kPanLeft},
+              {"pan_right", ViewKey::kPanRight},     {"tilt_up", ViewKey::kTiltUp},
+              {"tilt_down", ViewKey::kTiltDown},     {"zoom_in", ViewKey::kZoomIn},
+              {"zoom_out", ViewKey::kZoomOut},       {"overlay", ViewKey::kToggleOverlay}};
+          std::lock_guard<std::mutex> lock(web_keys_mutex_);
+          web_keys_.push_back(keys.at(key));
+          return "";
+        } catch (const std::invalid_argument& error) {
+          return error.what();
+        }
+      };
+    }
     try {
       web_ = std::make_unique<web::StreamServer>(server);
-      web_->SetLevel(web::LevelInfoJson(level_), web::MakeLevelModel(level_).glb);
+      web_->SetLevel(web::LevelInfoJson(level_, nullptr, options_.web_control),
+                     web::MakeLevelModel(level_).glb);
     } catch (const std::exception& e) {
       throw CommandError(e.what());
     }
@@ -237,8 +265,16 @@ void SandboxLoop::Tick(double wall_s, double drain_budget_s, TickRecord* record)
 }
 
 bool SandboxLoop::TakeViewKeys(double drain_budget_s) {
-  if (!live_view_) return true;
   ViewControls& controls = cameras_.controls();
+  if (options_.web_control) {  // the browser view's camera commands
+    std::vector<ViewKey> keys;
+    {
+      std::lock_guard<std::mutex> lock(web_keys_mutex_);
+      keys.swap(web_keys_);
+    }
+    for (const ViewKey key : keys) controls.Apply(key, int(loaded_.cameras.size()));
+  }
+  if (!live_view_) return true;
   for (const ViewKey key : live_view_->TakeKeys()) {
     controls.Apply(key, int(loaded_.cameras.size()));
   }
@@ -437,6 +473,25 @@ void SandboxLoop::ReportRecordingFailure() {
   if (recording_failure_reported_ || link_.record_error().empty()) return;
   recording_failure_reported_ = true;
   err_ << "sandbox run: recording stopped: " << link_.record_error() << "\n";
+}
+
+void SandboxLoop::ShowCameraFrame(const std::string& camera, std::int64_t tick,
+                                  const render::CameraView& view, const render::Frame& frame,
+                                  const std::filesystem::path& color_file) {
+  if (!web_ || web_->counts().clients == 0 || frame.rgb.empty()) return;
+  const auto now = Clock::now();
+  Clock::time_point& due = web_camera_due_[camera];
+  if (now < due) return;
+  due = now + std::chrono::milliseconds(int(1000.0 / kWebCameraHz));
+  web::CameraFrame shown{camera, tick, view.X_WC, view.fov_y_rad, frame.width, frame.height, {}};
+  if (color_file.extension() == ".jpg") {  // the writer's own JPEG
+    std::ifstream in(color_file, std::ios::binary);
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    shown.jpeg = bytes.str();
+  }
+  if (shown.jpeg.empty()) shown.jpeg = EncodeJpeg(frame);
+  web_->SetCameraFrame(shown);
 }
 
 void SandboxLoop::PublishWebState(const TickRecord& record, double wall_s) {

@@ -20,7 +20,9 @@
 
 #include <atomic>
 #include <cstdint>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <ostream>
 #include <vector>
 
@@ -109,6 +111,11 @@ class SandboxLoop {
   void PublishSurfacesIfDue(double t, std::int64_t now_utime);
   // Between ticks: the browser view's state (--web), handed to its server.
   void PublishWebState(const TickRecord& record, double wall_s);
+  // On the frame pipeline's encoder thread: a written frame to the browser
+  // view (its JPEG, or one encoded), kWebCameraHz a camera while a client is there.
+  void ShowCameraFrame(const std::string& camera, std::int64_t tick,
+                       const render::CameraView& view, const render::Frame& frame,
+                       const std::filesystem::path& color_file);
   // The browser view's state after a tick, with the sensors' samples or without.
   web::StreamState WebState(const TickRecord& record, bool with_samples);
   // Between ticks: the floating origin to the first robot when it is far from it.
@@ -150,6 +157,10 @@ class SandboxLoop {
   static constexpr std::size_t kWebSamplesPerSensor = 20000;  // at most so many a sensor
   double web_samples_due_s_{0.0}, web_samples_wall_due_s_{0.0};  // --web's next samples
   double recorded_samples_due_s_{0.0};                            // RunHooks::web_state's
+  static constexpr double kWebCameraHz = 2.0;  // camera frames a camera sent so often
+  std::map<std::string, std::chrono::steady_clock::time_point> web_camera_due_;  // encoder thread
+  std::mutex web_keys_mutex_;
+  std::vector<ViewKey> web_keys_;  // --web-control's camera commands, not yet applied
 
   std::int64_t tick_{0};
   double tick_time_s_{0.0};              // the last tick's time (lock-step: its input's)

@@ -128,7 +128,8 @@ aiMaterial* MakeMaterial(const scene::Material& source) {
 
 }  // namespace
 
-std::string LevelInfoJson(const scene::Level& level, const RecordedRun* recorded) {
+std::string LevelInfoJson(const scene::Level& level, const RecordedRun* recorded,
+                          bool camera_control) {
   nlohmann::json surfaces = nlohmann::json::array(), robots = nlohmann::json::array();
   const scene::SurfaceIds ids(level);
   for (const scene::SurfaceEntry& entry : ids.entries())
@@ -145,7 +146,8 @@ std::string LevelInfoJson(const scene::Level& level, const RecordedRun* recorded
   nlohmann::json info = {{"type", "level"},
                          {"name", level.name},
                          {"surfaces", std::move(surfaces)},
-                         {"robots", std::move(robots)}};
+                         {"robots", std::move(robots)},
+                         {"camera_control", camera_control}};
   if (recorded != nullptr) {
     info["recorded"] = {{"log", recorded->log},
                         {"ticks", recorded->ticks},

@@ -38,7 +38,9 @@ struct RecordedRun {
   std::int64_t ticks{0};
   double duration_s{0.0};
 };
-std::string LevelInfoJson(const scene::Level& level, const RecordedRun* recorded = nullptr);
+// `camera_control`: the page may steer the cameras (`--web-control`).
+std::string LevelInfoJson(const scene::Level& level, const RecordedRun* recorded = nullptr,
+                          bool camera_control = false);
 
 // The name of robot `robot`'s node ("sandbox_robot0"; three.js keeps it as is).
 std::string RobotNodeName(int robot);

@@ -2,37 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <nlohmann/json.hpp>
+#include <stdexcept>
 #include <string>
 
 namespace sandbox::web {
-
-PlayerCommand ParsePlayerCommand(std::string_view text) {
-  const nlohmann::json json = nlohmann::json::parse(text, nullptr, false);
-  if (json.is_discarded() || !json.is_object())
-    throw std::invalid_argument("a player command must be a JSON object");
-  if (json.value("type", nlohmann::json()) != "player")
-    throw std::invalid_argument("'type' must be \"player\"");
-  PlayerCommand command;
-  for (const auto& [key, value] : json.items()) {
-    if (key == "type") continue;
-    if (key == "play") {
-      if (!value.is_boolean()) throw std::invalid_argument("'play' must be true or false");
-      command.play = value.get<bool>();
-    } else if (key == "speed") {
-      if (!value.is_number() || !(value.get<double>() >= 0.01 && value.get<double>() <= 100.0))
-        throw std::invalid_argument("'speed' must be a number from 0.01 to 100");
-      command.speed = value.get<double>();
-    } else if (key == "seek") {
-      if (!value.is_number_integer() || value.get<std::int64_t>() < 0)
-        throw std::invalid_argument("'seek' must be a tick, a whole number from 0");
-      command.seek = value.get<std::int64_t>();
-    } else {
-      throw std::invalid_argument("unknown field '" + key + "' (play, speed, seek)");
-    }
-  }
-  return command;
-}
 
 Playhead::Playhead(std::vector<double> times_s) : times_s_(std::move(times_s)) {
   if (times_s_.empty()) throw std::invalid_argument("a playhead needs at least one tick");

@@ -4,25 +4,12 @@
 // and by time while playing, at `speed` times the run's own clock. One
 // playhead for every client: what one does, all see.
 
-#include <cstdint>
-#include <optional>
-#include <stdexcept>
-#include <string_view>
+#include <cstddef>
 #include <vector>
 
+#include "web/commands.h"
+
 namespace sandbox::web {
-
-// {"type": "player", "play": true|false, "speed": 0.01..100, "seek": TICK},
-// each field but type optional (docs/reference/web.md).
-struct PlayerCommand {
-  std::optional<bool> play;
-  std::optional<double> speed;
-  std::optional<std::int64_t> seek;
-};
-
-// Throws std::invalid_argument naming the field for anything else: not JSON,
-// another type, a field of the wrong type or out of range, an unknown field.
-PlayerCommand ParsePlayerCommand(std::string_view text);
 
 class Playhead {
  public:

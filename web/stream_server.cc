@@ -1,5 +1,7 @@
 #include "web/stream_server.h"
 
+#include <nlohmann/json.hpp>
+
 #include <chrono>
 #include <fstream>
 #include <map>
@@ -117,6 +119,14 @@ class StreamServer::Impl {
     ++counts_.states_published;
   }
 
+  void SetCameraFrame(const CameraFrame& frame) {
+    auto encoded = std::make_shared<const std::string>(EncodeCameraFrame(frame));
+    std::lock_guard<std::mutex> lock(mutex_);
+    CameraSlot& slot = cameras_[frame.camera];
+    slot.message = std::move(encoded);
+    ++slot.sequence;
+  }
+
   bool WantsState() const { return counts_.clients > 0 && !state_pending_; }
 
   ServerCounts counts() const {
@@ -137,12 +147,19 @@ class StreamServer::Impl {
     c.states_published = counts_.states_published;
     c.states_sent = counts_.states_sent;
     c.states_skipped = counts_.states_skipped;
+    c.camera_frames = counts_.camera_frames;
     c.bytes_sent = counts_.bytes_sent;
     return c;
   }
 
  private:
+  // A camera's newest frame, encoded, and how many it has had.
+  struct CameraSlot {
+    std::shared_ptr<const std::string> message;
+    std::int64_t sequence{0};
+  };
   struct Client {
+    std::map<std::string, std::int64_t> camera_sequence;  // the last frame sent of each
     bool level_sent{false};
     bool behind{false};
     Clock::time_point behind_since;
@@ -151,7 +168,7 @@ class StreamServer::Impl {
   struct Counts {
     std::atomic<std::int64_t> clients{0}, connections{0}, http_requests{0}, not_found{0},
         refused_origin{0}, refused_full{0}, failed{0}, messages_dropped{0}, commands{0},
-        commands_refused{0}, closed_oversized{0},
+        commands_refused{0}, closed_oversized{0}, camera_frames{0},
         closed_protocol{0}, dropped_slow{0}, states_published{0}, states_sent{0}, states_skipped{0},
         bytes_sent{0};
   };
@@ -230,6 +247,7 @@ class StreamServer::Impl {
   void SendToClients() {
     Encoder encode;
     std::shared_ptr<const std::string> level, level_info;
+    std::map<std::string, CameraSlot> cameras;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       encode = std::move(pending_);
@@ -237,6 +255,7 @@ class StreamServer::Impl {
       state_pending_ = false;
       level = level_;
       level_info = level_info_;
+      cameras = cameras_;
     }
     if (clients_.empty()) return;
     const EncodedState state = encode ? encode() : EncodedState();
@@ -251,6 +270,16 @@ class StreamServer::Impl {
         con->send(level->data(), level->size(), websocketpp::frame::opcode::binary);
         counts_.bytes_sent += std::int64_t(level_info->size() + level->size());
         client.level_sent = true;
+      }
+      if (con->get_buffered_amount() <= options_.max_queued_bytes) {
+        for (const auto& [camera, slot] : cameras) {
+          std::int64_t& sent = client.camera_sequence[camera];
+          if (sent == slot.sequence || !slot.message) continue;
+          sent = slot.sequence;
+          con->send(slot.message->data(), slot.message->size(), websocketpp::frame::opcode::binary);
+          ++counts_.camera_frames;
+          counts_.bytes_sent += std::int64_t(slot.message->size());
+        }
       }
       if (state.text.empty()) continue;
       if (con->get_buffered_amount() > options_.max_queued_bytes) {
@@ -287,6 +316,7 @@ class StreamServer::Impl {
   Encoder pending_;
   std::atomic<bool> state_pending_{false};
   std::shared_ptr<const std::string> level_, level_info_;
+  std::map<std::string, CameraSlot> cameras_;
   Counts counts_;
 };
 
@@ -300,6 +330,28 @@ std::string StreamServer::url() const {
   if (host.find(':') != std::string::npos) host = "[" + host + "]";
   return "http://" + host + ":" + std::to_string(port_) + "/";
 }
+void StreamServer::SetCameraFrame(const CameraFrame& frame) { impl_->SetCameraFrame(frame); }
+
+std::string EncodeCameraFrame(const CameraFrame& frame) {
+  const Eigen::Vector3d p = frame.X_WC.translation();
+  const Eigen::Quaterniond q(frame.X_WC.linear());
+  std::string header = nlohmann::json({{"camera", frame.camera},
+                                       {"tick", frame.tick},
+                                       {"p", {p.x(), p.y(), p.z()}},
+                                       {"q", {q.w(), q.x(), q.y(), q.z()}},
+                                       {"fov_y_deg", frame.fov_y_rad * 180.0 / M_PI},
+                                       {"width", frame.width},
+                                       {"height", frame.height}})
+                           .dump();
+  header.append((4 - header.size() % 4) % 4, ' ');
+  std::string out = "CAMF";
+  const std::uint32_t length = std::uint32_t(header.size());
+  out.append(reinterpret_cast<const char*>(&length), 4);  // little-endian (x86, ARM)
+  out += header;
+  out += frame.jpeg;
+  return out;
+}
+
 void StreamServer::SetLevel(std::string info_json, std::string glb) {
   impl_->SetLevel(std::move(info_json), std::move(glb));
 }

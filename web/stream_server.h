@@ -25,6 +25,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <Eigen/Geometry>
+
 namespace sandbox::web {
 
 struct ServerOptions {
@@ -53,7 +55,7 @@ struct ServerCounts {
   std::int64_t refused_full{0};      // a WebSocket over max_clients (503)
   std::int64_t failed{0};            // handshakes that failed (bad HTTP, bad upgrade)
   std::int64_t messages_dropped{0};  // messages from clients (read-only)
-  std::int64_t commands{0};          // messages on_text took
+  std::int64_t commands{0};          // messages on_text took (player, camera commands)
   std::int64_t commands_refused{0};  // messages on_text refused
   std::int64_t closed_oversized{0};  // closed for a message over max_message_bytes
   std::int64_t closed_protocol{0};   // closed for a bad frame
@@ -61,6 +63,7 @@ struct ServerCounts {
   std::int64_t states_published{0};  // Publish calls
   std::int64_t states_sent{0};       // states sent, all clients
   std::int64_t states_skipped{0};    // states a client was too far behind for
+  std::int64_t camera_frames{0};     // camera frames sent, all clients
   std::int64_t bytes_sent{0};
 };
 
@@ -77,6 +80,21 @@ struct EncodedState {
   std::string text;
   std::string binary;
 };
+
+// A camera's latest frame as the page shows it: in its frustum, at the pose
+// it was rendered from.
+struct CameraFrame {
+  std::string camera;
+  std::int64_t tick{0};
+  Eigen::Isometry3d X_WC{Eigen::Isometry3d::Identity()};  // x forward, y left, z up
+  double fov_y_rad{1.0};
+  int width{0}, height{0};
+  std::string jpeg;  // the image file's bytes
+};
+// Its binary message: "CAMF", a little-endian uint32 header length, the
+// JSON header (camera, tick, p, q (w, x, y, z), fov_y_deg, width, height;
+// padded with spaces to 4 bytes), then the JPEG. docs/reference/web.md.
+std::string EncodeCameraFrame(const CameraFrame& frame);
 
 class StreamServer {
  public:
@@ -101,6 +119,9 @@ class StreamServer {
   // Any thread, never waits on a client: the newest state, as a function that
   // encodes it (it owns what it encodes); replaces one not yet encoded.
   void Publish(Encoder encode);
+  // Any thread, never waits on a client: a camera's newest frame, sent once
+  // to each client (one that is behind gets the newest when it catches up).
+  void SetCameraFrame(const CameraFrame& frame);
   // Any thread: whether a state would be sent (a client is connected and
   // the last state published has been taken): the loop builds one only then,
   // so a state is at most one send period old and costs nothing without clients.

@@ -3,7 +3,7 @@
 // websocketpp (as `sandbox run --web` does, here over its in-memory
 // transport) with the server's own rules for files, hosts and origins
 // (web/request_rules.h), its limits on message size and, for text messages,
-// `sandbox view`'s player commands (web/player.h).
+// `sandbox view`'s player and --web-control's camera commands (web/commands.h).
 
 #include <cstdint>
 #include <sstream>
@@ -11,7 +11,7 @@
 #include <websocketpp/config/core.hpp>
 #include <websocketpp/server.hpp>
 
-#include "web/player.h"
+#include "web/commands.h"
 #include "web/request_rules.h"
 
 namespace {
@@ -39,10 +39,15 @@ Server& TheServer() {
                                    : websocketpp::http::status_code::ok);
       con->set_body(sandbox::web::ContentType(file));
     });
-    // What `sandbox view` does with a text message: a player command.
+    // What `sandbox view` and `--web-control` do with a text message: a
+    // player or a camera command.
     s->set_message_handler([](websocketpp::connection_hdl, Server::message_ptr message) {
       try {
         (void)sandbox::web::ParsePlayerCommand(message->get_payload());
+      } catch (const std::invalid_argument&) {
+      }
+      try {
+        (void)sandbox::web::ParseCameraCommand(message->get_payload());
       } catch (const std::invalid_argument&) {
       }
     });

@@ -131,7 +131,8 @@ void WebRequestSeeds(const fs::path& dir) {
                                    frame(0x9, "ping") + frame(0x8, Bytes("\x03\xe8", 2)));
   Write(dir / "stream_player", handshake + frame(0x1, R"({"type":"player","play":true})") +
                                    frame(0x1, R"({"type":"player","speed":4,"seek":120})") +
-                                   frame(0x1, R"({"type":"player","seek":-1})"));
+                                   frame(0x1, R"({"type":"player","seek":-1})") +
+                                   frame(0x1, R"({"type":"camera","key":"zoom_in"})"));
   Bytes other = handshake;
   other.replace(other.find("Origin: http://127.0.0.1:8080"), 29, "Origin: http://evil.example");
   Write(dir / "stream_other_origin", other);

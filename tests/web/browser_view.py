@@ -94,7 +94,8 @@ class WebDriver:
 def main():
     sandbox = sys.argv[1]
     out = tempfile.mkdtemp(prefix="sandbox-browser-")
-    demo = subprocess.Popen([sandbox, "demo", "--web", "0", "--duration", "120", "--out", out],
+    demo = subprocess.Popen([sandbox, "demo", "--web", "0", "--web-control", "--duration", "120",
+                             "--out", out],
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     lines = []
     url = None
@@ -146,6 +147,9 @@ def main():
         print("browser view: %d of the face scanner's hits checked against the level model the "
               "page draws: each within %.1e m of its surfaces; a click picks sample %s"
               % (checked, worst, picked))
+        camera_note = camera_frame(browser, out)
+        print("browser view: " + camera_note)
+        print("browser view: " + steer_trailing_camera(browser))
         iou, tick, pixels = robot_overlap(browser, sandbox, out)
         errors = browser.script_errors()
         assert not errors, errors
@@ -162,6 +166,8 @@ def main():
     shutil.rmtree(out, ignore_errors=True)
     summary = re.search(r"browser view: (\d+) clients", rest)
     assert summary and int(summary.group(1)) >= 1, rest
+    commands = re.search(r"commands: (\d+) taken, (\d+) refused", rest)
+    assert commands and commands.group(1) == "3" and commands.group(2) == "0", rest
     print("sandbox: " + summary.group(0))
 
 
@@ -268,6 +274,61 @@ def _samples(browser):
     view = browser.run("return window.sandboxView")
     samples = (view.get("samples") or {}).get("ELAHA/scanner")
     return view if samples and samples["hits"] >= 10 else None
+
+
+def thumbnail(image, box=None):
+    """A 32 x 24 grey thumbnail's pixel values (of `box` when given)."""
+    if box:
+        image = image.crop(box)
+    return list(image.convert("L").resize((32, 24), Image.BILINEAR).getdata())
+
+
+def camera_frame(browser, out):
+    """The chase camera's latest frame as the page shows it: the very JPEG the
+    frame writer wrote for that tick (its size), drawn upright in the
+    camera's frustum: looked at from the camera's own pose, the page shows
+    the frame (thumbnails within 25 grey levels on average; the frame upside
+    down is farther)."""
+    wait_for("the chase camera's frame", lambda: browser.run(
+        "const c = window.sandboxView.cameras.chase; return c && c.decoded"), seconds=100.0)
+    browser.run("window.sandboxControl.hold(true)")
+    frame = browser.run("return window.sandboxView.cameras.chase")
+    written = os.path.join(out, "chase", "chase_%06d.jpg" % frame["tick"])
+    assert os.path.getsize(written) == frame["bytes"], (written, frame["bytes"])
+    browser.run("window.sandboxControl.setCamera(%s, %s, %f); window.sandboxControl.cameraOnly('chase')"
+                % (frame["p"], frame["q"], frame["fovDeg"]))
+    drawn = browser.run("return window.sandboxView.framesDrawn")
+    wait_for("a frame through the camera",
+             lambda: browser.run("return window.sandboxView.framesDrawn") > drawn + 1)
+    shot = browser.screenshot()
+    if os.environ.get("SANDBOX_BROWSER_SHOTS"):
+        shot.save(os.path.join(os.environ["SANDBOX_BROWSER_SHOTS"], "through_chase.png"))
+    width, height = shot.size
+    shown_width = height * frame["width"] / frame["height"]  # the page's aspect is wider
+    box = (round((width - shown_width) / 2), 0, round((width + shown_width) / 2), height)
+    page = thumbnail(shot, box)
+    image = Image.open(written)
+    upright = sum(abs(a - b) for a, b in zip(page, thumbnail(image))) / len(page)
+    flipped = sum(abs(a - b) for a, b in zip(page, thumbnail(image.transpose(Image.FLIP_TOP_BOTTOM)))) / len(page)
+    browser.run("window.sandboxControl.cameraOnly(null); window.sandboxControl.setCamera(null); "
+                "window.sandboxControl.hold(false)")
+    assert upright < 25 and upright < flipped, (upright, flipped)
+    return ("the chase camera's frame of tick %d (%d bytes, the writer's file) drawn in its "
+            "frustum: %.1f grey levels from the file seen through it (%.1f upside down)"
+            % (frame["tick"], frame["bytes"], upright, flipped))
+
+
+def steer_trailing_camera(browser):
+    """--web-control: the page's zoom button, pressed three times, zooms the
+    trailing camera in (1.25x a press): its frames come with a narrower view."""
+    wait_for("the trailing camera's frame", lambda: browser.run(
+        "return window.sandboxView.cameras.trailing"), seconds=100.0)
+    before = browser.run("return window.sandboxView.cameras.trailing.fovDeg")
+    browser.run("const b = document.querySelector('#steer [data-key=zoom_in]'); "
+                "b.click(); b.click(); b.click()")
+    after = wait_for("a zoomed trailing frame", lambda: (lambda f: f if f < before * 0.7 else None)(
+        browser.run("return window.sandboxView.cameras.trailing.fovDeg")))
+    return "zoom pressed 3 times: the trailing camera's view %.1f -> %.1f degrees" % (before, after)
 
 
 def robot_overlap(browser, sandbox, out):

@@ -125,7 +125,7 @@ def main():
         view.send_signal(signal.SIGINT)
         rest, _ = view.communicate(timeout=60)
         shutil.rmtree(work, ignore_errors=True)
-    match = re.search(r"player commands: (\d+) taken, (\d+) refused", rest)
+    match = re.search(r"commands: (\d+) taken, (\d+) refused", rest)
     assert match and int(match.group(1)) == 7 and int(match.group(2)) == 1, rest
     print("sandbox view: " + match.group(0))
 

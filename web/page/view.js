@@ -58,6 +58,7 @@ control.mask = (on) => {
   scene.background = new THREE.Color(on ? 0x000000 : 0x8fb4d8);
   document.getElementById('panel').style.display = on ? 'none' : '';
   for (const cloud of sampleClouds.values()) cloud.visible = !on;
+  for (const entry of cameraFrusta.values()) entry.group.visible = !on;
   if (!level) return;
   level.traverse((object) => {
     if (object.name === 'axes') object.visible = !on;
@@ -181,6 +182,8 @@ let surfaces = new Map();  // id -> { kind, name }
 function levelInfo(info) {
   view.levelName = info.name;
   surfaces = new Map(info.surfaces.map((s) => [s.id, s]));
+  // --web-control: the page may steer the cameras.
+  document.getElementById('steer').hidden = !info.camera_control;
   if (info.recorded) {
     view.recordedTicks = info.recorded.ticks;
     slider.max = tickInput.max = info.recorded.ticks - 1;
@@ -201,6 +204,13 @@ function command(fields) {
   }
 }
 control.player = command;
+// Steers the cameras as the live view's keys do (sandbox run --web-control).
+control.steer = (key) => {
+  if (socket && socket.readyState === WebSocket.OPEN) socket.send(JSON.stringify({ type: 'camera', key }));
+};
+for (const button of document.querySelectorAll('#steer button')) {
+  button.addEventListener('click', () => control.steer(button.dataset.key));
+}
 playButton.addEventListener('click', () => command({ play: !view.playing }));
 speedSelect.addEventListener('change', () => command({ speed: Number(speedSelect.value) }));
 slider.addEventListener('input', () => { sliding = true; tickInput.value = slider.value; });
@@ -269,6 +279,77 @@ function showSamples(buffer) {
   for (const [key, cloud] of sampleClouds) cloud.visible = seen.has(key) && !view.masked;
 }
 colourBy.addEventListener('change', () => { for (const cloud of sampleClouds.values()) colourSamples(cloud); });
+
+// The cameras: each one's frustum, 6 m deep, at the pose its latest frame
+// was rendered from, with that frame on its far end.
+const cameraFrusta = new Map();  // name -> { group, image, texture }
+const toGlCamera = new THREE.Quaternion().setFromRotationMatrix(new THREE.Matrix4().set(
+  0, 0, -1, 0, -1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 1));
+view.cameras = {};
+
+function cameraFrustum(name) {
+  const group = new THREE.Group();
+  group.name = 'camera:' + name;
+  const lines = new THREE.LineSegments(new THREE.BufferGeometry(),
+                                       new THREE.LineBasicMaterial({ color: 0xffe060 }));
+  const texture = new THREE.Texture();
+  texture.minFilter = THREE.LinearFilter;  // any size: no mipmaps
+  texture.generateMipmaps = false;
+  const image = new THREE.Mesh(new THREE.PlaneBufferGeometry(1, 1),
+                               new THREE.MeshBasicMaterial({ map: texture, side: THREE.DoubleSide }));
+  group.add(lines, image);
+  scene.add(group);
+  const entry = { group, lines, image, texture };
+  cameraFrusta.set(name, entry);
+  return entry;
+}
+
+function showCameraFrame(buffer) {
+  if (view.held) return;
+  const length = new DataView(buffer).getUint32(4, true);
+  const header = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, 8, length)));
+  const jpeg = new Blob([new Uint8Array(buffer, 8 + length)], { type: 'image/jpeg' });
+  const entry = cameraFrusta.get(header.camera) || cameraFrustum(header.camera);
+  // In three.js's camera axes (x right, y up, looking down -z): the far end at z = -depth.
+  const depth = 6, h = depth * Math.tan((header.fov_y_deg * Math.PI) / 360);
+  const w = (h * header.width) / header.height;
+  const corners = [[-w, -h], [w, -h], [w, h], [-w, h]].map(([x, y]) => [x, y, -depth]);
+  const points = [];
+  for (let i = 0; i < 4; ++i) points.push(0, 0, 0, ...corners[i], ...corners[i], ...corners[(i + 1) % 4]);
+  entry.lines.geometry.setAttribute('position', new THREE.Float32BufferAttribute(points, 3));
+  entry.image.scale.set(2 * w, 2 * h, 1);
+  entry.image.position.set(0, 0, -depth);
+  entry.group.position.set(header.p[0], header.p[1], header.p[2]);
+  entry.group.quaternion.set(header.q[1], header.q[2], header.q[3], header.q[0]).multiply(toGlCamera);
+  entry.group.visible = !view.masked;
+  const shown = { tick: header.tick, bytes: jpeg.size, width: header.width, height: header.height,
+                  p: header.p, q: header.q, fovDeg: header.fov_y_deg, decoded: false };
+  view.cameras[header.camera] = shown;
+  // WebGL does not flip an ImageBitmap on upload: flipped here, as three.js
+  // would an image (the frame's top row at the plane's top).
+  createImageBitmap(jpeg, { imageOrientation: 'flipY' }).then((bitmap) => {
+    entry.texture.flipY = false;
+    entry.texture.image = bitmap;
+    entry.texture.needsUpdate = true;
+    shown.decoded = bitmap.width === header.width && bitmap.height === header.height;
+  });
+}
+
+// Draws one camera's latest frame alone, on black (its frustum's lines
+// hidden): a test looks through it from the camera's own pose. null: all again.
+control.cameraOnly = (name) => {
+  view.masked = name !== null;
+  scene.background = new THREE.Color(name !== null ? 0x000000 : 0x8fb4d8);
+  document.getElementById('panel').style.display = name !== null ? 'none' : '';
+  scene.traverse((object) => {
+    if (object.isMesh || object.isPoints || object.isLine || object.name === 'axes') {
+      let visible = name === null;
+      object.traverseAncestors((a) => { if (a.name === 'camera:' + name) visible = object.isMesh; });
+      object.visible = visible;
+    }
+  });
+  for (const entry of cameraFrusta.values()) entry.group.visible = true;
+};
 
 // Pick: a click on a sample shows what it is.
 const picker = new THREE.Raycaster();
@@ -342,6 +423,10 @@ function connect() {
     const magic = new TextDecoder().decode(new Uint8Array(event.data, 0, 4));
     if (magic === 'SMPL') {
       pendingSamples = event.data;
+      return;
+    }
+    if (magic === 'CAMF') {
+      showCameraFrame(event.data);
       return;
     }
     new GLTFLoader().parse(event.data, '', (gltf) => {

@@ -1,3 +1,4 @@
+#include "web/commands.h"
 #include "web/player.h"
 
 #include <gtest/gtest.h>
@@ -30,6 +31,29 @@ TEST(PlayerCommandTest, ReadsEachFieldAndRefusesTheRestNamingIt) {
   for (const auto& [text, named] : bad) {
     try {
       ParsePlayerCommand(text);
+      ADD_FAILURE() << text << " was taken";
+    } catch (const std::invalid_argument& error) {
+      EXPECT_NE(std::string(error.what()).find(named), std::string::npos)
+          << text << ": " << error.what();
+    }
+  }
+}
+
+TEST(CameraCommandTest, TakesTheKeysTheLiveViewSteersCamerasWithAndNoOthers) {
+  for (const char* key : kCameraKeys)
+    EXPECT_EQ(ParseCameraCommand(std::string(R"({"type":"camera","key":")") + key + "\"}"), key);
+  const std::pair<const char*, const char*> bad[] = {
+      {"{", "JSON object"},
+      {R"({"type":"player","key":"zoom_in"})", "'type'"},
+      {R"({"type":"camera"})", "'key'"},
+      {R"({"type":"camera","key":"quit"})", "got 'quit'"},
+      {R"({"type":"camera","key":"pause"})", "got 'pause'"},
+      {R"({"type":"camera","key":7})", "'key'"},
+      {R"({"type":"camera","key":"zoom_in","times":3})", "unknown field 'times'"},
+  };
+  for (const auto& [text, named] : bad) {
+    try {
+      ParseCameraCommand(text);
       ADD_FAILURE() << text << " was taken";
     } catch (const std::invalid_argument& error) {
       EXPECT_NE(std::string(error.what()).find(named), std::string::npos)
