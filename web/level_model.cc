@@ -11,7 +11,12 @@
 
 #include <algorithm>
 #include <assimp/Exporter.hpp>
+#include <cctype>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
 #include <functional>
+#include <sstream>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -71,7 +76,13 @@ aiMesh* MakeRobotMesh(const scene::SkinnedMesh& source, const std::string& joint
   mesh->mVertices = new aiVector3D[mesh->mNumVertices];
   const bool normals = bind.normals_A.size() == bind.positions_A.size();
   if (normals) mesh->mNormals = new aiVector3D[mesh->mNumVertices];
+  const bool uvs = bind.uvs.size() == bind.positions_A.size();
+  if (uvs) {
+    mesh->mTextureCoords[0] = new aiVector3D[mesh->mNumVertices];
+    mesh->mNumUVComponents[0] = 2;
+  }
   for (std::size_t v = 0; v < bind.positions_A.size(); ++v) {
+    if (uvs) mesh->mTextureCoords[0][v] = aiVector3D(bind.uvs[v].x(), bind.uvs[v].y(), 0.0f);
     const Eigen::Vector3f& p = bind.positions_A[v];
     mesh->mVertices[v] = aiVector3D(p.x(), p.y(), p.z());
     if (normals) {
@@ -115,10 +126,41 @@ aiMesh* MakeRobotMesh(const scene::SkinnedMesh& source, const std::string& joint
   return mesh;
 }
 
-aiMaterial* MakeMaterial(const scene::Material& source) {
+// A material's base colour texture as a browser decodes it (a PNG or JPEG
+// file's bytes), or empty: none, another format, raw texels, unreadable.
+std::pair<std::string, std::string> TextureFile(const scene::Material& material,
+                                                const scene::Level& level) {
+  auto format_of = [](std::string hint) {
+    for (char& c : hint) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return hint == "png" ? "png" : hint == "jpg" || hint == "jpeg" ? "jpg" : "";
+  };
+  if (!material.base_color_texture_path.empty()) {
+    const std::filesystem::path path = material.base_color_texture_path;
+    const std::string format = format_of(path.extension().string().substr(
+        std::min<std::size_t>(1, path.extension().string().size())));
+    std::ifstream in(path, std::ios::binary);
+    if (format.empty() || !in) return {};
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    return {bytes.str(), format};
+  }
+  const int i = material.base_color_texture_embedded;
+  if (i < 0 || std::size_t(i) >= level.textures.size()) return {};
+  const scene::EmbeddedTexture& texture = level.textures[std::size_t(i)];
+  const std::string format = format_of(texture.format_hint);
+  if (texture.height != 0 || format.empty()) return {};
+  return {std::string(texture.bytes.begin(), texture.bytes.end()), format};
+}
+
+aiMaterial* MakeMaterial(const scene::Material& source, int texture = -1) {
   auto* material = new aiMaterial;
   const aiString name(source.name);
   material->AddProperty(&name, AI_MATKEY_NAME);
+  if (texture >= 0) {  // an embedded texture of the scene: "*N"
+    const aiString file("*" + std::to_string(texture));
+    material->AddProperty(&file, AI_MATKEY_TEXTURE(aiTextureType_DIFFUSE, 0));
+    material->AddProperty(&file, AI_MATKEY_TEXTURE(aiTextureType_BASE_COLOR, 0));
+  }
   const aiColor4D color(source.base_color.x(), source.base_color.y(), source.base_color.z(),
                         source.base_color.w());
   material->AddProperty(&color, 1, AI_MATKEY_COLOR_DIFFUSE);
@@ -158,7 +200,8 @@ std::string LevelInfoJson(const scene::Level& level, const RecordedRun* recorded
 
 std::string RobotNodeName(int robot) { return "sandbox_robot" + std::to_string(robot); }
 
-LevelModel MakeLevelModel(const scene::Level& level, std::size_t max_triangles) {
+LevelModel MakeLevelModel(const scene::Level& level, std::size_t max_triangles,
+                          std::size_t max_texture_bytes) {
   LevelModel model;
   for (const scene::Actor& actor : level.actors) model.source_triangles += actor.num_triangles();
   const double ratio = model.source_triangles > max_triangles
@@ -167,9 +210,42 @@ LevelModel MakeLevelModel(const scene::Level& level, std::size_t max_triangles) 
 
   // aiScene owns what it points to (and deletes it with new's partners).
   auto scene = std::make_unique<aiScene>();
+  // Base colour textures (PNG, JPEG) embedded, each file once, within a budget.
   std::vector<aiMaterial*> materials;
-  for (const scene::Material& material : level.materials)
-    materials.push_back(MakeMaterial(material));
+  std::vector<aiTexture*> textures;
+  std::map<std::string, int> texture_of_file;
+  std::size_t texture_bytes = 0;
+  for (const scene::Material& material : level.materials) {
+    int texture = -1;
+    const std::string key = material.base_color_texture_path.empty()
+                                ? "#" + std::to_string(material.base_color_texture_embedded)
+                                : material.base_color_texture_path;
+    if (const auto found = texture_of_file.find(key); found != texture_of_file.end()) {
+      texture = found->second;
+    } else if (auto [bytes, format] = TextureFile(material, level);
+               !bytes.empty() && texture_bytes + bytes.size() <= max_texture_bytes) {
+      auto* t = new aiTexture;
+      t->mWidth = unsigned(bytes.size());
+      t->mHeight = 0;  // compressed: a whole file
+      std::snprintf(t->achFormatHint, sizeof(t->achFormatHint), "%s", format.c_str());
+      t->pcData = new aiTexel[(bytes.size() + sizeof(aiTexel) - 1) / sizeof(aiTexel)];
+      std::memcpy(t->pcData, bytes.data(), bytes.size());
+      texture_bytes += bytes.size();
+      texture = int(textures.size());
+      textures.push_back(t);
+      texture_of_file[key] = texture;
+    } else if (!bytes.empty()) {  // over the budget
+      ++model.textures_left_out;
+      texture_of_file[key] = -1;
+    }
+    materials.push_back(MakeMaterial(material, texture));
+  }
+  model.textures = textures.size();
+  scene->mNumTextures = unsigned(textures.size());
+  if (!textures.empty()) {
+    scene->mTextures = new aiTexture*[textures.size()];
+    std::copy(textures.begin(), textures.end(), scene->mTextures);
+  }
   const int default_material = int(materials.size());
   scene::Material fallback;
   fallback.name = "default";
@@ -200,7 +276,13 @@ LevelModel MakeLevelModel(const scene::Level& level, std::size_t max_triangles) 
       mesh->mVertices = new aiVector3D[mesh->mNumVertices];
       const bool normals = source.normals_A.size() == source.positions_A.size();
       if (normals) mesh->mNormals = new aiVector3D[mesh->mNumVertices];
+      const bool uvs = source.uvs.size() == source.positions_A.size();
+      if (uvs) {
+        mesh->mTextureCoords[0] = new aiVector3D[mesh->mNumVertices];
+        mesh->mNumUVComponents[0] = 2;
+      }
       for (std::size_t v = 0; v < source.positions_A.size(); ++v) {
+        if (uvs) mesh->mTextureCoords[0][v] = aiVector3D(source.uvs[v].x(), source.uvs[v].y(), 0.0f);
         const Eigen::Vector3f p = X_WA * source.positions_A[v];
         mesh->mVertices[v] = aiVector3D(p.x(), p.y(), p.z());
         if (normals) {

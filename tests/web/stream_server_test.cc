@@ -13,9 +13,12 @@
 #include <unistd.h>
 
 #include <assimp/Importer.hpp>
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -500,6 +503,71 @@ TEST(LevelModelTest, TheSampleLevelAsABinaryGltfThatAssimpReadsBack) {
   EXPECT_EQ(small.robot_triangles, robot_triangles);  // robots are not simplified
   EXPECT_LT(small.triangles - small.robot_triangles, 2600u);
   EXPECT_GT(small.triangles - small.robot_triangles, 100u);
+}
+
+// A textured scene's base colour textures go in as their files are, with the
+// meshes' texture coordinates: assimp reads back the same bytes and the same UVs.
+TEST(LevelModelTest, BaseColourTexturesAndTheirCoordinatesGoIn) {
+  const std::filesystem::path truck =
+      std::filesystem::path(SANDBOX_SHARED_ASSETS) / "cesium-milk-truck/CesiumMilkTruck.glb";
+  if (!std::filesystem::exists(truck)) GTEST_SKIP() << truck << " is not on this machine";
+  scene::LoadOptions options;
+  const scene::Level level = scene::LoadLevel(truck, options);
+  ASSERT_FALSE(level.textures.empty());
+  const LevelModel model = MakeLevelModel(level);
+  EXPECT_EQ(model.textures, 1u);  // the truck's one texture, shared by its materials
+  EXPECT_EQ(model.textures_left_out, 0u);
+  Assimp::Importer importer;
+  const aiScene* read = importer.ReadFileFromMemory(model.glb.data(), model.glb.size(), 0, "glb");
+  ASSERT_NE(read, nullptr) << importer.GetErrorString();
+  ASSERT_EQ(read->mNumTextures, 1u);
+  const aiTexture* texture = read->mTextures[0];
+  ASSERT_EQ(texture->mHeight, 0u);
+  const scene::EmbeddedTexture& source = level.textures[0];
+  EXPECT_EQ(std::string(reinterpret_cast<const char*>(texture->pcData), texture->mWidth),
+            std::string(source.bytes.begin(), source.bytes.end()));
+  // A textured material names it; the first textured mesh has its UVs.
+  std::size_t textured = 0;
+  for (unsigned m = 0; m < read->mNumMaterials; ++m) {
+    aiString file;
+    if (read->mMaterials[m]->GetTexture(aiTextureType_DIFFUSE, 0, &file) == AI_SUCCESS) {
+      EXPECT_EQ(std::string(file.C_Str()), "*0");
+      ++textured;
+    }
+  }
+  EXPECT_GT(textured, 0u);
+  // Each textured vertex read back is one of the level's: the same position
+  // with the same coordinates (the exporter joins identical vertices, so
+  // counts and order may differ).
+  std::set<std::array<long, 5>> in_level;
+  auto key = [](float x, float y, float z, float u, float v) {
+    return std::array<long, 5>{std::lround(x * 1e4), std::lround(y * 1e4), std::lround(z * 1e4),
+                               std::lround(u * 1e5), std::lround(v * 1e5)};
+  };
+  for (const scene::Actor& actor : level.actors) {
+    for (const scene::Mesh& mesh : actor.meshes) {
+      for (std::size_t v = 0; v < mesh.uvs.size(); ++v) {
+        const Eigen::Vector3f p = (actor.X_WA.cast<float>() * mesh.positions_A[v]);
+        in_level.insert(key(p.x(), p.y(), p.z(), mesh.uvs[v].x(), mesh.uvs[v].y()));
+      }
+    }
+  }
+  std::size_t checked = 0, matched = 0;
+  for (unsigned m = 0; m < read->mNumMeshes; ++m) {
+    const aiMesh* mesh = read->mMeshes[m];
+    if (!mesh->HasTextureCoords(0)) continue;
+    for (unsigned v = 0; v < mesh->mNumVertices; ++v, ++checked) {
+      const aiVector3D& p = mesh->mVertices[v];
+      const aiVector3D& uv = mesh->mTextureCoords[0][v];
+      matched += in_level.count(key(p.x, p.y, p.z, uv.x, uv.y));
+    }
+  }
+  EXPECT_GT(checked, 1000u);
+  EXPECT_EQ(matched, checked);
+  // Over the byte budget: left out (counted), the base colour stays.
+  const LevelModel lean = MakeLevelModel(level, 2'000'000, 1000);
+  EXPECT_EQ(lean.textures, 0u);
+  EXPECT_EQ(lean.textures_left_out, 1u);
 }
 
 // The robot as the browser skins it: the model's skin joints, weights and
