@@ -1,7 +1,7 @@
 // web_clients URL N SECONDS: N WebSocket clients on a browser view's stream
 // (sandbox run --web), each reading for SECONDS; prints what they received:
-// the level's bytes, states and bytes a second per client (states and
-// scan samples apart). For
+// the level's bytes, states and bytes a second per client (states, scan
+// samples and camera frames apart). For
 // scripts/bench-web; it asserts nothing.
 
 #include <atomic>
@@ -23,7 +23,8 @@ namespace {
 using Client = websocketpp::client<websocketpp::config::asio_client>;
 
 struct Received {
-  std::atomic<std::int64_t> level_bytes{0}, states{0}, state_bytes{0}, sample_bytes{0};
+  std::atomic<std::int64_t> level_bytes{0}, states{0}, state_bytes{0}, sample_bytes{0},
+      camera_bytes{0};
   std::atomic<bool> open{false}, failed{false};
 };
 
@@ -56,6 +57,8 @@ int main(int argc, char** argv) {
       const std::string& payload = message->get_payload();
       if (payload.rfind("SMPL", 0) == 0) {
         r->sample_bytes += std::int64_t(payload.size());
+      } else if (payload.rfind("CAMF", 0) == 0) {
+        r->camera_bytes += std::int64_t(payload.size());
       } else if (payload.rfind("glTF", 0) == 0 || payload.rfind("{\"type\":\"level\"", 0) == 0) {
         r->level_bytes += std::int64_t(payload.size());
       } else {
@@ -78,20 +81,22 @@ int main(int argc, char** argv) {
   client.stop();
   thread.join();
   int opened = 0;
-  std::int64_t states = 0, bytes = 0, sample_bytes = 0, level = 0;
+  std::int64_t states = 0, bytes = 0, sample_bytes = 0, camera_bytes = 0, level = 0;
   for (const auto& r : received) {
     opened += r->open ? 1 : 0;
     states += r->states;
     bytes += r->state_bytes;
     sample_bytes += r->sample_bytes;
+    camera_bytes += r->camera_bytes;
     level = std::max<std::int64_t>(level, r->level_bytes);
   }
   std::printf(
       "web_clients: %d of %d connected, level %.2f MB, %.1f states/s and %.1f kB/s a client "
-      "(states %.1f kB/s, samples %.1f kB/s)\n",
+      "(states %.1f kB/s, samples %.1f kB/s, camera frames %.1f kB/s)\n",
       opened, count, double(level) / 1e6, double(states) / std::max(1, count) / seconds,
-      double(bytes + sample_bytes) / std::max(1, count) / seconds / 1e3,
+      double(bytes + sample_bytes + camera_bytes) / std::max(1, count) / seconds / 1e3,
       double(bytes) / std::max(1, count) / seconds / 1e3,
-      double(sample_bytes) / std::max(1, count) / seconds / 1e3);
+      double(sample_bytes) / std::max(1, count) / seconds / 1e3,
+      double(camera_bytes) / std::max(1, count) / seconds / 1e3);
   return opened == count ? 0 : 1;
 }

@@ -449,7 +449,6 @@ function resize() {
   }
 }
 
-const started = performance.now();
 function animate() {
   requestAnimationFrame(animate);
   if (pendingState !== null && !view.held) {
@@ -464,7 +463,8 @@ function animate() {
   if (!view.camera) controls.update();
   renderer.render(scene, camera);
   view.framesDrawn += 1;
-  if (view.firstFrameMs === null && view.levelLoaded) view.firstFrameMs = performance.now() - started;
+  // From the page's navigation (performance.now()'s origin) to its first frame with the level.
+  if (view.firstFrameMs === null && view.levelLoaded) view.firstFrameMs = performance.now();
 }
 connect();
 animate();
