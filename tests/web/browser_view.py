@@ -138,7 +138,7 @@ def main():
         green = sum(1 for r, g, b in pixels if g > r + 10 and g > b + 10) / len(pixels)
         assert green > 0.15, "green (grass) covers %.1f%% of the screenshot" % (100 * green)
         fps = (later["framesDrawn"] - first["framesDrawn"]) / seconds
-        print("browser view: level and first frame %.0f ms after the page opened (page's own "
+        print("browser view: level and first frame %.0f ms after the page's navigation (its own "
               "clock), %.1f frames/s in headless Chromium (software GL), %d states in %.0f s, "
               "wing moved %.1f m, grass %.0f%% of the screenshot"
               % (later["firstFrameMs"], fps, later["states"] - first["states"], seconds, moved,

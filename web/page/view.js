@@ -231,10 +231,20 @@ function surfaceColour(id, colour) {
   return colour.setHSL((id * 0.618034) % 1, 0.75, 0.55);
 }
 
+// Which samples are drawn (and picked): all, the hits only (an index of
+// them), or none.
+const shownSamples = document.getElementById('shown');
 function colourSamples(cloud) {
   const { hit, surface } = cloud.userData;
   const colours = cloud.geometry.getAttribute('color');
   const c = new THREE.Color();
+  if (shownSamples.value === 'hits') {
+    const hits = [];
+    for (let i = 0; i < hit.length; ++i) if (hit[i]) hits.push(i);
+    cloud.geometry.setIndex(hits);
+  } else {
+    cloud.geometry.setIndex(null);
+  }
   for (let i = 0; i < hit.length; ++i) {
     if (colourBy.value === 'surface') surfaceColour(surface[i], c);
     else if (hit[i]) c.setRGB(0.95, 0.2, 0.15);
@@ -242,6 +252,7 @@ function colourSamples(cloud) {
     colours.setXYZ(i, c.r, c.g, c.b);
   }
   colours.needsUpdate = true;
+  cloud.visible = shownSamples.value !== 'none' && !view.masked;
 }
 
 function showSamples(buffer) {
@@ -261,7 +272,7 @@ function showSamples(buffer) {
     let cloud = sampleClouds.get(key);
     if (!cloud) {
       cloud = new THREE.Points(new THREE.BufferGeometry(),
-                               new THREE.PointsMaterial({ size: 3, sizeAttenuation: false,
+                               new THREE.PointsMaterial({ size: 2, sizeAttenuation: false,
                                                           vertexColors: THREE.VertexColors }));
       cloud.name = 'samples:' + key;
       cloud.frustumCulled = false;
@@ -269,6 +280,7 @@ function showSamples(buffer) {
       scene.add(cloud);
     }
     cloud.geometry.setAttribute('position', new THREE.BufferAttribute(xyz, 3));
+    cloud.geometry.boundingSphere = null;  // recomputed for these (picking needs it)
     cloud.geometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
     cloud.position.set(header.origin[0], header.origin[1], header.origin[2]);
     cloud.userData = { hit, surface, set, tick: header.tick };
@@ -276,9 +288,13 @@ function showSamples(buffer) {
     seen.add(key);
     view.samples[key] = { count: n, hits: hit.reduce((a, b) => a + b, 0), tick: header.tick };
   }
-  for (const [key, cloud] of sampleClouds) cloud.visible = seen.has(key) && !view.masked;
+  for (const [key, cloud] of sampleClouds) {
+    cloud.visible = seen.has(key) && !view.masked && shownSamples.value !== 'none';
+  }
 }
-colourBy.addEventListener('change', () => { for (const cloud of sampleClouds.values()) colourSamples(cloud); });
+for (const select of [colourBy, shownSamples]) {
+  select.addEventListener('change', () => { for (const cloud of sampleClouds.values()) colourSamples(cloud); });
+}
 
 // The cameras: each one's frustum, 6 m deep, at the pose its latest frame
 // was rendered from, with that frame on its far end.
