@@ -94,7 +94,7 @@ class WebDriver:
 def main():
     sandbox = sys.argv[1]
     out = tempfile.mkdtemp(prefix="sandbox-browser-")
-    demo = subprocess.Popen([sandbox, "demo", "--web", "0", "--web-control", "--duration", "120",
+    demo = subprocess.Popen([sandbox, "demo", "--web", "0", "--web-control", "--duration", "300",
                              "--out", out],
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     lines = []
