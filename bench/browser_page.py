@@ -10,59 +10,46 @@ nothing.
 usage: browser_page.py SANDBOX FLY_WING LEVEL [SECONDS]
 """
 import os
-import re
 import signal
 import subprocess
 import sys
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "web"))
-from browser_view import WebDriver, free_port, wait_for, _answers  # noqa: E402
+from browser_view import Chromium, served, wait_for  # noqa: E402
 
 
 def measure(sandbox, fly_wing, level, seconds, flying):
     started = time.monotonic()
     run = subprocess.Popen([sandbox, "run", level, "--web", "0", "--duration", str(seconds + 60)],
                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    url = None
-    while url is None:
-        line = run.stdout.readline()
-        if not line:
-            raise SystemExit("browser_page: the sandbox ended before serving")
-        match = re.search(r"browser view at (http://\S+)", line)
-        url = match.group(1) if match else None
+    url = served(run).group(1)
     serving_s = time.monotonic() - started
     pilots = [subprocess.Popen([fly_wing, "--slot", slot, "--duration", str(seconds + 50)],
                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
               for slot in (("wing", "left", "right") if flying else ())]
-    port = free_port()
-    driver = subprocess.Popen(["/usr/bin/chromedriver", "--port=%d" % port],
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                              start_new_session=True)
-    browser = None
     try:
-        wait_for("chromedriver", lambda: _answers(port))
-        browser = WebDriver(port)
-        browser.go(url)
-        robots = 3 if flying else 0
-        wait_for("the level and %d robots" % robots, lambda: browser.run(
-            "const v = window.sandboxView; return v.firstFrameMs !== null && "
-            "Object.values(v.robots).filter((r) => r.has_pose).length >= %d" % robots))
-        first_ms = browser.run("return window.sandboxView.firstFrameMs")
-        a = browser.run("return window.sandboxView.framesDrawn")
-        time.sleep(seconds)
-        b = browser.run("return window.sandboxView.framesDrawn")
-        return serving_s, first_ms, (b - a) / seconds
+        with Chromium() as browser:
+            return page_figures(browser, url, 3 if flying else 0, seconds, serving_s)
     finally:
-        if browser is not None:
-            browser.quit()
-        os.killpg(driver.pid, signal.SIGKILL)
-        driver.wait()
         for pilot in pilots:
             pilot.kill()
             pilot.wait()
         run.send_signal(signal.SIGINT)
         run.communicate(timeout=60)
+
+
+def page_figures(browser, url, robots, seconds, serving_s):
+    """(serving, first frame, frames a second) of the page once `robots` fly."""
+    browser.go(url)
+    wait_for("the level and %d robots" % robots, lambda: browser.run(
+        "const v = window.sandboxView; return v.firstFrameMs !== null && "
+        "Object.values(v.robots).filter((r) => r.has_pose).length >= %d" % robots))
+    first_ms = browser.run("return window.sandboxView.firstFrameMs")
+    a = browser.run("return window.sandboxView.framesDrawn")
+    time.sleep(seconds)
+    b = browser.run("return window.sandboxView.framesDrawn")
+    return serving_s, first_ms, (b - a) / seconds
 
 
 def main():

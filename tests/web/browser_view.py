@@ -91,76 +91,58 @@ class WebDriver:
         self.call("DELETE", "/session/%s" % self.session)
 
 
+class Chromium:
+    """chromedriver and the headless Chromium it drives, as a context: the
+    WebDriver session on entry; on exit both are ended (chromedriver in a
+    process group of its own, so that the browser goes with it)."""
+
+    def __enter__(self):
+        port = free_port()
+        self.driver = subprocess.Popen(["/usr/bin/chromedriver", "--port=%d" % port],
+                                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                                       start_new_session=True)
+        self.browser = None
+        try:
+            wait_for("chromedriver", lambda: _answers(port))
+            self.browser = WebDriver(port)
+        except BaseException:
+            self.__exit__(None, None, None)
+            raise
+        return self.browser
+
+    def __exit__(self, *exc):
+        if self.browser is not None:
+            self.browser.quit()
+        os.killpg(self.driver.pid, signal.SIGKILL)
+        self.driver.wait()
+        return False
+
+
+def served(process, pattern=r"browser view at (http://\S+)"):
+    """The match of `pattern` in the lines `process` prints (its stdout, text)
+    up to the first that has it; AssertionError with them when it ends first."""
+    lines = []
+    while True:
+        line = process.stdout.readline()
+        if not line:
+            raise AssertionError("ended before serving:\n" + "".join(lines))
+        lines.append(line)
+        match = re.search(pattern, line)
+        if match:
+            return match
+
+
 def main():
     sandbox = sys.argv[1]
     out = tempfile.mkdtemp(prefix="sandbox-browser-")
     demo = subprocess.Popen([sandbox, "demo", "--web", "0", "--web-control", "--duration", "300",
                              "--out", out],
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    lines = []
-    url = None
-    while url is None:
-        line = demo.stdout.readline()
-        if not line:
-            raise AssertionError("the demo ended before serving:\n" + "".join(lines))
-        lines.append(line)
-        match = re.search(r"browser view at (http://\S+)", line)
-        url = match.group(1) if match else None
-    driver_port = free_port()
-    # In a process group of its own: the browser it starts goes with it.
-    driver = subprocess.Popen(["/usr/bin/chromedriver", "--port=%d" % driver_port],
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                              start_new_session=True)
-    browser = None
+    url = served(demo).group(1)
     try:
-        wait_for("chromedriver", lambda: _answers(driver_port))
-        browser = WebDriver(driver_port)
-        started = time.monotonic()
-        browser.go(url)
-        view = wait_for("the level and a posed wing", lambda: _ready(browser))
-        first = browser.run("return window.sandboxView")
-        time.sleep(3.0)
-        later = browser.run("return window.sandboxView")
-        seconds = 3.0
-        # States arrive and move on; the wing flies (the example flight is at
-        # 20 m/s and more: metres in 3 s).
-        assert later["tick"] > first["tick"] + 10, (first["tick"], later["tick"])
-        assert later["received"] > first["received"] + 10
-        assert later["states"] > first["states"]
-        a, b = first["robots"]["ELAHA"]["p"], later["robots"]["ELAHA"]["p"]
-        moved = sum((x - y) ** 2 for x, y in zip(a, b)) ** 0.5
-        assert moved > 5.0, "the wing moved %.2f m in 3 s" % moved
-        assert later["robots"]["ELAHA"]["has_pose"]
-        assert later["robots"]["ELAHA"]["rejected"] == 0
-        # The level is drawn: the sample level's ground is grass, green over red and blue.
-        image = browser.screenshot()
-        pixels = list(image.getdata())
-        green = sum(1 for r, g, b in pixels if g > r + 10 and g > b + 10) / len(pixels)
-        assert green > 0.15, "green (grass) covers %.1f%% of the screenshot" % (100 * green)
-        fps = (later["framesDrawn"] - first["framesDrawn"]) / seconds
-        print("browser view: level and first frame %.0f ms after the page's navigation (its own "
-              "clock), %.1f frames/s in headless Chromium (software GL), %d states in %.0f s, "
-              "wing moved %.1f m, grass %.0f%% of the screenshot"
-              % (later["firstFrameMs"], fps, later["states"] - first["states"], seconds, moved,
-                 100 * green))
-        checked, worst, picked = sample_checks(browser)
-        print("browser view: %d of the face scanner's hits checked against the level model the "
-              "page draws: each within %.1e m of its surfaces; a click picks sample %s"
-              % (checked, worst, picked))
-        camera_note = camera_frame(browser, out)
-        print("browser view: " + camera_note)
-        print("browser view: " + steer_trailing_camera(browser))
-        iou, tick, pixels = robot_overlap(browser, sandbox, out)
-        errors = browser.script_errors()
-        assert not errors, errors
-        print("browser view: the skinned wing at tick %d overlaps OSMesa's render from the same "
-              "camera with IoU %.3f (%d robot pixels)" % (tick, iou, pixels))
-        assert iou >= 0.95, "IoU %.3f" % iou
+        with Chromium() as browser:
+            check_demo(browser, sandbox, url, out)
     finally:
-        if browser is not None:
-            browser.quit()
-        os.killpg(driver.pid, signal.SIGKILL)
-        driver.wait()
         demo.send_signal(signal.SIGINT)
         rest, _ = demo.communicate(timeout=120)
     shutil.rmtree(out, ignore_errors=True)
@@ -169,6 +151,50 @@ def main():
     commands = re.search(r"commands: (\d+) taken, (\d+) refused", rest)
     assert commands and commands.group(1) == "3" and commands.group(2) == "0", rest
     print("sandbox: " + summary.group(0))
+
+
+def check_demo(browser, sandbox, url, out):
+    """What a user sees of the demo, each part checked (see the top)."""
+    browser.go(url)
+    wait_for("the level and a posed wing", lambda: _ready(browser))
+    first = browser.run("return window.sandboxView")
+    time.sleep(3.0)
+    later = browser.run("return window.sandboxView")
+    seconds = 3.0
+    # States arrive and move on; the wing flies (the example flight is at
+    # 20 m/s and more: metres in 3 s).
+    assert later["tick"] > first["tick"] + 10, (first["tick"], later["tick"])
+    assert later["received"] > first["received"] + 10
+    assert later["states"] > first["states"]
+    a, b = first["robots"]["ELAHA"]["p"], later["robots"]["ELAHA"]["p"]
+    moved = sum((x - y) ** 2 for x, y in zip(a, b)) ** 0.5
+    assert moved > 5.0, "the wing moved %.2f m in 3 s" % moved
+    assert later["robots"]["ELAHA"]["has_pose"]
+    assert later["robots"]["ELAHA"]["rejected"] == 0
+    # The level is drawn: the sample level's ground is grass, green over red and blue.
+    image = browser.screenshot()
+    pixels = list(image.getdata())
+    green = sum(1 for r, g, b in pixels if g > r + 10 and g > b + 10) / len(pixels)
+    assert green > 0.15, "green (grass) covers %.1f%% of the screenshot" % (100 * green)
+    fps = (later["framesDrawn"] - first["framesDrawn"]) / seconds
+    print("browser view: level and first frame %.0f ms after the page's navigation (its own "
+          "clock), %.1f frames/s in headless Chromium (software GL), %d states in %.0f s, "
+          "wing moved %.1f m, grass %.0f%% of the screenshot"
+          % (later["firstFrameMs"], fps, later["states"] - first["states"], seconds, moved,
+             100 * green))
+    checked, worst, picked = sample_checks(browser)
+    print("browser view: %d of the face scanner's hits checked against the level model the "
+          "page draws: each within %.1e m of its surfaces; a click picks sample %s"
+          % (checked, worst, picked))
+    camera_note = camera_frame(browser, out)
+    print("browser view: " + camera_note)
+    print("browser view: " + steer_trailing_camera(browser))
+    iou, tick, pixels = robot_overlap(browser, sandbox, out)
+    errors = browser.script_errors()
+    assert not errors, errors
+    print("browser view: the skinned wing at tick %d overlaps OSMesa's render from the same "
+          "camera with IoU %.3f (%d robot pixels)" % (tick, iou, pixels))
+    assert iou >= 0.95, "IoU %.3f" % iou
 
 
 def matrix_from_quaternion(q):
@@ -252,7 +278,7 @@ def sample_checks(browser):
     level's surfaces (the page's own model of it, by three.js's ray casting:
     independent of the sandbox's ray caster) and names a surface; a click on
     one picks it. Returns (hits checked, farthest from a surface, picked)."""
-    view = wait_for("the face scanner's hits", lambda: _samples(browser), seconds=100.0)
+    wait_for("the face scanner's hits", lambda: _samples(browser), seconds=100.0)
     browser.run("window.sandboxControl.hold(true)")
     drawn = browser.run("return window.sandboxView.framesDrawn")
     wait_for("a frame of the held state",
