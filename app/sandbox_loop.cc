@@ -532,6 +532,7 @@ web::StreamState SandboxLoop::WebState(const TickRecord& record, bool with_sampl
         for (int j = 0; j < 4; ++j) robot.joints.push_back(X_BN(i, j));
     }
     for (const bridge::ChannelStatus& channel : feed.Channels(tick_utime_)) {
+      robot.received += channel.received;
       robot.rejected += channel.rejected;
       if (channel.stale) robot.stale.push_back(channel.channel);
     }

@@ -21,6 +21,7 @@ std::string EncodeState(const StreamState& state) {
   for (const StreamState::Robot& robot : state.robots) {
     nlohmann::json r = BodyJson(robot);
     r["has_pose"] = robot.has_pose;
+    r["received"] = robot.received;
     r["rejected"] = robot.rejected;
     r["stale"] = robot.stale;
     r["bones"] = robot.bone_values;

@@ -20,6 +20,7 @@ struct StreamState {
   };
   struct Robot : Body {
     bool has_pose{false};            // a pose has arrived
+    std::int64_t received{0};        // inputs received so far (all its channels)
     std::int64_t rejected{0};        // inputs refused so far
     std::vector<std::string> stale;  // its input channels gone quiet
     std::vector<double> bone_values;  // flat, in bone-map order (RobotState::bone_values)

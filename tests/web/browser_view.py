@@ -171,6 +171,10 @@ def check_demo(browser, sandbox, url, out):
     assert moved > 5.0, "the wing moved %.2f m in 3 s" % moved
     assert later["robots"]["ELAHA"]["has_pose"]
     assert later["robots"]["ELAHA"]["rejected"] == 0
+    # Its inputs a second (pose and bones at 100 Hz from the example model).
+    rate = wait_for("the wing's input rate", lambda: browser.run(
+        "return window.sandboxView.robots.ELAHA.inputsPerSecond") or None)
+    assert rate > 20, rate
     # The level is drawn: the sample level's ground is grass, green over red and blue.
     image = browser.screenshot()
     pixels = list(image.getdata())

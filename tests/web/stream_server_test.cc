@@ -78,6 +78,7 @@ class RawSocket {
   }
   ~RawSocket() { close(fd_); }
   bool connected() const { return connected_; }
+  int fd() const { return fd_; }
   void Send(const std::string& bytes) {
     ASSERT_EQ(send(fd_, bytes.data(), bytes.size(), MSG_NOSIGNAL), ssize_t(bytes.size()));
   }
@@ -308,6 +309,59 @@ TEST(StreamServerTest, MessagesAreDroppedAndAnOversizedOneClosesTheConnection) {
   EXPECT_EQ(client.close_code_, 1009);  // message too big
   EXPECT_EQ(server.counts().closed_oversized, 1);
   EXPECT_EQ(server.counts().messages_dropped, 1);
+}
+
+// A message in fragments that never ends (no frame with FIN): closed once its
+// fragments pass the message limit, as an oversized message is.
+TEST(StreamServerTest, AFragmentedMessageWithoutEndIsClosedAtTheLimit) {
+  ServerOptions options = TestOptions();
+  options.max_message_bytes = 1024;
+  StreamServer server(options);
+  RawSocket socket(server.port());
+  socket.Send(kHandshake);
+  EXPECT_EQ(StatusLine(socket.ReadHeaders()), "HTTP/1.1 101 Switching Protocols");
+  // Masked frames of 100 bytes, FIN clear: a text frame, then continuations.
+  auto fragment = [](unsigned char opcode) {
+    std::string frame;
+    frame += char(opcode);    // FIN 0
+    frame += char(0x80 | 100);  // masked, 100 bytes
+    frame += std::string(4, '\0');  // a zero mask: the payload as it is
+    frame += std::string(100, 'x');
+    return frame;
+  };
+  socket.Send(fragment(0x1));
+  for (int i = 0; i < 20 && server.counts().closed_oversized == 0; ++i) {
+    if (send(socket.fd(), fragment(0x0).data(), 106, MSG_NOSIGNAL) != 106) break;
+    std::this_thread::sleep_for(10ms);
+  }
+  ASSERT_TRUE(WaitFor([&] { return server.counts().closed_oversized == 1; }));
+  EXPECT_EQ(server.counts().messages_dropped, 0);  // never a whole message
+  EXPECT_EQ(server.counts().clients, 0);
+}
+
+// With on_text (sandbox view, --web-control) a text message is a command:
+// taken or refused, counted; a binary one is still dropped.
+TEST(StreamServerTest, OnTextTakesOrRefusesEachTextMessage) {
+  ServerOptions options = TestOptions();
+  std::vector<std::string> taken;
+  std::mutex mutex;
+  options.on_text = [&](const std::string& text) -> std::string {
+    if (text != "good") return "not good";
+    std::lock_guard<std::mutex> lock(mutex);
+    taken.push_back(text);
+    return "";
+  };
+  StreamServer server(options);
+  StreamClient client(server.port());
+  ASSERT_TRUE(WaitFor([&] { return client.open_.load(); }));
+  client.Send("good");
+  client.Send("bad");
+  client.Send("good");
+  ASSERT_TRUE(WaitFor([&] { return server.counts().commands == 2; }));
+  ASSERT_TRUE(WaitFor([&] { return server.counts().commands_refused == 1; }));
+  std::lock_guard<std::mutex> lock(mutex);
+  EXPECT_EQ(taken, (std::vector<std::string>{"good", "good"}));
+  EXPECT_EQ(server.counts().messages_dropped, 0);
 }
 
 TEST(StreamServerTest, MalformedRequestsAndFramesAreRefusedAndCounted) {

@@ -131,6 +131,7 @@ function drawPlot() {
   }
 }
 
+const inputRates = new Map();  // robot -> { at, received, rate }
 function showState(state) {
   view.tick = state.tick;
   if (state.player) showPlayer(state.player, state.tick);
@@ -162,9 +163,21 @@ function showState(state) {
   }
   document.getElementById('status').textContent =
     `tick ${state.tick}  t ${state.t.toFixed(2)} s  tick ${state.tick_ms.toFixed(2)} ms  late ${state.late_ms.toFixed(2)} ms`;
-  document.getElementById('robots').innerHTML = state.robots.map((r) =>
-    `<tr><td>${r.name}</td><td>${r.has_pose ? 'posed' : 'no pose'}</td><td>${r.rejected} rejected</td>` +
-    `<td>${r.stale.length ? 'stale: ' + r.stale.join(' ') : ''}</td></tr>`).join('');
+  // Each robot's input rate: its inputs received over the last second or so of states.
+  const now = performance.now();
+  document.getElementById('robots').innerHTML = state.robots.map((r) => {
+    const seen = inputRates.get(r.name) || { at: now, received: r.received, rate: 0 };
+    if (now - seen.at >= 1000) {
+      seen.rate = ((r.received - seen.received) * 1000) / (now - seen.at);
+      seen.at = now;
+      seen.received = r.received;
+    }
+    inputRates.set(r.name, seen);
+    view.robots[r.name].inputsPerSecond = seen.rate;
+    return `<tr><td>${r.name}</td><td>${r.has_pose ? 'posed' : 'no pose'}</td>` +
+      `<td>${seen.rate.toFixed(0)} inputs/s</td><td>${r.rejected} rejected</td>` +
+      `<td>${r.stale.length ? 'stale: ' + r.stale.join(' ') : ''}</td></tr>`;
+  }).join('');
   history.push(state);
   if (history.length > 240) history.shift();
   drawPlot();
