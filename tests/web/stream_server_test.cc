@@ -391,17 +391,21 @@ TEST(StreamServerTest, AClientThatNeverReadsSkipsStatesThenIsDroppedAndOthersKee
   EXPECT_EQ(StatusLine(stuck.ReadHeaders()), "HTTP/1.1 101 Switching Protocols");
   StreamClient reader(server.port());
   ASSERT_TRUE(WaitFor([&] { return reader.open_.load(); }));
-  // Large states (1 MB each) until the stuck client is dropped.
+  // Large states (a small text, a 1 MB binary: cheap to make and to read, so
+  // a slow machine fills the stuck client's socket as soon) until it is dropped.
+  const auto samples = std::make_shared<const std::string>(1 << 20, '\x5a');
   std::int64_t tick = 0;
   const bool dropped = WaitFor([&] {
     StreamState state;
     state.tick = ++tick;
-    state.actors.resize(12000, StreamState::Body{std::string(40, 'a')});
-    server.Publish([state] { return EncodeState(state); });
+    server.Publish([text = EncodeState(state), samples] { return EncodedState(text, *samples); });
     std::this_thread::sleep_for(10ms);
     return server.counts().dropped_slow == 1;
   });
-  ASSERT_TRUE(dropped);
+  const ServerCounts counts = server.counts();
+  ASSERT_TRUE(dropped) << "published " << counts.states_published << ", sent "
+                       << counts.states_sent << ", skipped " << counts.states_skipped
+                       << ", bytes " << counts.bytes_sent;
   EXPECT_GT(server.counts().states_skipped, 0);
   EXPECT_GT(reader.Text().size(), 5u);
   EXPECT_TRUE(reader.open_ && !reader.closed_);
