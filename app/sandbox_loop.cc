@@ -88,6 +88,14 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
     prefixes.push_back(config.channel_prefix);
   }
   unknown_robots_ = std::make_unique<bridge::UnknownRobots>(link_, prefixes, &reject_log_);
+  if (log_) {
+    std::vector<bridge::RecordedRobot> recorded;
+    for (const bridge::RobotBridgeConfig& config : loaded_.bridges) {
+      recorded.push_back({config.channel_prefix, config.pose,
+                          config.state_in_pose_convention ? config.pose : bridge::Translation{}});
+    }
+    log_states_ = std::make_unique<bridge::StatesAsInputs>(std::move(recorded));
+  }
   for (const sensors::MountedSensor& mounted : loaded_.sensors) {
     sensors_.emplace_back(mounted);
     sensor_schedules_.emplace_back(mounted.spec.rate_hz);
@@ -301,8 +309,20 @@ bool SandboxLoop::NextLockstepInput(double wall_s, bool* wait) {
   std::vector<std::uint8_t> data;
   std::int64_t utime = 0;
   while (!has_pose() && log_->Next(&channel, &data, &utime)) {
-    link_.Inject(channel, data.data(), unsigned(data.size()));
-    link_.Drain();
+    log_feed_.clear();
+    const std::string refused = log_states_->Translate(channel, data, &log_feed_);
+    if (!refused.empty()) reject_log_.Note(channel, refused);
+    for (const bridge::LogEvent& event : log_feed_) {
+      link_.Inject(event.channel, event.data.data(), unsigned(event.data.size()));
+      link_.Drain();
+    }
+  }
+  const std::vector<std::string> from_states = log_states_->robots_from_states();
+  for (; robots_from_states_ < from_states.size(); ++robots_from_states_) {
+    const std::string& prefix = from_states[robots_from_states_];
+    err_ << "\rsandbox: " << options_.replay_file << " holds what a run applied (" << prefix
+         << "/STATE before any " << prefix << "/POSE): its states are replayed as " << prefix
+         << "'s POSE and BONES\n";
   }
   if (!has_pose()) return false;  // the log has ended
   if (wall_s >= next_progress_s_) {

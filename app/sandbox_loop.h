@@ -39,6 +39,7 @@
 #include "app/tick_stats.h"
 #include "bridge/lcm_link.h"
 #include "bridge/outputs.h"
+#include "bridge/recorded_states.h"
 #include "bridge/reject_log.h"
 #include "bridge/robot_feed.h"
 #include "bridge/unknown_robots.h"
@@ -132,6 +133,9 @@ class SandboxLoop {
   StopRequest stop_;
   // The replayed log and the link before the level: a bad file or URL fails at once.
   std::unique_ptr<bridge::LogReader> log_;
+  std::unique_ptr<bridge::StatesAsInputs> log_states_;  // a --record log's STATEs as inputs
+  std::vector<bridge::LogEvent> log_feed_;
+  std::size_t robots_from_states_{0};  // said so far
   bridge::LcmLink link_;
   const LoadedLevel loaded_;
   const scene::Level& level_{loaded_.level};

@@ -11,6 +11,9 @@
 #include <set>
 #include <sstream>
 
+#include "sandbox_msgs/bone_values_t.hpp"
+#include "sandbox_msgs/robot_pose_t.hpp"
+#include "sandbox_msgs/robot_state_t.hpp"
 #include "tests/app/flight_log.h"
 #include "tests/app/run_sandbox.h"
 #include "tests/test_util.h"
@@ -122,6 +125,96 @@ TEST(ReplayTest, InputTimeThatJumpsBackOrIsNegativeKeepsTheSensorsOnTheTickSched
   EXPECT_EQ(run.out.find("jumped back"), std::string::npos) << run.out;
   EXPECT_EQ(MessagesOn(out, "ELAHA/RANGE"), 50);
   EXPECT_EQ(MessagesOn(out, "ELAHA/SCAN_FACE"), 50);
+}
+
+template <typename Message>
+std::vector<std::uint8_t> Encode(Message& message) {
+  std::vector<std::uint8_t> bytes(std::size_t(message.getEncodedSize()));
+  message.encode(bytes.data(), 0, int(bytes.size()));
+  return bytes;
+}
+
+// Every message on `channel` of an LCM log, decoded.
+template <typename Message>
+std::vector<Message> Decoded(const std::string& path, const std::string& channel) {
+  std::vector<Message> messages;
+  lcm::LogFile log(path, "r");
+  EXPECT_TRUE(log.good()) << path;
+  while (const lcm::LogEvent* event = log.readNextEvent()) {
+    if (event->channel != channel) continue;
+    messages.emplace_back();
+    EXPECT_EQ(messages.back().decode(event->data, 0, event->datalen), event->datalen);
+  }
+  return messages;
+}
+
+// A --record log holds what the run applied (STATE), not its inputs: its
+// replay takes each STATE as the robot's BONES and POSE, so the replayed run
+// applies the first run's inputs again (checked against the poses and bone
+// values this test wrote) and its sensors scan exactly as the first run's did.
+TEST(ReplayTest, ARecordedRunIsReplayedFromItsStates) {
+  sandbox::testing::TempDir dir;
+  const std::string inputs = (dir.path() / "inputs.lcmlog").string();
+  WriteFlightLog(inputs, 60);
+  // The wing's 45 bone values, bending a little more each pose.
+  const auto poses = Decoded<sandbox_msgs::robot_pose_t>(inputs, "ELAHA/POSE");
+  ASSERT_EQ(poses.size(), 60u);
+  auto bend = [](std::size_t i, int k) { return 0.002 * double(i) * std::sin(1.0 + k); };
+  {
+    lcm::LogFile log(inputs, "w");
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      sandbox_msgs::bone_values_t bones{};
+      bones.utime = poses[i].utime;
+      bones.seq = std::int64_t(i);
+      bones.num_values = 45;
+      for (int k = 0; k < 45; ++k) bones.values.push_back(bend(i, k));
+      sandbox_msgs::robot_pose_t pose = poses[i];
+      for (const auto& [channel, bytes] : {std::pair{std::string("ELAHA/BONES"), Encode(bones)},
+                                           std::pair{std::string("ELAHA/POSE"), Encode(pose)}}) {
+        lcm::LogEvent event{};
+        event.timestamp = pose.utime;
+        event.channel = channel;
+        event.datalen = std::int32_t(bytes.size());
+        event.data = const_cast<std::uint8_t*>(bytes.data());
+        ASSERT_EQ(log.writeEvent(&event), 0);
+      }
+    }
+  }
+  const std::string first = (dir.path() / "first.lcmlog").string(),
+                    second = (dir.path() / "second.lcmlog").string();
+  auto run = RunSandbox("run --replay " + inputs + " --record " + first + " --out " +
+                        (dir.path() / "a").string() + " --scans-every 0.2 --frames none");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_EQ(run.out.find("holds what a run applied"), std::string::npos) << run.out;
+  run = RunSandbox("run --replay " + first + " --record " + second + " --out " +
+                   (dir.path() / "b").string() + " --scans-every 0.2 --frames none");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("holds what a run applied (ELAHA/STATE before any ELAHA/POSE): its "
+                         "states are replayed as ELAHA's POSE and BONES"),
+            std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("sandbox run: 60 ticks"), std::string::npos) << run.out;
+
+  const auto states = Decoded<sandbox_msgs::robot_state_t>(second, "ELAHA/STATE");
+  ASSERT_EQ(states.size(), poses.size());
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    EXPECT_EQ(states[i].utime, poses[i].utime) << i;
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(states[i].position[k], poses[i].position[k], 1e-9);
+    for (int k = 0; k < 4; ++k) {
+      EXPECT_NEAR(states[i].orientation[k], poses[i].orientation[k], 1e-12) << i;
+    }
+    ASSERT_EQ(states[i].num_values, 45) << i;
+    for (int k = 0; k < 45; ++k)
+      EXPECT_NEAR(states[i].bone_values[std::size_t(k)], bend(i, k), 1e-12);
+  }
+  EXPECT_EQ(MessagesOn(second, "ELAHA/SCAN_FACE"), 60);
+  int scans = 0;
+  for (const auto& entry : fs::directory_iterator(dir.path() / "a" / "scans")) {
+    ++scans;
+    EXPECT_EQ(Read(entry.path()), Read(dir.path() / "b" / "scans" / entry.path().filename()))
+        << entry.path().filename();
+  }
+  EXPECT_GE(scans, 5);
 }
 
 TEST(ReplayTest, TopicsOfALogGiveTypeRateSizeAndBandwidthAsTableOrJson) {

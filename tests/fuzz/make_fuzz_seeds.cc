@@ -28,6 +28,7 @@
 #include "sandbox_msgs/bone_values_t.hpp"
 #include "sandbox_msgs/camera_command_t.hpp"
 #include "sandbox_msgs/robot_pose_t.hpp"
+#include "sandbox_msgs/robot_state_t.hpp"
 #include "sandbox_msgs/scan_face_compact_t.hpp"
 #include "sandbox_msgs/status_t.hpp"
 #include "sandbox_msgs/surface_table_t.hpp"
@@ -149,6 +150,18 @@ void LogSeeds(const fs::path& dir) {
     log.Write("ELAHA/POSE", bytes.data(), unsigned(bytes.size()), 1000 * i);
   }
   log.Close();
+  // A --record log's STATEs, of the robot the target replays from its states.
+  sandbox::bridge::LogWriter recorded((dir / "recorded").string());
+  sandbox_msgs::robot_state_t state{};
+  state.orientation[0] = 1;
+  state.num_values = 2;
+  state.bone_values = {0.5, -0.5};
+  for (int i = 0; i < 3; ++i) {
+    state.seq = i;
+    const Bytes bytes = Encode(state);
+    recorded.Write("R/STATE", bytes.data(), unsigned(bytes.size()), 1000 * i);
+  }
+  recorded.Close();
 }
 
 // PNG's CRC-32, for the zip below.

@@ -118,10 +118,11 @@ class Chromium:
         return False
 
 
-def served(process, pattern=r"browser view at (http://\S+)"):
+def served(process, pattern=r"browser view at (http://\S+)", lines=None):
     """The match of `pattern` in the lines `process` prints (its stdout, text)
-    up to the first that has it; AssertionError with them when it ends first."""
-    lines = []
+    up to the first that has it, those lines appended to `lines`;
+    AssertionError with them when it ends first."""
+    lines = [] if lines is None else lines
     while True:
         line = process.stdout.readline()
         if not line:

@@ -6,7 +6,9 @@ on it, opens the page through chromedriver and drives its player: a jump to a
 tick shows that tick's pose (the log's own POSE message of that index, read
 here from the file: lock-step, tick N is the N-th pose), the slider moved by
 hand jumps there too, play moves the ticks on at about the chosen speed, pause
-holds them; a bad command is refused and counted.
+holds them; a bad command is refused and counted. Then the same flight's
+`sandbox run --replay --record` log (STATE messages, no POSE): `sandbox view`
+replays its states as inputs, and its ticks show the flight's poses again.
 
 usage: recorded_view.py SANDBOX FLY_WING
 """
@@ -43,28 +45,63 @@ def poses(log):
     return out
 
 
+def serve(sandbox, log, lines=None):
+    """`sandbox view LOG` serving: the process and its line's match (ticks, url)."""
+    view = subprocess.Popen([sandbox, "view", log, "--web", "0"], stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True)
+    return view, served(view, r"(\d+) ticks of .* at (http://\S+)", lines)
+
+
+def finish(view):
+    view.send_signal(signal.SIGINT)
+    rest, _ = view.communicate(timeout=60)
+    return rest
+
+
 def main():
     sandbox, fly_wing = sys.argv[1], sys.argv[2]
     work = tempfile.mkdtemp(prefix="sandbox-recorded-")
-    log = os.path.join(work, "flight.lcmlog")
-    subprocess.run([fly_wing, "--write-log", log, "--duration", "20", "--rate", "100"],
-                   check=True, stdout=subprocess.DEVNULL)
-    expected = poses(log)
-    assert len(expected) == 2000, len(expected)
-    view = subprocess.Popen([sandbox, "view", log, "--web", "0"], stdout=subprocess.PIPE,
-                            stderr=subprocess.STDOUT, text=True)
-    match = served(view, r"(\d+) ticks of .* at (http://\S+)")
-    assert int(match.group(1)) == len(expected), match.group(0)
     try:
-        with Chromium() as browser:
-            play(browser, match.group(2), expected)
+        log = os.path.join(work, "flight.lcmlog")
+        subprocess.run([fly_wing, "--write-log", log, "--duration", "20", "--rate", "100"],
+                       check=True, stdout=subprocess.DEVNULL)
+        expected = poses(log)
+        assert len(expected) == 2000, len(expected)
+        view, match = serve(sandbox, log)
+        try:
+            assert int(match.group(1)) == len(expected), match.group(0)
+            with Chromium() as browser:
+                play(browser, match.group(2), expected)
+        finally:
+            rest = finish(view)
+        match = re.search(r"commands: (\d+) taken, (\d+) refused", rest)
+        assert match and int(match.group(1)) == 7 and int(match.group(2)) == 1, rest
+        print("sandbox view: " + match.group(0))
+
+        recorded = os.path.join(work, "recorded.lcmlog")
+        subprocess.run([sandbox, "run", "--replay", log, "--record", recorded, "--frames",
+                        "none"], check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        assert not poses(recorded), "a --record log holds no POSE"
+        replayed = []
+        view, match = serve(sandbox, recorded, replayed)
+        try:
+            assert int(match.group(1)) == len(expected), match.group(0)
+            with Chromium() as browser:
+                browser.go(match.group(2))
+                for tick in (1500, 3):
+                    browser.run("window.sandboxControl.player({seek: %d})" % tick)
+                    p = wait_for("tick %d of the recorded log" % tick, lambda: browser.run(
+                        "const v = window.sandboxView; return v.tick === %d && v.robots.ELAHA "
+                        "&& v.robots.ELAHA.p" % tick))
+                    error = max(abs(a - b) for a, b in zip(p, expected[tick]))
+                    assert error < 1e-6, (tick, p, expected[tick])
+        finally:
+            rest = finish(view)
+        replayed = "".join(replayed)
+        assert "its states are replayed as ELAHA's POSE and BONES" in replayed, replayed
+        print("sandbox view of the --record log: 2 jumps showed the flight's pose at each tick")
     finally:
-        view.send_signal(signal.SIGINT)
-        rest, _ = view.communicate(timeout=60)
         shutil.rmtree(work, ignore_errors=True)
-    match = re.search(r"commands: (\d+) taken, (\d+) refused", rest)
-    assert match and int(match.group(1)) == 7 and int(match.group(2)) == 1, rest
-    print("sandbox view: " + match.group(0))
 
 
 def play(browser, url, expected):
