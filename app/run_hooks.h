@@ -19,8 +19,10 @@ struct RunHooks {
   // test slows given ticks here).
   std::function<void(std::int64_t tick)> end_of_tick;
   // Called after each tick with the browser view's state of it (`sandbox view`
-  // keeps them).
+  // keeps them), with the sensors' samples once every web_samples_every_s of
+  // the run's time.
   std::function<void(web::StreamState&& state)> web_state;
+  double web_samples_every_s{1.0};
   // Called before the link closes: let go of what before_tick subscribed.
   std::function<void(bridge::LcmLink& link)> before_close;
 };

@@ -240,7 +240,7 @@ int SandboxLoop::Run() {
     if (web_ && web_->WantsState()) PublishWebState(record, seconds_since_start(Clock::now()));
     if (hooks_.web_state) {
       const bool due = tick_time_s_ >= recorded_samples_due_s_;
-      if (due) recorded_samples_due_s_ = tick_time_s_ + 1.0 / kWebSamplesHz;
+      if (due) recorded_samples_due_s_ = tick_time_s_ + hooks_.web_samples_every_s;
       hooks_.web_state(WebState(record, due));
     }
     KeepOriginNearRobot();  // between ticks: the next tick's rays see the new origin

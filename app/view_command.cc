@@ -21,9 +21,10 @@ namespace {
 
 const char* kUsage =
     "usage: sandbox view LOG [--level LEVEL] [--web [ADDR:]PORT] [--isolate]\n"
-    "  LOG       an LCM log of a run's inputs (lcm-logger, fly_wing --write-log), replayed in\n"
-    "            lock-step first (with a progress line), then shown in the browser view with\n"
-    "            a player: play, pause, speed, a time slider, a jump to a tick\n"
+    "  LOG       an LCM log of a run's inputs (lcm-logger, fly_wing --write-log) or a run's\n"
+    "            --record log (its STATE messages replayed as inputs), replayed in lock-step\n"
+    "            first (with a progress line), then shown in the browser view with a player:\n"
+    "            play, pause, speed, a time slider, a jump to a tick\n"
     "  --level   the level it was flown in (default: the bundled sample level)\n"
     "  --web     where to serve it (default 127.0.0.1 and any free port; the address is\n"
     "            printed); docs/reference/web.md\n"
@@ -31,16 +32,15 @@ const char* kUsage =
     "Keeps every tick's poses and joints, and the sensors' samples once a second of the\n"
     "log's time (about 35 MB a minute of a 100 Hz flight of the sample level).\n";
 
-// The replayed run: each tick's state, and the ones whose samples are kept.
+// The replayed run: each tick's state, and the ones with their samples (the
+// loop sends samples once every RunHooks::web_samples_every_s).
 struct Recording {
   std::vector<web::StreamState> states;  // samples dropped, see below
   std::vector<std::size_t> sample_ticks;  // ticks whose samples are kept, in order
   std::vector<web::StreamState> samples;  // the states of those ticks, with their samples
-  double next_samples_s{0.0};
 
   void Add(web::StreamState&& state) {
-    if (state.has_samples && state.time_s >= next_samples_s) {
-      next_samples_s = state.time_s + 1.0;
+    if (state.has_samples) {
       sample_ticks.push_back(states.size());
       samples.push_back(state);
     }
@@ -91,10 +91,12 @@ int RunView(const std::vector<std::string>& args, std::ostream& out, std::ostrea
     Recording recording;
     RunHooks hooks;
     hooks.web_state = [&recording](web::StreamState&& state) { recording.Add(std::move(state)); };
+    hooks.web_samples_every_s = 1.0;  // the usage's "once a second of the log's time"
     SandboxLoop loop(options, hooks, out, err);
     if (loop.Run() != 0) return 1;
     if (recording.states.empty()) {
-      err << "sandbox view: " << options.replay_file << ": no pose to replay\n";
+      err << "sandbox view: " << options.replay_file
+          << ": no pose to replay (no <robot>/POSE or <robot>/STATE of this level's robots)\n";
       return 1;
     }
     std::vector<double> times;

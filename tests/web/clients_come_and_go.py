@@ -25,6 +25,9 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from browser_view import served  # noqa: E402
+
 
 def rss_kib(pid):
     with open("/proc/%d/status" % pid) as status:
@@ -36,15 +39,7 @@ def rss_kib(pid):
 
 def start_serving(args):
     process = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    lines = []
-    while True:
-        line = process.stdout.readline()
-        if not line:
-            raise AssertionError("ended before serving:\n" + "".join(lines))
-        lines.append(line)
-        match = re.search(r"browser view at http://([^/\s]+)/", line)
-        if match:
-            return process, match.group(1)
+    return process, served(process, r"browser view at http://([^/\s]+)/").group(1)
 
 
 def stop(process):
