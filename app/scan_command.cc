@@ -115,21 +115,6 @@ double Positive(const std::string& text, const std::string& option) {
 
 // The lidar of `sandbox scan`: the manifest's lidar keys given on the command
 // line (their defaults without), refused naming the key.
-sensors::LidarConfig LidarSettings(const std::string& text) {
-  try {
-    const scene::SettingsTable table = scene::ParseSettingsText(text, "--lidar", "lidar");
-    scene::SettingsReader read(table);
-    sensors::LidarConfig config = sensors::LidarConfig::Read(read);
-    read.RejectUnknownKeys("lidar");
-    config.ValidateOrThrow();
-    return config;
-  } catch (const scene::LevelError& error) {
-    throw UsageError(error.what());
-  } catch (const std::invalid_argument& error) {
-    throw UsageError(std::string("--lidar: ") + error.what());
-  }
-}
-
 }  // namespace
 
 int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
@@ -175,7 +160,12 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       throw UsageError("--lidar sets the lidar: give --sensor lidar");
     }
     // Checked before the level loads.
-    const sensors::LidarConfig lidar_config = LidarSettings(parsed->Value("--lidar"));
+    sensors::LidarConfig lidar_config;
+    try {
+      lidar_config = sensors::LidarConfig::FromText(parsed->Value("--lidar"), "--lidar");
+    } catch (const std::invalid_argument& error) {
+      throw UsageError(error.what());
+    }
 
     const LoadedLevel loaded = LoadCheckedLevel(
         level_file, {},
@@ -262,7 +252,7 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
         const std::size_t c = i / std::size_t(scan.azimuth_steps);
         const std::size_t k = i % std::size_t(scan.azimuth_steps);
         std::ostringstream range;
-        range << "," << scan.range_m[i];
+        range << std::setprecision(10) << "," << scan.range_m[i];
         if (bright) range << "," << scan.intensity[i];
         if (lasts) range << "," << scan.last_range_m[i] << "," << scan.last_surface[i];
         if (lasts && bright) range << "," << scan.last_intensity[i];
@@ -275,7 +265,7 @@ int RunScan(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       const sensors::RangeReading reading = sensors::MeasureRange({}, world, caster, filter, X_WS);
       header = "hit,x,y,z,range";
       std::ostringstream range;
-      range << "," << reading.range_m;
+      range << std::setprecision(10) << "," << reading.range_m;
       samples.push_back({std::to_string(int(reading.hit)) + ",", reading.hit, reading.point_W,
                          range.str(), reading.surface, reading.normal_W.cast<float>()});
     }

@@ -5,6 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "scene/manifest.h"
 #include "sensors/lidar_returns.h"
 
 namespace sandbox::sensors {
@@ -375,6 +376,21 @@ void Lidar::Sweep(const scene::CollisionWorld& world, RayCaster& caster, const R
   scan->time_s.resize(std::size_t(config_.azimuth_steps));
   for (int k = 0; k < config_.azimuth_steps; ++k) {
     scan->time_s[std::size_t(k)] = k / (config_.azimuth_steps * config_.rotation_hz);
+  }
+}
+
+LidarConfig LidarConfig::FromText(const std::string& text, const std::string& origin) {
+  try {
+    const scene::SettingsTable table = scene::ParseSettingsText(text, origin, "lidar");
+    scene::SettingsReader read(table);
+    LidarConfig config = Read(read);
+    read.RejectUnknownKeys("lidar");
+    config.ValidateOrThrow();
+    return config;
+  } catch (const scene::LevelError& error) {
+    throw std::invalid_argument(error.what());
+  } catch (const std::invalid_argument& error) {
+    throw std::invalid_argument(origin + ": " + error.what());
   }
 }
 

@@ -67,6 +67,10 @@ struct LidarConfig {
   // The [[robot.sensor]] table's own keys (docs/reference/levels.md); throws scene::LevelError
   // naming the key.
   static LidarConfig Read(scene::SettingsReader& read);
+  // The same keys as TOML on one line ("channels = 32, seed = 7": sandbox
+  // scan --lidar, Python), validated; `origin` names the source in messages.
+  // Throws std::invalid_argument: "--lidar: ..." naming the key.
+  static LidarConfig FromText(const std::string& text, const std::string& origin);
   std::string Summary() const;  // "16x1024, 100 m"
 };
 
