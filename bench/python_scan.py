@@ -1,7 +1,7 @@
 #!/usr/bin/python3
-"""A face scan through Python against the same scan from C++ in one process
-(target: at most 1.05x), and the arrays' data pointers against the scan's own
-buffers (zero copies).
+"""A face scan and a render through Python against the same from C++ in one
+process (target: at most 1.05x each), and the arrays' data pointers against
+the scan's own buffers (zero copies).
 
 usage: PYTHONPATH=build/python bench/python_scan.py [ROUNDS]   (default 7)
 """
@@ -36,6 +36,22 @@ def main():
         n = int(round(2 * half_extent / resolution)) + 1
         ratios.sort()
         print("%-30s %12.3f %12.3f %8.3f" % ("6 x %d x %d, %g m" % (n, n, resolution),
+                                             1e3 * cpp, 1e3 * python, ratios[len(ratios) // 2]))
+    print("%-30s %12s %12s %8s" % ("render (fixed camera, high)", "C++ ms", "Python ms", "ratio"))
+    for width, height in ((320, 240), (640, 480)):
+        ratios = []
+        for _ in range(rounds):
+            cpp = world._time_render((-40, -60, 35), width, height, 5)
+            python = float("inf")
+            for _ in range(5):
+                start = time.perf_counter()
+                frame = world.render("fixed", (-40, -60, 35), width=width, height=height,
+                                     kinds="color,depth")
+                frame.color, frame.depth  # the arrays, made
+                python = min(python, time.perf_counter() - start)
+            ratios.append(python / cpp)
+        ratios.sort()
+        print("%-30s %12.3f %12.3f %8.3f" % ("colour and depth, %d x %d" % (width, height),
                                              1e3 * cpp, 1e3 * python, ratios[len(ratios) // 2]))
     lidar = world.lidar_scan((0, 0, 30))
     same = (lidar.range.__array_interface__["data"][0] == lidar._addresses()["range"] and

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "app/defaults.h"
+#include "app/images.h"
 #include "app/loaded_level.h"
 #include "scene/collision_world.h"
 #include "scene/robot_state.h"
@@ -29,6 +30,8 @@
 #include "sensors/ground_scanner.h"
 #include "sensors/lidar.h"
 #include "sensors/range_sensor.h"
+#include "sensors/render/cameras.h"
+#include "sensors/render/renderer.h"
 
 namespace py = pybind11;
 
@@ -131,6 +134,9 @@ struct GroundScanResult {
 };
 struct LidarScanResult {
   sensors::LidarScan scan;
+};
+struct FrameResult {
+  render::Frame frame;
 };
 
 class World {
@@ -274,6 +280,69 @@ class World {
     return result;
   }
 
+  FrameResult Render(const std::string& camera, const py::object& position,
+                     const py::handle& orientation, const std::optional<std::string>& robot,
+                     int width, int height, double fov, const std::string& kinds,
+                     const std::string& quality) {
+    render::RenderSettings settings = render::RenderSettings::Preset(render::ParseQuality(quality));
+    settings.images = render::ParseImageKinds(kinds);
+    render::CameraView view;
+    if (width < 1 || width > 16384 || height < 1 || height > 16384) {
+      throw py::value_error("width and height must be 1 to 16384, got " + std::to_string(width) +
+                            " x " + std::to_string(height));
+    }
+    view.width = width;
+    view.height = height;
+    view.fov_y_rad = fov * M_PI / 180.0;
+    if (camera == "fixed") {
+      if (position.is_none()) throw py::value_error("a fixed camera needs its position");
+      view.X_WC = Pose(position, orientation);
+    } else if (camera == "chase" || camera == "trailing" || camera == "payload") {
+      if (!position.is_none()) {
+        throw py::value_error("a " + camera +
+                              " camera follows its robot: give robot, not position");
+      }
+      if (states_.empty())
+        throw py::value_error("a " + camera + " camera needs a robot; the level has none");
+      const Eigen::Isometry3d X_WB = states_[std::size_t(robot ? Robot(*robot) : 0)]->pose();
+      view.X_WC = camera == "chase"      ? render::ChaseCamera({}).Update(X_WB, 0.0)
+                  : camera == "trailing" ? render::TrailingPose(X_WB, 25.0, 8.0, {})
+                                         : X_WB;
+    } else {
+      throw py::value_error("camera must be 'fixed', 'chase', 'trailing' or 'payload', got '" +
+                            camera + "'");
+    }
+    if (loaded_.level.terrain) view.far_m = 1.0e6;
+    view.ValidateOrThrow();
+    FrameResult result;
+    py::gil_scoped_release release;
+    RenderInto(view, settings, &result.frame);
+    return result;
+  }
+
+  // A fixed camera's colour and depth at `position` (looking along x),
+  // `repeats` times in C++ alone: the best time of one, in seconds (for
+  // bench/python_scan.py, against render from Python).
+  double TimeRender(const py::handle& position, int width, int height, int repeats) {
+    render::RenderSettings settings = render::RenderSettings::Preset(render::Quality::kHigh);
+    settings.images = render::kColorImage | render::kDepthImage;
+    render::CameraView view;
+    view.width = width;
+    view.height = height;
+    view.X_WC = Pose(position, py::make_tuple(1, 0, 0, 0));
+    view.ValidateOrThrow();
+    py::gil_scoped_release release;
+    double best = 1e300;
+    for (int i = 0; i < repeats; ++i) {
+      const auto start = std::chrono::steady_clock::now();
+      render::Frame frame;
+      RenderInto(view, settings, &frame);
+      best = std::min(
+          best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    }
+    return best;
+  }
+
   // The same face scan as FaceScan's, `repeats` times in C++ alone (no
   // Python objects, no arrays): the best time of one, in seconds. For
   // bench/python_scan.py, which compares it with face_scan from Python.
@@ -355,6 +424,28 @@ class World {
     }
   }
 
+  // Draws the level and the robots as posed, alone (the robots' skins are
+  // brought up to date, and one renderer draws one frame at a time).
+  void RenderInto(const render::CameraView& view, const render::RenderSettings& settings,
+                  render::Frame* frame) {
+    std::unique_lock<std::shared_mutex> lock(mutex_);
+    if (!renderer_) {
+      renderer_ = render::MakeRenderer();
+      renderer_->SetLevel(loaded_.level, app::OpenCvTextureDecoder(loaded_.level.limits));
+    }
+    if (terrain_) {
+      terrain_->Update({view.X_WC.translation()}, 0.0, &world_, scene::TerrainStreamer::Wait::kAll);
+      terrain_->TakeMessages();
+      renderer_->SetTerrain(terrain_->drawn());
+    }
+    std::vector<const scene::RobotState*> robots;
+    for (const auto& state : states_) {
+      state->Skin();
+      robots.push_back(state.get());
+    }
+    renderer_->Render(view, {}, robots, settings, frame);
+  }
+
   const app::LoadedLevel loaded_;
   scene::CollisionWorld world_;
   std::vector<std::unique_ptr<scene::RobotState>> states_;
@@ -362,6 +453,7 @@ class World {
   mutable std::shared_mutex mutex_;  // scans share the world; poses and tiles change it
   std::mutex caster_mutex_;
   sensors::RayCaster caster_;
+  std::unique_ptr<render::Renderer> renderer_;  // made at the first render
 };
 
 }  // namespace
@@ -528,6 +620,43 @@ PYBIND11_MODULE(sandbox, module) {
           },
           "float32 (channels, steps) view, 0 to 1, or None without 'intensity = true'");
 
+  py::class_<FrameResult>(module, "Frame", "A camera's images, row 0 at the top.")
+      .def_property_readonly("width", [](const FrameResult& f) { return f.frame.width; })
+      .def_property_readonly("height", [](const FrameResult& f) { return f.frame.height; })
+      .def_property_readonly(
+          "color",
+          [](py::object self) -> py::object {
+            const auto& f = self.cast<const FrameResult&>().frame;
+            if (f.rgb.empty()) return py::none();
+            return View(f.rgb.data(), {f.height, f.width, 3}, self);
+          },
+          "uint8 (height, width, 3) view, RGB; None when not asked for")
+      .def_property_readonly(
+          "depth",
+          [](py::object self) -> py::object {
+            const auto& f = self.cast<const FrameResult&>().frame;
+            if (f.depth_m.empty()) return py::none();
+            return View(f.depth_m.data(), {f.height, f.width}, self);
+          },
+          "float32 (height, width) view: metres along the optical axis, inf where sky")
+      .def_property_readonly(
+          "segmentation",
+          [](py::object self) -> py::object {
+            const auto& f = self.cast<const FrameResult&>().frame;
+            if (f.segment.empty()) return py::none();
+            return View(f.segment.data(), {f.height, f.width}, self);
+          },
+          "uint32 (height, width) view: the surface id seen (World.surfaces()), 0 sky")
+      .def_property_readonly(
+          "normals",
+          [](py::object self) -> py::object {
+            const auto& f = self.cast<const FrameResult&>().frame;
+            if (f.normal_C.empty()) return py::none();
+            return View(f.normal_C.data(), {f.height, f.width, 3}, self);
+          },
+          "float32 (height, width, 3) view: unit normals, camera frame (x forward, y left, z "
+          "up); 0 where sky");
+
   py::class_<World>(module, "World",
                     "A level loaded in-process (a manifest or a scene file; default: the "
                     "bundled sample level), its robots at their spawn poses.")
@@ -556,6 +685,18 @@ PYBIND11_MODULE(sandbox, module) {
            py::arg("see_robots") = false,
            "A lidar sweep at a pose; settings: the manifest's lidar keys as TOML on one line, "
            "e.g. 'channels = 32, seed = 7' (default 16 x 1024, -15..15 degrees, 100 m).")
+      .def("render", &World::Render, py::arg("camera") = "fixed", py::arg("position") = py::none(),
+           py::arg("orientation") = std::vector<double>{1, 0, 0, 0}, py::arg("robot") = py::none(),
+           py::arg("width") = 640, py::arg("height") = 480, py::arg("fov") = 60.0,
+           py::arg("kinds") = "color", py::arg("quality") = "high",
+           "A camera's images as numpy (as sandbox render): 'fixed' at position and orientation "
+           "(x forward, y left, z up), or 'chase', 'trailing', 'payload' following a robot as "
+           "posed (default the first); kinds: a comma list of color, depth, segmentation, "
+           "normals; quality: fast, high or plain.")
+      .def("_time_render", &World::TimeRender, py::arg("position"), py::arg("width"),
+           py::arg("height"), py::arg("repeats"),
+           "The best of `repeats` renders (colour and depth) timed in C++ alone, seconds (for "
+           "the benchmark).")
       .def("_time_face_scan", &World::TimeFaceScan, py::arg("position"), py::arg("resolution"),
            py::arg("half_extent"), py::arg("repeats"),
            "The best of `repeats` face scans timed in C++ alone, seconds (for the benchmark).")

@@ -72,3 +72,16 @@ def test_a_level_that_is_not_there_is_a_level_error(level, isolate):
     else:
         assert False, "loaded a level that is not there"
     assert np.isfinite(REFERENCE["range"])
+
+
+@settings(max_examples=60, deadline=None, database=None)
+@given(camera=st.sampled_from(["fixed", "chase", "trailing", "payload", "", "side"]),
+       position=st.one_of(st.none(), anything), orientation=anything,
+       robot=st.one_of(st.none(), st.text(max_size=6), st.just("ELAHA")),
+       size=st.integers(-5, 40), fov=numbers, kinds=st.text(max_size=20),
+       quality=st.sampled_from(["fast", "high", "plain", "best", ""]))
+def test_renders_take_any_argument(camera, position, orientation, robot, size, fov, kinds,
+                                   quality):
+    call(WORLD.render, camera, position, orientation, robot, size, size, fov, kinds, quality)
+    call(WORLD.render, camera, position, orientation, robot, 16, 12, 60.0, "color", quality)
+    assert WORLD.ray((0, 0, 80)) == REFERENCE

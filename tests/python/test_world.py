@@ -180,3 +180,29 @@ def test_bad_arguments_are_python_errors_naming_them(world):
         world.lidar_scan((0, 0, 3), settings="channels = -2")
     with pytest.raises(sandbox.LevelError, match="/nonexistent/level.toml"):
         sandbox.World("/nonexistent/level.toml")
+
+
+def read_png(path):
+    from PIL import Image
+    return np.array(Image.open(path))
+
+
+def test_render_equals_the_command_lines(world, tmp_path):
+    out = tmp_path / "look.png"
+    subprocess.run([SANDBOX, "render", "--camera", "fixed", "--at", "-15,-45,32,0,0,45",
+                    "--robot-at", "0,-30,30", "--width", "160", "--height", "120",
+                    "--kind", "color,depth,segmentation", "--out", str(out)],
+                   check=True, stdout=subprocess.DEVNULL)
+    world.set_pose("ELAHA", (0, -30, 30))
+    frame = world.render("fixed", (-15, -45, 32), yaw(45), width=160, height=120,
+                         kinds="color,depth,segmentation")
+    assert (frame.width, frame.height) == (160, 120) and frame.normals is None
+    assert np.array_equal(frame.color, read_png(out)[:, :, :3])
+    millimetres = read_png(tmp_path / "look_depth.png").astype(np.int64)
+    depth = frame.depth
+    near = np.isfinite(depth) & (depth < 60)
+    assert near.sum() > 1000
+    assert np.abs(np.round(depth[near] * 1000) - millimetres[near]).max() <= 1
+    assert np.array_equal(frame.segmentation, read_png(tmp_path / "look_seg.png"))
+    robot = {s["id"] for s in world.surfaces() if s["robot"] == "ELAHA"}
+    assert np.isin(frame.segmentation, list(robot)).sum() > 50  # the wing is in the picture

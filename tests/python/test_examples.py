@@ -1,0 +1,43 @@
+"""examples/python/ on a small case: the dataset writer's files are what its
+index says, its images those `sandbox render` draws at the pose the index
+gives, its scans around that pose."""
+import csv
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+EXAMPLES = os.path.join(HERE, "..", "..", "examples", "python")
+
+
+def test_the_dataset_writer(tmp_path):
+    out = tmp_path / "dataset"
+    subprocess.run([sys.executable, os.path.join(EXAMPLES, "dataset.py"), str(out), "3",
+                    "--size", "96x72", "--seed", "5"], check=True, stdout=subprocess.DEVNULL)
+    with open(out / "index.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 3
+    with open(out / "surfaces.csv") as f:
+        robot = {int(r["id"]) for r in csv.DictReader(f) if r["robot"] == "ELAHA"}
+    for row in rows:
+        images = np.load(out / row["images"])
+        assert images["color"].shape == (72, 96, 3)
+        look = tmp_path / ("look%s.png" % row["sample"])
+        subprocess.run([os.environ.get("SANDBOX", "sandbox"), "render", "--camera", "chase",
+                        "--at", "%s,%s,%s,0,0,%s" % (row["x"], row["y"], row["z"], row["heading_deg"]),
+                        "--width", "96", "--height", "72", "--kind", "color,segmentation",
+                        "--out", str(look)], check=True, stdout=subprocess.DEVNULL)
+        from PIL import Image
+        drawn = np.array(Image.open(look))[:, :, :3]
+        assert (images["color"] == drawn).all(axis=2).mean() > 0.999, row
+        segments = np.array(Image.open(tmp_path / ("look%s_seg.png" % row["sample"])))
+        assert (images["segmentation"] == segments).mean() > 0.999, row
+        assert np.isin(images["segmentation"], list(robot)).any(), row  # the wing is in it
+        points = np.load(out / row["scan"])
+        assert points.shape == (6, 51, 51, 3)
+        # The scan is centred on the pose: its box's faces are 25 m either side of it.
+        centre = np.array([float(row["x"]), float(row["y"]), float(row["z"])])
+        assert np.nanmax(np.abs(points - centre)) <= 25 * 3 ** 0.5 + 1e-6
+        assert int(row["hits"]) > 100  # the ground is within 20 m below
