@@ -1,8 +1,8 @@
 // The Python module `sandbox` (pybind11): a level loaded in-process, its
-// robots posed, and scans at any pose as numpy arrays that view the scan's
-// own buffers (read-only, kept alive by the scan object). The GIL is released
-// while a scan casts; scans from several threads run at once (each beyond the
-// first on a one-thread caster of its own), a pose waits for them.
+// robots posed, scans at any pose and cameras' images, returned as numpy
+// views (python/results.h). The GIL is released while a scan casts or a
+// camera draws; scans from several threads run at once (each beyond the
+// first on a one-thread caster of its own), poses and renders wait for them.
 // docs/reference/python.md.
 
 #include <pybind11/numpy.h>
@@ -23,6 +23,7 @@
 #include "app/defaults.h"
 #include "app/images.h"
 #include "app/loaded_level.h"
+#include "python/results.h"
 #include "scene/collision_world.h"
 #include "scene/robot_state.h"
 #include "scene/terrain_streamer.h"
@@ -37,16 +38,6 @@ namespace py = pybind11;
 
 namespace sandbox::python {
 namespace {
-
-// A read-only array over `data` (owned by `owner`, which it keeps alive).
-template <typename T>
-py::array View(const T* data, std::vector<py::ssize_t> shape, py::handle owner) {
-  py::array array(py::dtype::of<T>(), std::move(shape), data, owner);
-  // numpy's flag cleared directly (setting array.flags.writeable from C++
-  // costs a microsecond a view through Python's attribute machinery).
-  py::detail::array_proxy(array.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
-  return array;
-}
 
 // `value` as `count` finite doubles, else ValueError naming `argument`.
 std::vector<double> FiniteVector(const py::handle& value, std::size_t count,
@@ -125,19 +116,6 @@ double Positive(double value, const std::string& argument) {
   throw py::key_error("no " + what + " '" + name +
                       "'; the level has: " + (list.empty() ? "none" : list));
 }
-
-struct FaceScanResult {
-  sensors::FaceScan scan;
-};
-struct GroundScanResult {
-  sensors::HeightMap map;
-};
-struct LidarScanResult {
-  sensors::LidarScan scan;
-};
-struct FrameResult {
-  render::Frame frame;
-};
 
 class World {
  public:
@@ -467,195 +445,7 @@ PYBIND11_MODULE(sandbox, module) {
       "(docs/reference/python.md).";
   py::register_exception<sandbox::scene::LevelError>(module, "LevelError", PyExc_RuntimeError);
 
-  py::class_<FaceScanResult>(module, "FaceScan",
-                             "A six-face scan: per face an n x n grid (face f, row, column).")
-      .def_property_readonly("n", [](const FaceScanResult& s) { return s.scan.n; })
-      .def_property_readonly("resolution",
-                             [](const FaceScanResult& s) { return s.scan.resolution_m; })
-      .def_property_readonly("half_extent",
-                             [](const FaceScanResult& s) { return s.scan.half_extent_m; })
-      .def_property_readonly(
-          "occupancy",
-          [](py::object self) {
-            const auto& s = self.cast<const FaceScanResult&>().scan;
-            py::list faces;
-            for (const auto& face : s.faces)
-              faces.append(View(face.occupancy.data(), {s.n, s.n}, self));
-            return faces;
-          },
-          "6 int8 (n, n) views: 1 occupied, 0 free (sensors.md, Occupancy)")
-      .def_property_readonly(
-          "distance",
-          [](py::object self) {
-            const auto& s = self.cast<const FaceScanResult&>().scan;
-            py::list faces;
-            for (const auto& face : s.faces)
-              faces.append(View(face.distance_m.data(), {s.n, s.n}, self));
-            return faces;
-          },
-          "6 float32 (n, n) views: metres from the ray's start along the face's axis")
-      .def_property_readonly(
-          "surface",
-          [](py::object self) {
-            const auto& s = self.cast<const FaceScanResult&>().scan;
-            py::list faces;
-            for (const auto& face : s.faces)
-              faces.append(View(face.surface.data(), {s.n, s.n}, self));
-            return faces;
-          },
-          "6 int32 (n, n) views: the surface id hit (World.surfaces()), 0 none")
-      .def_property_readonly(
-          "normal",
-          [](py::object self) {
-            const auto& s = self.cast<const FaceScanResult&>().scan;
-            py::list faces;
-            for (const auto& face : s.faces) {
-              faces.append(View(face.normal_W.data()->data(), {s.n, s.n, 3}, self));
-            }
-            return faces;
-          },
-          "6 float32 (n, n, 3) views: the unit normal at the hit, world frame; 0 free")
-      .def(
-          "points",
-          [](const FaceScanResult& self) {
-            const auto& s = self.scan;
-            py::array_t<double> points({6, s.n, s.n, 3});
-            double* out = points.mutable_data();
-            for (int f = 0; f < 6; ++f) {
-              for (std::size_t k = 0; k < std::size_t(s.n) * std::size_t(s.n); ++k) {
-                const Eigen::Vector3d p = s.PointW(f, k);
-                for (int c = 0; c < 3; ++c) *out++ = p[c];
-              }
-            }
-            return points;
-          },
-          "(6, n, n, 3) float64, world: each sample's hit or its ray's end (a new array)");
-
-  py::class_<GroundScanResult>(module, "GroundScan",
-                               "A height map below a point: n x n (row, column).")
-      .def_property_readonly("n", [](const GroundScanResult& s) { return s.map.n; })
-      .def_property_readonly("resolution",
-                             [](const GroundScanResult& s) { return s.map.resolution_m; })
-      .def_property_readonly(
-          "corner",
-          [](const GroundScanResult& s) {
-            return py::make_tuple(s.map.corner_W.x(), s.map.corner_W.y());
-          },
-          "x, y of row 0, column 0 (rows along y, columns along x)")
-      .def_property_readonly(
-          "height",
-          [](py::object self) {
-            const auto& m = self.cast<const GroundScanResult&>().map;
-            return View(m.height_m.data(), {m.n, m.n}, self);
-          },
-          "float64 (n, n) view: the ground's height, NaN without ground")
-      .def_property_readonly(
-          "surface",
-          [](py::object self) {
-            const auto& m = self.cast<const GroundScanResult&>().map;
-            return View(m.surface.data(), {m.n, m.n}, self);
-          },
-          "int32 (n, n) view: the surface id hit, 0 none")
-      .def_property_readonly(
-          "normal",
-          [](py::object self) {
-            const auto& m = self.cast<const GroundScanResult&>().map;
-            return View(m.normal_W.data()->data(), {m.n, m.n, 3}, self);
-          },
-          "float32 (n, n, 3) view: the ground's unit normal, world frame");
-
-  py::class_<LidarScanResult>(module, "LidarScan", "A lidar sweep: channels x azimuth steps.")
-      .def_property_readonly("channels", [](const LidarScanResult& s) { return s.scan.channels; })
-      .def_property_readonly("steps", [](const LidarScanResult& s) { return s.scan.azimuth_steps; })
-      .def_property_readonly(
-          "range",
-          [](py::object self) {
-            const auto& s = self.cast<const LidarScanResult&>().scan;
-            return View(s.range_m.data(), {s.channels, s.azimuth_steps}, self);
-          },
-          "float32 (channels, steps) view: metres to the hit, or the range when none")
-      .def_property_readonly(
-          "hit",
-          [](py::object self) {
-            const auto& s = self.cast<const LidarScanResult&>().scan;
-            return View(s.hit.data(), {s.channels, s.azimuth_steps}, self);
-          },
-          "uint8 (channels, steps) view: 1 when the beam hit")
-      .def_property_readonly(
-          "points",
-          [](py::object self) {
-            const auto& s = self.cast<const LidarScanResult&>().scan;
-            return View(s.points_W.data()->data(), {s.channels, s.azimuth_steps, 3}, self);
-          },
-          "float64 (channels, steps, 3) view: the hit or the beam's end, world")
-      .def_property_readonly(
-          "surface",
-          [](py::object self) {
-            const auto& s = self.cast<const LidarScanResult&>().scan;
-            return View(s.surface.data(), {s.channels, s.azimuth_steps}, self);
-          },
-          "int32 (channels, steps) view: the surface id hit, 0 none")
-      .def_property_readonly(
-          "normal",
-          [](py::object self) {
-            const auto& s = self.cast<const LidarScanResult&>().scan;
-            return View(s.normal_W.data()->data(), {s.channels, s.azimuth_steps, 3}, self);
-          },
-          "float32 (channels, steps, 3) view: the unit normal at the hit, world")
-      .def(
-          "_addresses",
-          [](const LidarScanResult& self) {
-            py::dict out;
-            out["range"] = reinterpret_cast<std::uintptr_t>(self.scan.range_m.data());
-            out["points"] = reinterpret_cast<std::uintptr_t>(self.scan.points_W.data());
-            return out;
-          },
-          "where the scan's own buffers are (the tests compare the arrays' data with them)")
-      .def_property_readonly(
-          "intensity",
-          [](py::object self) -> py::object {
-            const auto& s = self.cast<const LidarScanResult&>().scan;
-            if (s.intensity.empty()) return py::none();
-            return View(s.intensity.data(), {s.channels, s.azimuth_steps}, self);
-          },
-          "float32 (channels, steps) view, 0 to 1, or None without 'intensity = true'");
-
-  py::class_<FrameResult>(module, "Frame", "A camera's images, row 0 at the top.")
-      .def_property_readonly("width", [](const FrameResult& f) { return f.frame.width; })
-      .def_property_readonly("height", [](const FrameResult& f) { return f.frame.height; })
-      .def_property_readonly(
-          "color",
-          [](py::object self) -> py::object {
-            const auto& f = self.cast<const FrameResult&>().frame;
-            if (f.rgb.empty()) return py::none();
-            return View(f.rgb.data(), {f.height, f.width, 3}, self);
-          },
-          "uint8 (height, width, 3) view, RGB; None when not asked for")
-      .def_property_readonly(
-          "depth",
-          [](py::object self) -> py::object {
-            const auto& f = self.cast<const FrameResult&>().frame;
-            if (f.depth_m.empty()) return py::none();
-            return View(f.depth_m.data(), {f.height, f.width}, self);
-          },
-          "float32 (height, width) view: metres along the optical axis, inf where sky")
-      .def_property_readonly(
-          "segmentation",
-          [](py::object self) -> py::object {
-            const auto& f = self.cast<const FrameResult&>().frame;
-            if (f.segment.empty()) return py::none();
-            return View(f.segment.data(), {f.height, f.width}, self);
-          },
-          "uint32 (height, width) view: the surface id seen (World.surfaces()), 0 sky")
-      .def_property_readonly(
-          "normals",
-          [](py::object self) -> py::object {
-            const auto& f = self.cast<const FrameResult&>().frame;
-            if (f.normal_C.empty()) return py::none();
-            return View(f.normal_C.data(), {f.height, f.width, 3}, self);
-          },
-          "float32 (height, width, 3) view: unit normals, camera frame (x forward, y left, z "
-          "up); 0 where sky");
+  BindResults(module);
 
   py::class_<World>(module, "World",
                     "A level loaded in-process (a manifest or a scene file; default: the "
