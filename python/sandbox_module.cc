@@ -148,14 +148,7 @@ class World {
                const py::handle& orientation) {
     const int r = Robot(robot);
     const Eigen::Isometry3d X = Pose(position, orientation);
-    py::gil_scoped_release release;
-    std::unique_lock<std::shared_mutex> lock(mutex_);
-    if (!states_[std::size_t(r)]->SetPose(X)) {
-      throw std::invalid_argument("pose of " + robot +
-                                  " refused: " + states_[std::size_t(r)]->last_rejection());
-    }
-    states_[std::size_t(r)]->UpdateKinematics();
-    world_.UpdateRobot(r, *states_[std::size_t(r)]);
+    Change(r, "pose", [&](scene::RobotState& state) { return state.SetPose(X); });
   }
 
   void SetBones(const std::string& robot, const py::handle& values) {
@@ -163,14 +156,7 @@ class World {
     const std::size_t count = std::size_t(loaded_.level.robots[std::size_t(r)].num_values);
     if (count == 0) throw py::value_error(robot + " has no bones");
     const std::vector<double> v = FiniteVector(values, count, "values");
-    py::gil_scoped_release release;
-    std::unique_lock<std::shared_mutex> lock(mutex_);
-    if (!states_[std::size_t(r)]->SetBones(v)) {
-      throw std::invalid_argument("bone values of " + robot +
-                                  " refused: " + states_[std::size_t(r)]->last_rejection());
-    }
-    states_[std::size_t(r)]->UpdateKinematics();
-    world_.UpdateRobot(r, *states_[std::size_t(r)]);
+    Change(r, "bone values", [&](scene::RobotState& state) { return state.SetBones(v); });
   }
 
   py::tuple GetPose(const std::string& robot) const {
@@ -400,6 +386,21 @@ class World {
       sensors::RayCaster own(1);
       scan(own, filter);
     }
+  }
+
+  // Robot r's state changed by `set` (false: refused, ValueError with the
+  // state's reason), alone: its nodes and collision body follow.
+  template <typename Set>
+  void Change(int r, const std::string& what, Set&& set) {
+    scene::RobotState& state = *states_[std::size_t(r)];
+    py::gil_scoped_release release;
+    std::unique_lock<std::shared_mutex> lock(mutex_);
+    if (!set(state)) {
+      throw std::invalid_argument(what + " of " + state.model().name +
+                                  " refused: " + state.last_rejection());
+    }
+    state.UpdateKinematics();
+    world_.UpdateRobot(r, state);
   }
 
   // Draws the level and the robots as posed, alone (the robots' skins are

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sandbox_msgs/robot_pose_t.hpp"
+#include "tests/encoded.h"
 
 namespace sandbox::testing {
 
@@ -34,8 +35,7 @@ inline void WriteFlightLog(const std::string& path, int poses, std::int64_t peri
     pose.position[2] = 60;
     pose.orientation[0] = std::cos((a + M_PI / 2) / 2);
     pose.orientation[3] = std::sin((a + M_PI / 2) / 2);
-    std::vector<std::uint8_t> bytes(std::size_t(pose.getEncodedSize()));
-    pose.encode(bytes.data(), 0, int(bytes.size()));
+    std::vector<std::uint8_t> bytes = Encoded(pose);
     lcm::LogEvent event;
     event.eventnum = i;
     event.timestamp = pose.utime;

@@ -16,10 +16,12 @@
 #include "sandbox_msgs/robot_state_t.hpp"
 #include "tests/app/flight_log.h"
 #include "tests/app/run_sandbox.h"
+#include "tests/encoded.h"
 #include "tests/test_util.h"
 
 namespace {
 
+using sandbox::testing::Encoded;
 using sandbox::testing::RunSandbox;
 using sandbox::testing::WriteFlightLog;
 namespace fs = std::filesystem;
@@ -127,13 +129,6 @@ TEST(ReplayTest, InputTimeThatJumpsBackOrIsNegativeKeepsTheSensorsOnTheTickSched
   EXPECT_EQ(MessagesOn(out, "ELAHA/SCAN_FACE"), 50);
 }
 
-template <typename Message>
-std::vector<std::uint8_t> Encode(Message& message) {
-  std::vector<std::uint8_t> bytes(std::size_t(message.getEncodedSize()));
-  message.encode(bytes.data(), 0, int(bytes.size()));
-  return bytes;
-}
-
 // Every message on `channel` of an LCM log, decoded.
 template <typename Message>
 std::vector<Message> Decoded(const std::string& path, const std::string& channel) {
@@ -169,8 +164,8 @@ TEST(ReplayTest, ARecordedRunIsReplayedFromItsStates) {
       bones.num_values = 45;
       for (int k = 0; k < 45; ++k) bones.values.push_back(bend(i, k));
       sandbox_msgs::robot_pose_t pose = poses[i];
-      for (const auto& [channel, bytes] : {std::pair{std::string("ELAHA/BONES"), Encode(bones)},
-                                           std::pair{std::string("ELAHA/POSE"), Encode(pose)}}) {
+      for (const auto& [channel, bytes] : {std::pair{std::string("ELAHA/BONES"), Encoded(bones)},
+                                           std::pair{std::string("ELAHA/POSE"), Encoded(pose)}}) {
         lcm::LogEvent event{};
         event.timestamp = pose.utime;
         event.channel = channel;

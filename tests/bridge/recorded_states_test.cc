@@ -9,17 +9,12 @@
 #include "sandbox_msgs/bone_values_t.hpp"
 #include "sandbox_msgs/robot_pose_t.hpp"
 #include "sandbox_msgs/robot_state_t.hpp"
+#include "tests/encoded.h"
 
 namespace {
 
 using namespace sandbox::bridge;
-
-template <typename Message>
-std::vector<std::uint8_t> Encode(Message& message) {
-  std::vector<std::uint8_t> bytes(std::size_t(message.getEncodedSize()));
-  message.encode(bytes.data(), 0, int(bytes.size()));
-  return bytes;
-}
+using sandbox::testing::Encoded;
 
 template <typename Message>
 Message Decode(const LogEvent& event) {
@@ -46,7 +41,7 @@ TEST(StatesAsInputsTest, AStateBecomesBonesThenPoseInTheRobotsConvention) {
   StatesAsInputs states({RecordedRobot{"WING", ned, Translation{}}});
   sandbox_msgs::robot_state_t state = NorthboundState();
   std::vector<LogEvent> feed;
-  EXPECT_EQ(states.Translate("WING/STATE", Encode(state), &feed), "");
+  EXPECT_EQ(states.Translate("WING/STATE", Encoded(state), &feed), "");
   ASSERT_EQ(feed.size(), 2u);
   EXPECT_EQ(feed[0].channel, "WING/BONES");
   const auto bones = Decode<sandbox_msgs::bone_values_t>(feed[0]);
@@ -72,7 +67,7 @@ TEST(StatesAsInputsTest, AStateAlreadyInThePoseConventionIsTakenAsItIs) {
   state.num_values = 0;
   state.bone_values.clear();
   std::vector<LogEvent> feed;
-  EXPECT_EQ(states.Translate("WING/STATE", Encode(state), &feed), "");
+  EXPECT_EQ(states.Translate("WING/STATE", Encoded(state), &feed), "");
   ASSERT_EQ(feed.size(), 1u);  // no bone values: no BONES
   const auto pose = Decode<sandbox_msgs::robot_pose_t>(feed[0]);
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(pose.position[k], state.position[k], 1e-12);
@@ -84,7 +79,7 @@ TEST(StatesAsInputsTest, AStateAlreadyInThePoseConventionIsTakenAsItIs) {
 TEST(StatesAsInputsTest, ARobotWhosePoseComesFirstKeepsItsOwnInputs) {
   StatesAsInputs states({RecordedRobot{"A", {}, {}}, RecordedRobot{"B", {}, {}}});
   sandbox_msgs::robot_state_t state = NorthboundState();
-  const std::vector<std::uint8_t> bytes = Encode(state);
+  const std::vector<std::uint8_t> bytes = Encoded(state);
   std::vector<LogEvent> feed;
   states.Translate("A/POSE", {1, 2, 3}, &feed);
   states.Translate("A/STATE", bytes, &feed);
@@ -107,12 +102,12 @@ TEST(StatesAsInputsTest, ARobotWhosePoseComesFirstKeepsItsOwnInputs) {
 TEST(StatesAsInputsTest, AStateThatDoesNotDecodeIsSkippedWithItsReason) {
   StatesAsInputs states({RecordedRobot{"WING", {}, {}}});
   sandbox_msgs::robot_state_t state = NorthboundState();
-  std::vector<std::uint8_t> bytes = Encode(state);
+  std::vector<std::uint8_t> bytes = Encoded(state);
   bytes.resize(bytes.size() - 3);
   std::vector<LogEvent> feed;
   EXPECT_NE(states.Translate("WING/STATE", bytes, &feed).find("robot_state_t"), std::string::npos);
   state.orientation[0] = std::nan("");
-  EXPECT_EQ(states.Translate("WING/STATE", Encode(state), &feed),
+  EXPECT_EQ(states.Translate("WING/STATE", Encoded(state), &feed),
             "its orientation is not a unit quaternion");
   EXPECT_TRUE(feed.empty());
   EXPECT_EQ(states.states_refused(), 2);
