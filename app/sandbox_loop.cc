@@ -7,9 +7,9 @@
 #include <chrono>
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <mutex>
-#include <fstream>
 #include <sstream>
 #include <string>
 
@@ -89,12 +89,7 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
   }
   unknown_robots_ = std::make_unique<bridge::UnknownRobots>(link_, prefixes, &reject_log_);
   if (log_) {
-    std::vector<bridge::RecordedRobot> recorded;
-    for (const bridge::RobotBridgeConfig& config : loaded_.bridges) {
-      recorded.push_back({config.channel_prefix, config.pose,
-                          config.state_in_pose_convention ? config.pose : bridge::Translation{}});
-    }
-    log_states_ = std::make_unique<bridge::StatesAsInputs>(std::move(recorded));
+    log_states_ = std::make_unique<bridge::StatesAsInputs>(bridge::RecordedRobots(loaded_.bridges));
   }
   for (const sensors::MountedSensor& mounted : loaded_.sensors) {
     sensors_.emplace_back(mounted);
@@ -317,9 +312,7 @@ bool SandboxLoop::NextLockstepInput(double wall_s, bool* wait) {
       link_.Drain();
     }
   }
-  const std::vector<std::string> from_states = log_states_->robots_from_states();
-  for (; robots_from_states_ < from_states.size(); ++robots_from_states_) {
-    const std::string& prefix = from_states[robots_from_states_];
+  for (const std::string& prefix : log_states_->TakeNewRobotsFromStates()) {
     err_ << "\rsandbox: " << options_.replay_file << " holds what a run applied (" << prefix
          << "/STATE before any " << prefix << "/POSE): its states are replayed as " << prefix
          << "'s POSE and BONES\n";

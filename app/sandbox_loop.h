@@ -114,9 +114,8 @@ class SandboxLoop {
   void PublishWebState(const TickRecord& record, double wall_s);
   // On the frame pipeline's encoder thread: a written frame to the browser
   // view (its JPEG, or one encoded), kWebCameraHz a camera while a client is there.
-  void ShowCameraFrame(const std::string& camera, std::int64_t tick,
-                       const render::CameraView& view, const render::Frame& frame,
-                       const std::filesystem::path& color_file);
+  void ShowCameraFrame(const std::string& camera, std::int64_t tick, const render::CameraView& view,
+                       const render::Frame& frame, const std::filesystem::path& color_file);
   // The browser view's state after a tick, with the sensors' samples or without.
   web::StreamState WebState(const TickRecord& record, bool with_samples);
   // Between ticks: the floating origin to the first robot when it is far from it.
@@ -135,7 +134,6 @@ class SandboxLoop {
   std::unique_ptr<bridge::LogReader> log_;
   std::unique_ptr<bridge::StatesAsInputs> log_states_;  // a --record log's STATEs as inputs
   std::vector<bridge::LogEvent> log_feed_;
-  std::size_t robots_from_states_{0};  // said so far
   bridge::LcmLink link_;
   const LoadedLevel loaded_;
   const scene::Level& level_{loaded_.level};
@@ -156,11 +154,11 @@ class SandboxLoop {
   std::unique_ptr<LiveView> live_view_;  // before frames_: frames_ calls into it
   bool write_frames_{false};
   std::unique_ptr<FramePipeline> frames_;
-  std::unique_ptr<web::StreamServer> web_;  // the browser view (--web)
-  static constexpr double kWebSamplesHz = 5.0;                // scan samples sent so often
-  static constexpr std::size_t kWebSamplesPerSensor = 20000;  // at most so many a sensor
+  std::unique_ptr<web::StreamServer> web_;                       // the browser view (--web)
+  static constexpr double kWebSamplesHz = 5.0;                   // scan samples sent so often
+  static constexpr std::size_t kWebSamplesPerSensor = 20000;     // at most so many a sensor
   double web_samples_due_s_{0.0}, web_samples_wall_due_s_{0.0};  // --web's next samples
-  double recorded_samples_due_s_{0.0};                            // RunHooks::web_state's
+  double recorded_samples_due_s_{0.0};                           // RunHooks::web_state's
   static constexpr double kWebCameraHz = 2.0;  // camera frames a camera sent so often
   std::map<std::string, std::chrono::steady_clock::time_point> web_camera_due_;  // encoder thread
   std::mutex web_keys_mutex_;

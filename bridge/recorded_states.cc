@@ -17,6 +17,15 @@ LogEvent Encoded(const std::string& channel, Message& message) {
 
 }  // namespace
 
+std::vector<RecordedRobot> RecordedRobots(const std::vector<RobotBridgeConfig>& bridges) {
+  std::vector<RecordedRobot> robots;
+  for (const RobotBridgeConfig& config : bridges) {
+    robots.push_back({config.channel_prefix, config.pose,
+                      config.state_in_pose_convention ? config.pose : Translation{}});
+  }
+  return robots;
+}
+
 StatesAsInputs::StatesAsInputs(std::vector<RecordedRobot> robots) {
   for (RecordedRobot& robot : robots) {
     by_pose_[robot.channel_prefix + "/POSE"] = robots_.size();
@@ -38,7 +47,10 @@ std::string StatesAsInputs::Translate(const std::string& channel,
     return "";
   }
   Robot& robot = robots_[state->second];
-  if (robot.source == Source::kUnknown) robot.source = Source::kStates;
+  if (robot.source == Source::kUnknown) {
+    robot.source = Source::kStates;
+    newly_.push_back(robot.config.channel_prefix);
+  }
   if (robot.source == Source::kInputs) {
     feed->push_back(LogEvent{channel, data});
     return "";

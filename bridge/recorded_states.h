@@ -13,8 +13,10 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "bridge/robot_bridge_config.h"
 #include "bridge/translation.h"
 
 namespace sandbox::bridge {
@@ -24,6 +26,9 @@ struct RecordedRobot {
   Translation pose;   // its POSE input's convention
   Translation state;  // its STATE's: the world (the default) or the pose convention
 };
+
+// One a robot, from the robots' bridge settings (Level::robots order).
+std::vector<RecordedRobot> RecordedRobots(const std::vector<RobotBridgeConfig>& bridges);
 
 struct LogEvent {
   std::string channel;
@@ -43,6 +48,8 @@ class StatesAsInputs {
 
   // The prefixes of the robots replayed from their states, so far.
   std::vector<std::string> robots_from_states() const;
+  // Those that became so since the last call (to be said once each).
+  std::vector<std::string> TakeNewRobotsFromStates() { return std::exchange(newly_, {}); }
   std::int64_t states_replayed() const { return replayed_; }
   std::int64_t states_refused() const { return refused_; }
 
@@ -54,6 +61,7 @@ class StatesAsInputs {
   };
   std::vector<Robot> robots_;
   std::map<std::string, std::size_t> by_pose_, by_state_;  // channel -> robot
+  std::vector<std::string> newly_;
   std::int64_t replayed_{0}, refused_{0};
 };
 

@@ -97,6 +97,8 @@ TEST(StatesAsInputsTest, ARobotWhosePoseComesFirstKeepsItsOwnInputs) {
   EXPECT_EQ(feed[4].data, (std::vector<std::uint8_t>{4, 5}));
   EXPECT_EQ(feed[5].channel, "OTHER/STATE");
   EXPECT_EQ(states.robots_from_states(), std::vector<std::string>{"B"});
+  EXPECT_EQ(states.TakeNewRobotsFromStates(), std::vector<std::string>{"B"});
+  EXPECT_TRUE(states.TakeNewRobotsFromStates().empty());  // said once
 }
 
 TEST(StatesAsInputsTest, AStateThatDoesNotDecodeIsSkippedWithItsReason) {
