@@ -108,6 +108,23 @@ double Positive(double value, const std::string& argument) {
   return value;
 }
 
+// A one-off face scan's settings, as `sandbox scan` has them: every face
+// in full, with normals, finer than a sensor of the loop may be.
+sensors::FaceScannerConfig FaceConfig(double resolution, double half_extent,
+                                      const std::string& aligned) {
+  sensors::FaceScannerConfig config;
+  config.resolution_m = Positive(resolution, "resolution");
+  config.half_extent_m = Positive(half_extent, "half_extent");
+  if (aligned != "body" && aligned != "world") {
+    throw py::value_error("aligned must be 'body' or 'world', got '" + aligned + "'");
+  }
+  config.alignment = aligned == "body" ? sensors::Alignment::kBody : sensors::Alignment::kWorld;
+  config.refresh = sensors::Refresh::kFull;
+  config.sample_budget = 1e7;
+  config.normals = true;
+  return config;
+}
+
 // KeyError naming `name` and listing the known ones.
 [[noreturn]] void Unknown(const std::string& what, const std::string& name,
                           const std::vector<std::string>& known) {
@@ -193,16 +210,7 @@ class World {
   FaceScanResult FaceScan(const py::handle& position, const py::handle& orientation,
                           double resolution, double half_extent, const std::string& aligned,
                           bool see_robots) {
-    sensors::FaceScannerConfig config;
-    config.resolution_m = Positive(resolution, "resolution");
-    config.half_extent_m = Positive(half_extent, "half_extent");
-    if (aligned != "body" && aligned != "world") {
-      throw py::value_error("aligned must be 'body' or 'world', got '" + aligned + "'");
-    }
-    config.alignment = aligned == "body" ? sensors::Alignment::kBody : sensors::Alignment::kWorld;
-    config.refresh = sensors::Refresh::kFull;
-    config.sample_budget = 1e7;
-    config.normals = true;
+    const sensors::FaceScannerConfig config = FaceConfig(resolution, half_extent, aligned);
     const Eigen::Isometry3d X_WS = Pose(position, orientation);
     const sensors::FaceScanner scanner(config);  // throws std::invalid_argument
     FaceScanResult result{scanner.EmptyScan()};
@@ -312,12 +320,7 @@ class World {
   // bench/python_scan.py, which compares it with face_scan from Python.
   double TimeFaceScan(const py::handle& position, double resolution, double half_extent,
                       int repeats) {
-    sensors::FaceScannerConfig config;
-    config.resolution_m = Positive(resolution, "resolution");
-    config.half_extent_m = Positive(half_extent, "half_extent");
-    config.refresh = sensors::Refresh::kFull;
-    config.sample_budget = 1e7;
-    config.normals = true;
+    const sensors::FaceScannerConfig config = FaceConfig(resolution, half_extent, "body");
     const Eigen::Isometry3d X_WS = Pose(position, py::make_tuple(1, 0, 0, 0));
     const sensors::FaceScanner scanner(config);
     double best = 1e300;
