@@ -1,8 +1,5 @@
 #include "app/sandbox_loop.h"
 
-#include <pthread.h>
-#include <sched.h>
-
 #include <algorithm>
 #include <chrono>
 #include <exception>
@@ -10,12 +7,14 @@
 #include <fstream>
 #include <iomanip>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <string>
 
 #include "app/command_line.h"
 #include "app/images.h"
 #include "app/run_summary.h"
+#include "app/thread_priority.h"
 #include "app/tick_pacer.h"
 #include "app/web_samples.h"
 #include "web/commands.h"
@@ -26,23 +25,6 @@ namespace sandbox::app {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-// SCHED_FIFO for the calling thread (threads it starts later inherit it; the
-// caster's workers and the frame threads, started earlier, do not). False
-// when not permitted.
-bool RaiseToRealTime() {
-  sched_param param{};
-  param.sched_priority = 10;  // above every normal thread, below the kernel's own
-  return pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
-}
-
-// Back to normal priority, however the loop ends.
-struct NormalPriorityAtExit {
-  ~NormalPriorityAtExit() {
-    sched_param param{};
-    pthread_setschedparam(pthread_self(), SCHED_OTHER, &param);
-  }
-};
 
 // Creates the output folder (and its scans/); returns the statistics file, or "".
 std::string PrepareOutDir(const RunOptions& options) {
@@ -71,6 +53,7 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
       cameras_(level_, loaded_.cameras),
       stats_(PrepareOutDir(options)) {
   if (!options_.record_file.empty()) link_.RecordTo(options_.record_file);
+  if (hooks_.published) link_.set_publish_tap(hooks_.published);
   if (level_.terrain) terrain_ = std::make_unique<scene::TerrainStreamer>(level_);
   robots_.resize(level_.robots.size());
   for (std::size_t r = 0; r < level_.robots.size(); ++r) {
@@ -183,7 +166,8 @@ int SandboxLoop::Run() {
     priority = RaiseToRealTime() ? ", real-time priority"
                                  : ", normal priority (real-time needs CAP_SYS_NICE or ulimit -r)";
   }
-  const SignalRoute signals(stop_);  // SIGINT and SIGTERM end the loop, and wake its waits
+  std::optional<SignalRoute> signals;  // SIGINT and SIGTERM end the loop, and wake its waits
+  if (hooks_.route_signals) signals.emplace(stop_);
   out_ << "sandbox run: " << level_.name << ", " << level_.robots.size() << " robots, "
        << (options_.sensors ? std::to_string(sensors_.size()) + " sensors, " : "sensors off, ")
        << (options_.publish ? "" : "publishing nothing, ")
@@ -292,7 +276,7 @@ bool SandboxLoop::TakeViewKeys(double drain_budget_s) {
 
 bool SandboxLoop::NextLockstepInput(double wall_s, bool* wait) {
   *wait = false;
-  if (!log_) {  // from the network: wait for a pose message
+  if (!log_ && !hooks_.lockstep_inputs) {  // from the network: wait for a pose message
     link_.Drain();
     if (!has_pose()) {
       link_.Wait(100);
@@ -300,28 +284,35 @@ bool SandboxLoop::NextLockstepInput(double wall_s, bool* wait) {
     }
     return true;
   }
-  std::string channel;
-  std::vector<std::uint8_t> data;
-  std::int64_t utime = 0;
-  while (!has_pose() && log_->Next(&channel, &data, &utime)) {
-    log_feed_.clear();
-    const std::string refused = log_states_->Translate(channel, data, &log_feed_);
-    if (!refused.empty()) reject_log_.Note(channel, refused);
+  while (!has_pose() && NextInputEvents()) {
     for (const bridge::LogEvent& event : log_feed_) {
       link_.Inject(event.channel, event.data.data(), unsigned(event.data.size()));
       link_.Drain();
     }
   }
-  for (const std::string& prefix : log_states_->TakeNewRobotsFromStates()) {
+  for (const std::string& prefix :
+       log_ ? log_states_->TakeNewRobotsFromStates() : std::vector<std::string>{}) {
     err_ << "\rsandbox: " << options_.replay_file << " holds what a run applied (" << prefix
          << "/STATE before any " << prefix << "/POSE): its states are replayed as " << prefix
          << "'s POSE and BONES\n";
   }
   if (!has_pose()) return false;  // the log has ended
-  if (wall_s >= next_progress_s_) {
+  if (log_ && wall_s >= next_progress_s_) {
     next_progress_s_ = wall_s + 0.25;
     PrintReplayProgress(*log_, tick_, wall_s, err_);
   }
+  return true;
+}
+
+bool SandboxLoop::NextInputEvents() {
+  log_feed_.clear();
+  if (!log_) return hooks_.lockstep_inputs(&log_feed_);
+  std::string channel;
+  std::vector<std::uint8_t> data;
+  std::int64_t utime = 0;
+  if (!log_->Next(&channel, &data, &utime)) return false;
+  const std::string refused = log_states_->Translate(channel, data, &log_feed_);
+  if (!refused.empty()) reject_log_.Note(channel, refused);
   return true;
 }
 

@@ -81,6 +81,8 @@ class SandboxLoop {
   // The live view when asked for (its window is the caller's to run), or null.
   LiveView* live_view() { return live_view_.get(); }
   const scene::Level& level() const { return level_; }
+  // The level with its sensors, cameras and robots' channels.
+  const LoadedLevel& loaded_level() const { return loaded_; }
 
  private:
   // A robot: its state, what drives it and what it publishes.
@@ -94,6 +96,9 @@ class SandboxLoop {
   // Lock-step: makes the next pose available (reading the replayed log up to
   // it). False: stop (the log has ended); *wait: nothing yet, try again.
   bool NextLockstepInput(double wall_s, bool* wait);
+  // The replayed log's next events (or RunHooks::lockstep_inputs') into
+  // log_feed_; false when there are no more.
+  bool NextInputEvents();
   // The live view's keys; false when the tick is skipped (paused or quit).
   bool TakeViewKeys(double drain_budget_s);
   // Steps 1-5 of a tick, each below in order; the caller records it (6).

@@ -128,6 +128,7 @@ int LcmLink::Drain(double budget_s) {
 
 bool LcmLink::Publish(const std::string& channel, const void* data, unsigned size) {
   if (record_) record_->Write(channel, data, size, record_utime_);
+  if (tap_) tap_(channel, data, size);
   return impl_->lcm.publish(channel, data, size) == 0;
 }
 

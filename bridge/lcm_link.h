@@ -78,6 +78,9 @@ class LcmLink {
   int Drain(double budget_s = 0.005);
   // Publishes raw bytes (an encoded LCM message). Returns false on failure.
   bool Publish(const std::string& channel, const void* data, unsigned size);
+  // Also hands every message Publish() sends to `tap` (on the publishing thread).
+  using PublishTap = std::function<void(const std::string& channel, const void* data, unsigned size)>;
+  void set_publish_tap(PublishTap tap) { tap_ = std::move(tap); }
   // Publishes without recording (a replay feeding its inputs through memq://).
   bool Inject(const std::string& channel, const void* data, unsigned size);
   // Waits up to `timeout_ms` for one message and handles it; false on timeout.
@@ -103,6 +106,7 @@ class LcmLink {
   std::unique_ptr<Impl> impl_;
   std::unique_ptr<LogWriter> record_;
   std::int64_t record_utime_{0};
+  PublishTap tap_;
 };
 
 // Reads an LCM log file event by event (no network), for replays. The

@@ -1,4 +1,4 @@
-// The Python module `sandbox` (pybind11): a level loaded in-process, its
+// The Python extension `sandbox._sandbox` (pybind11): a level loaded in-process, its
 // robots posed, scans at any pose and cameras' images, returned as numpy
 // views (python/results.h). The GIL is released while a scan casts or a
 // camera draws; scans from several threads run at once (each beyond the
@@ -23,6 +23,7 @@
 #include "app/defaults.h"
 #include "app/images.h"
 #include "app/loaded_level.h"
+#include "python/lcm_access.h"
 #include "python/results.h"
 #include "scene/collision_world.h"
 #include "scene/robot_state.h"
@@ -441,15 +442,18 @@ class World {
 }  // namespace
 }  // namespace sandbox::python
 
-PYBIND11_MODULE(sandbox, module) {
+PYBIND11_MODULE(_sandbox, module) {
   using namespace sandbox::python;
   using sandbox::sensors::FaceScan;
   module.doc() =
       "The sandbox in-process: a level, its robots, scans as numpy arrays "
       "(docs/reference/python.md).";
-  py::register_exception<sandbox::scene::LevelError>(module, "LevelError", PyExc_RuntimeError);
+  py::register_exception<sandbox::scene::LevelError>(module, "LevelError", PyExc_RuntimeError)
+      .attr("__module__") = "sandbox";
 
   BindResults(module);
+  BindLcm(module);
+  BindLockstep(module);
 
   py::class_<World>(module, "World",
                     "A level loaded in-process (a manifest or a scene file; default: the "

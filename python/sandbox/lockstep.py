@@ -1,0 +1,119 @@
+"""`sandbox run --lockstep` in-process, one tick a step()."""
+
+import numpy as np
+
+from . import _sandbox
+from .messages import actors_message, bones_message, decode, joints_message, pose_message
+
+
+def _split_pose(pose):
+    """(position, orientation), or a position alone (the identity orientation)."""
+    if len(pose) == 2 and np.ndim(pose[0]) == 1:
+        return pose
+    return pose, (1.0, 0.0, 0.0, 0.0)
+
+
+class Outputs(dict):
+    """What one tick published: {channel: [Message, ...]} in publishing order
+    (a face scanner's six faces are six messages on one channel); `tick`."""
+
+    def __init__(self, tick):
+        super().__init__()
+        self.tick = tick
+
+    def __missing__(self, channel):
+        raise KeyError(f"tick {self.tick} published nothing on {channel!r}; it published on "
+                       f"{', '.join(sorted(self)) or 'no channel'}")
+
+
+class Lockstep:
+    """The program's loop (`sandbox run --lockstep`) in this process, ticked by
+    `step()`: the level as `sandbox run` loads it (default: the bundled sample
+    level), `args` any further `sandbox run` options (`--out DIR`, `--record
+    LOG`, `--no-sensors`, `--ticks N`, `--web PORT`, ...). Its outputs are
+    those of `sandbox run --replay` on the same inputs. Use it in a `with`
+    block, or call `close()`: that ends the run and finishes its files."""
+
+    def __init__(self, level=None, args=(), rate_hz=100.0):
+        if isinstance(args, str):
+            raise ValueError("args must be a list of sandbox run options, not one string")
+        args = [str(arg) for arg in args] + ([str(level)] if level is not None else [])
+        if not rate_hz > 0:
+            raise ValueError(f"rate_hz must be positive, got {rate_hz!r}")
+        self._run = _sandbox._Lockstep(args)
+        self._prefix = dict(self._run.robots)
+        self.robots = list(self._prefix)
+        self.actors = self._run.actors
+        self.name = self._run.name
+        self._period_us = round(1e6 / rate_hz)
+        self._utime = None
+        self._seq = {}
+        self._poses = {}
+        self.summary = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def _channel(self, robot, kind):
+        if robot not in self._prefix:
+            raise KeyError(f"no robot {robot!r}; the level has {', '.join(self.robots) or 'none'}")
+        return f"{self._prefix[robot]}/{kind}"
+
+    def _seq_of(self, channel):
+        seq = self._seq.get(channel, 0)
+        self._seq[channel] = seq + 1
+        return seq
+
+    def step(self, poses=None, bones=None, joints=None, actors=None, utime=None):
+        """Runs one tick on these inputs and returns its `Outputs`.
+
+        poses: {robot: (position, orientation)} (or just a position), in each
+        robot's pose convention; a robot left out keeps its last pose, re-sent
+        at this tick's time (every tick needs a pose: lock-step time is the
+        poses' utime). bones: {robot: values in bone-map order}; joints:
+        {robot: {joint: value} or every value}; actors: {movable actor:
+        (position, orientation)}, world. utime: this tick's time in
+        microseconds (default: the last plus one period of rate_hz)."""
+        if utime is None:
+            utime = 0 if self._utime is None else self._utime + self._period_us
+        utime = int(utime)
+        inputs = []
+        for robot, value in (bones or {}).items():
+            channel = self._channel(robot, "BONES")
+            inputs.append((channel, bones_message(value, utime, self._seq_of(channel))))
+        for robot, value in (joints or {}).items():
+            channel = self._channel(robot, "JOINTS")
+            inputs.append((channel, joints_message(value, utime, self._seq_of(channel))))
+        if actors:
+            channel = self._channel(self.robots[0], "ACTORS")
+            inputs.append((channel, actors_message(actors, utime, self._seq_of(channel))))
+        poses = dict(poses or {})
+        for robot in poses:
+            self._channel(robot, "POSE")  # a KeyError before anything is encoded
+        for robot, pose in {**self._poses, **poses}.items():
+            position, orientation = _split_pose(pose)
+            channel = self._channel(robot, "POSE")
+            inputs.append((channel, pose_message(position, orientation, utime, self._seq_of(channel))))
+            self._poses[robot] = (position, orientation)
+        if not self._poses:
+            raise ValueError("the first step needs a pose for at least one robot (poses=...)")
+        tick, published = self._run.step(inputs)
+        self._utime = utime
+        outputs = Outputs(tick)
+        for channel, data in published:
+            outputs.setdefault(channel, []).append(decode(data))
+        return outputs
+
+    @property
+    def messages(self):
+        """What the run has said on its error stream (rejected inputs, warnings)."""
+        return self._run.messages
+
+    def close(self):
+        """Ends the run (files finished); returns and keeps its summary (`summary`)."""
+        if self.summary is None:
+            self.summary = self._run.close()
+        return self.summary

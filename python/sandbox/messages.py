@@ -1,0 +1,117 @@
+"""The sandbox's LCM messages in Python: decoded by lcm-gen's Python types
+(generated at build time into sandbox/sandbox_msgs/, pure Python), their
+arrays as numpy, and the input messages encoded from Python values."""
+
+import math
+import types
+
+import numpy as np
+
+from . import sandbox_msgs
+
+# Every message type, by its name and by its fingerprint (the first 8 bytes).
+message_types = {name: getattr(sandbox_msgs, name) for name in dir(sandbox_msgs)
+                 if name.endswith("_t")}
+_BY_FINGERPRINT = {cls._get_packed_fingerprint(): cls for cls in message_types.values()}
+
+
+class Message(types.SimpleNamespace):
+    """A decoded message: its fields as attributes (as in bridge/lcmtypes/*.lcm,
+    flat), numeric arrays as numpy arrays, string arrays as lists;
+    `lcm_type` is the type's name."""
+
+
+def decode(data):
+    """The message in `data` (bytes) as a `Message`; ValueError when its
+    fingerprint is not a sandbox type or it does not decode."""
+    data = bytes(data)
+    cls = _BY_FINGERPRINT.get(data[:8])
+    if cls is None:
+        raise ValueError(f"not a sandbox message (fingerprint {data[:8].hex() or 'missing'})")
+    try:
+        raw = cls.decode(data)
+    except Exception as error:  # struct.error on a short message
+        raise ValueError(f"{cls.__name__} does not decode: {error}") from None
+    fields = {}
+    for name in cls.__slots__:
+        value = getattr(raw, name)
+        if isinstance(value, (tuple, list)):
+            if value and isinstance(value[0], str):
+                value = list(value)
+            else:
+                value = np.asarray(value, dtype=np.float64 if value and isinstance(value[0], float)
+                                   else np.int64)
+        fields[name] = value
+    return Message(lcm_type=cls.__name__, **fields)
+
+
+def finite(value, count, argument):
+    """`value` as `count` finite floats (a tuple), else ValueError naming `argument`."""
+    try:
+        array = np.asarray(value, dtype=np.float64).reshape(-1)
+    except (TypeError, ValueError):
+        raise ValueError(f"{argument} must be {count} numbers, got {value!r}") from None
+    if count is not None and array.size != count:
+        raise ValueError(f"{argument} must be {count} numbers, got {array.size}")
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{argument} must be finite, got {value!r}")
+    return tuple(float(v) for v in array)
+
+
+def pose_message(position, orientation, utime, seq):
+    message = sandbox_msgs.robot_pose_t()
+    message.utime, message.seq = int(utime), int(seq)
+    message.position = finite(position, 3, "position")
+    message.orientation = finite(orientation, 4, "orientation")
+    norm = math.sqrt(sum(v * v for v in message.orientation))
+    if abs(norm - 1.0) > 1e-6:
+        raise ValueError(f"orientation must be a unit quaternion (w, x, y, z), its norm is {norm}")
+    return message.encode()
+
+
+def bones_message(values, utime, seq):
+    message = sandbox_msgs.bone_values_t()
+    message.utime, message.seq = int(utime), int(seq)
+    message.values = finite(values, None, "bones")
+    message.num_values = len(message.values)
+    return message.encode()
+
+
+def joints_message(values, utime, seq):
+    """`values`: {joint name: value}, or every joint's value in the robot's order."""
+    message = sandbox_msgs.joint_values_t()
+    message.utime, message.seq = int(utime), int(seq)
+    if isinstance(values, dict):
+        names = list(values)
+        if not all(isinstance(name, str) for name in names):
+            raise ValueError("joints: names must be strings")
+        message.names = names
+        message.values = finite([values[name] for name in names], len(names), "joints")
+    else:
+        message.names = []
+        message.values = finite(values, None, "joints")
+    message.num_names, message.num_values = len(message.names), len(message.values)
+    return message.encode()
+
+
+def actors_message(placements, utime, seq):
+    """`placements`: {actor name: (position, orientation)}."""
+    if not isinstance(placements, dict):
+        raise ValueError("actors must be a dict {name: (position, orientation)}")
+    message = sandbox_msgs.actor_placements_t()
+    message.utime, message.seq = int(utime), int(seq)
+    message.names, positions, orientations = [], [], []
+    for name, placement in placements.items():
+        if not isinstance(name, str):
+            raise ValueError("actors: names must be strings")
+        try:
+            position, orientation = placement
+        except (TypeError, ValueError):
+            raise ValueError(f"actors[{name!r}] must be (position, orientation)") from None
+        message.names.append(name)
+        positions += finite(position, 3, f"actors[{name!r}] position")
+        orientations += finite(orientation, 4, f"actors[{name!r}] orientation")
+    message.positions, message.orientations = positions, orientations
+    message.num_actors = len(message.names)
+    message.num_positions, message.num_orientations = len(positions), len(orientations)
+    return message.encode()
