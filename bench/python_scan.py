@@ -1,14 +1,25 @@
 #!/usr/bin/python3
 """A face scan and a render through Python against the same from C++ in one
-process (target: at most 1.05x each), and the arrays' data pointers against
-the scan's own buffers (zero copies).
+process (target: at most 1.05x each), the arrays' data pointers against
+the scan's own buffers (zero copies), and Lockstep.step()'s tick rate against
+`sandbox run --replay` of the same inputs (target: at least 0.9x).
 
 usage: PYTHONPATH=build/python bench/python_scan.py [ROUNDS]   (default 7)
 """
+import math
+import os
+import pathlib
+import re
+import struct
+import subprocess
 import sys
+import tempfile
 import time
 
 import sandbox
+from sandbox import sandbox_msgs
+
+SANDBOX = os.environ.get("SANDBOX", str(pathlib.Path(__file__).resolve().parents[1] / "build/sandbox"))
 
 
 def best_python(world, position, resolution, half_extent, repeats):
@@ -60,6 +71,56 @@ def main():
           % ("yes" if same else "NO"))
     print("ratio: the median over the rounds of Python's best over C++'s best (the last round's "
           "times shown)")
+    bench_step(rounds)
+
+
+def flight(ticks, bones):
+    """(utime, position, orientation, bone values) a tick: a climbing turn, bending."""
+    for k in range(ticks):
+        heading = 0.002 * k
+        yield (1_000_000 + 10_000 * k, (0.3 * k, -100.0 + 0.2 * k, 40.0 + 0.01 * k),
+               (math.cos(heading / 2), 0.0, 0.0, math.sin(heading / 2)),
+               [0.2 * math.sin(0.01 * k + b) for b in range(bones)])
+
+
+def bench_step(rounds, ticks=3000):
+    """Lockstep.step() against sandbox run --replay on the same inputs: ticks a second."""
+    bones = len(sandbox.World().bones("ELAHA"))
+    inputs = list(flight(ticks, bones))
+    with tempfile.TemporaryDirectory() as folder:
+        log = pathlib.Path(folder) / "inputs.lcmlog"
+        with open(log, "wb") as f:
+            for k, (utime, position, q, bend) in enumerate(inputs):
+                for channel, message in (("ELAHA/BONES", sandbox_msgs.bone_values_t()),
+                                         ("ELAHA/POSE", sandbox_msgs.robot_pose_t())):
+                    message.utime, message.seq = utime, k
+                    if channel.endswith("BONES"):
+                        message.num_values, message.values = bones, bend
+                    else:
+                        message.position, message.orientation = position, q
+                    data = message.encode()
+                    f.write(struct.pack(">IqqII", 0xEDA1DA01, 2 * k, utime, len(channel), len(data)))
+                    f.write(channel.encode() + data)
+        ratios = []
+        for _ in range(rounds):
+            result = subprocess.run([SANDBOX, "run", "--replay", str(log)], capture_output=True,
+                                    text=True, check=True)
+            replay_hz = float(re.search(r"(\d+) ticks in [\d.]+ s \(([\d.]+) Hz\)",
+                                        result.stdout).group(2))
+            with sandbox.Lockstep() as run:
+                start = time.perf_counter()
+                for utime, position, q, bend in inputs:
+                    outputs = run.step(poses={"ELAHA": (position, q)}, bones={"ELAHA": bend},
+                                       utime=utime)
+                    outputs["ELAHA/STATE"]  # a controller's read: the STATE decoded
+                step_hz = ticks / (time.perf_counter() - start)
+            ratios.append(step_hz / replay_hz)
+    ratios.sort()
+    print("%-30s %12s %12s %8s" % ("lock-step ticks, %d" % ticks, "replay Hz", "step() Hz", "ratio"))
+    print("%-30s %12.0f %12.0f %8.3f" % ("poses, bones; STATE decoded", replay_hz, step_hz,
+                                         ratios[len(ratios) // 2]))
+    print("step ratio: the median over the rounds of step()'s tick rate over sandbox run "
+          "--replay's (its own figure) on the same inputs, sensors on (the last round's shown)")
 
 
 if __name__ == "__main__":

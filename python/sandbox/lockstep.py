@@ -1,5 +1,7 @@
 """`sandbox run --lockstep` in-process, one tick a step()."""
 
+from collections.abc import Mapping
+
 import numpy as np
 
 from . import _sandbox
@@ -13,17 +15,38 @@ def _split_pose(pose):
     return pose, (1.0, 0.0, 0.0, 0.0)
 
 
-class Outputs(dict):
+class Outputs(Mapping):
     """What one tick published: {channel: [Message, ...]} in publishing order
-    (a face scanner's six faces are six messages on one channel); `tick`."""
+    (a face scanner's six faces are six messages on one channel); `tick`.
+    A channel's messages are decoded when first asked for (`raw(channel)`:
+    their bytes)."""
 
-    def __init__(self, tick):
-        super().__init__()
+    def __init__(self, tick, published):
         self.tick = tick
+        self._raw, self._decoded = {}, {}
+        for channel, data in published:
+            self._raw.setdefault(channel, []).append(data)
 
-    def __missing__(self, channel):
-        raise KeyError(f"tick {self.tick} published nothing on {channel!r}; it published on "
-                       f"{', '.join(sorted(self)) or 'no channel'}")
+    def __getitem__(self, channel):
+        messages = self._decoded.get(channel)
+        if messages is None:
+            if channel not in self._raw:
+                raise KeyError(f"tick {self.tick} published nothing on {channel!r}; it published "
+                               f"on {', '.join(sorted(self._raw)) or 'no channel'}")
+            messages = self._decoded[channel] = [decode(data) for data in self._raw[channel]]
+        return messages
+
+    def raw(self, channel):
+        return self._raw[channel]
+
+    def __iter__(self):
+        return iter(self._raw)
+
+    def __len__(self):
+        return len(self._raw)
+
+    def __repr__(self):
+        return f"Outputs(tick {self.tick}, {', '.join(f'{c}: {len(m)}' for c, m in self._raw.items())})"
 
 
 class Lockstep:
@@ -102,10 +125,7 @@ class Lockstep:
             raise ValueError("the first step needs a pose for at least one robot (poses=...)")
         tick, published = self._run.step(inputs)
         self._utime = utime
-        outputs = Outputs(tick)
-        for channel, data in published:
-            outputs.setdefault(channel, []).append(decode(data))
-        return outputs
+        return Outputs(tick, published)
 
     @property
     def messages(self):
