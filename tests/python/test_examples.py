@@ -1,6 +1,7 @@
 """examples/python/ on a small case: the dataset writer's files are what its
 index says, its images those `sandbox render` draws at the pose the index
-gives, its scans around that pose."""
+gives, its scans around that pose; the wing's loop as its formula says.
+controller_bench.py runs in test_client.py."""
 import csv
 import os
 import subprocess
@@ -41,3 +42,21 @@ def test_the_dataset_writer(tmp_path):
         centre = np.array([float(row["x"]), float(row["y"]), float(row["z"])])
         assert np.nanmax(np.abs(points - centre)) <= 25 * 3 ** 0.5 + 1e-6
         assert int(row["hits"]) > 100  # the ground is within 20 m below
+
+
+def test_fly_wing(tmp_path):
+    """The loop flown as its formula says (restated), the chase frames at the camera's
+    30 Hz of 100 Hz ticks, the plot written, no input refused."""
+    import json
+    import math
+    ticks = 60
+    subprocess.run([sys.executable, os.path.join(EXAMPLES, "fly_wing.py"), str(tmp_path),
+                    "--ticks", str(ticks)], check=True, stdout=subprocess.DEVNULL)
+    flight = json.loads((tmp_path / "flight.json").read_text())
+    assert flight["refused"] == "" and flight["frames"] == ticks * 30 // 100
+    for k, position in enumerate(flight["positions"]):
+        angle = 2 * math.pi * k / ticks
+        assert np.allclose(position, (40 * math.sin(angle), -60, 70 - 40 * math.cos(angle)),
+                           atol=1e-9)
+    assert flight["occupied"] > 0
+    assert (tmp_path / "face_down.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
