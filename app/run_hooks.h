@@ -1,15 +1,13 @@
 #pragma once
 // In-process additions to `sandbox run`'s loop: the demo's fallback pilot and
 // its heartbeat listener, `sandbox view`'s recording of states, the Python
-// module's lock-step stepping, and test aids (a slow tick). All run on the
+// module's outputs, and test aids (a slow tick). All run on the
 // loop thread.
 
 #include <cstdint>
 #include <functional>
-#include <vector>
 
 #include "bridge/lcm_link.h"
-#include "bridge/recorded_states.h"
 #include "web/stream_state.h"
 
 namespace sandbox::app {
@@ -28,11 +26,6 @@ struct RunHooks {
   double web_samples_every_s{1.0};
   // Called before the link closes: let go of what before_tick subscribed.
   std::function<void(bridge::LcmLink& link)> before_close;
-  // Lock-step inputs from the caller instead of the network (with
-  // RunOptions::lockstep and no replay): called while no robot has a pose
-  // waiting; fills *events (given to the robots as if they had arrived) and
-  // returns false to end the run.
-  std::function<bool(std::vector<bridge::LogEvent>* events)> lockstep_inputs;
   // Every message the loop publishes, as it is published.
   bridge::LcmLink::PublishTap published;
   // False: SIGINT and SIGTERM are left to the caller (an interpreter's own).

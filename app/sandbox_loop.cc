@@ -4,7 +4,6 @@
 #include <chrono>
 #include <exception>
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <mutex>
 #include <optional>
@@ -12,14 +11,10 @@
 #include <string>
 
 #include "app/command_line.h"
-#include "app/images.h"
 #include "app/run_summary.h"
 #include "app/thread_priority.h"
-#include "app/tick_pacer.h"
-#include "app/web_samples.h"
 #include "web/commands.h"
 #include "web/level_model.h"
-#include "web/stream_state.h"
 
 namespace sandbox::app {
 namespace {
@@ -168,29 +163,16 @@ int SandboxLoop::Run() {
   }
   std::optional<SignalRoute> signals;  // SIGINT and SIGTERM end the loop, and wake its waits
   if (hooks_.route_signals) signals.emplace(stop_);
-  out_ << "sandbox run: " << level_.name << ", " << level_.robots.size() << " robots, "
-       << (options_.sensors ? std::to_string(sensors_.size()) + " sensors, " : "sensors off, ")
-       << (options_.publish ? "" : "publishing nothing, ")
-       << (options_.replay() ? "replaying " + options_.replay_file
-                             : PaceName(options_) + ", LCM " + link_.url())
-       << priority << "\n";
-  if (web_) out_ << "sandbox run: browser view at " << web_->url() << "\n";
-  out_ << std::flush;
-
   const double period_s = paced ? 1.0 / options_.rate_hz : 0.0;
+  Start(period_s, priority);
   // Inputs are drained for at most a quarter of a period (a flood cannot hold the loop).
   const double drain_budget_s = paced ? std::min(0.25 * period_s, 0.005) : 0.001;
-  const auto start = Clock::now();
-  auto seconds_since_start = [&start](Clock::time_point t) {
-    return std::chrono::duration<double>(t - start).count();
-  };
-  auto at = [&start](double s) {
-    return start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+  auto at = [this](double s) {
+    return start_ + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
   };
   const bool timed = options_.duration_s > 0.0;
-  TickPacer pacer(period_s, 0.0);
   while (!stop_.requested()) {
-    const double wall_s = seconds_since_start(Clock::now());
+    const double wall_s = SinceStart();
     if (timed && wall_s >= options_.duration_s) break;
     if (options_.lockstep) {
       bool wait = false;
@@ -199,38 +181,82 @@ int SandboxLoop::Run() {
     }
     if (!TakeViewKeys(drain_budget_s)) {
       if (cameras_.controls().quit) break;
-      pacer.Restart(seconds_since_start(Clock::now()));  // paused
+      pacer_.Restart(SinceStart());  // paused
       continue;
     }
-    const auto tick_start = Clock::now();
-    TickRecord record;
-    record.tick = tick_;
-    record.start_s = seconds_since_start(tick_start);
-    record.lateness_ms = 1e3 * pacer.Lateness(record.start_s);
-    Tick(wall_s, drain_budget_s, &record);
-    ++tick_;
-    if (options_.ticks > 0 && tick_ >= options_.ticks) stop_.Request();
-    // 6. Record the tick; wait for the next (or the end of the run, or a stop).
-    const auto tick_end = Clock::now();
-    record.duration_ms = std::chrono::duration<double, std::milli>(tick_end - tick_start).count();
     bool overrun = false;
-    const double next_s = pacer.Next(seconds_since_start(tick_end), &overrun);
-    stats_.Add(record, overrun);
-    if (web_ && web_->WantsState()) PublishWebState(record, seconds_since_start(Clock::now()));
-    if (hooks_.web_state) {
-      const bool due = tick_time_s_ >= recorded_samples_due_s_;
-      if (due) recorded_samples_due_s_ = tick_time_s_ + hooks_.web_samples_every_s;
-      hooks_.web_state(WebState(record, due));
-    }
-    KeepOriginNearRobot();  // between ticks: the next tick's rays see the new origin
+    const double next_s = TickAndRecord(wall_s, drain_budget_s, &overrun);
     if (paced && !overrun) {
       stop_.SleepUntil(at(timed ? std::min(next_s, options_.duration_s) : next_s));
     }
   }
+  return Finish();
+}
+
+void SandboxLoop::Start(double period_s, const std::string& priority) {
+  out_ << "sandbox run: " << level_.name << ", " << level_.robots.size() << " robots, "
+       << (options_.sensors ? std::to_string(sensors_.size()) + " sensors, " : "sensors off, ")
+       << (options_.publish ? "" : "publishing nothing, ")
+       << (options_.replay() ? "replaying " + options_.replay_file
+                             : PaceName(options_) + ", LCM " + link_.url())
+       << priority << "\n";
+  if (web_) out_ << "sandbox run: browser view at " << web_->url() << "\n";
+  out_ << std::flush;
+  start_ = Clock::now();
+  pacer_ = TickPacer(period_s, 0.0);
+}
+
+double SandboxLoop::SinceStart() const {
+  return std::chrono::duration<double>(Clock::now() - start_).count();
+}
+
+double SandboxLoop::TickAndRecord(double wall_s, double drain_budget_s, bool* overrun) {
+  const auto tick_start = Clock::now();
+  TickRecord record;
+  record.tick = tick_;
+  record.start_s = std::chrono::duration<double>(tick_start - start_).count();
+  record.lateness_ms = 1e3 * pacer_.Lateness(record.start_s);
+  Tick(wall_s, drain_budget_s, &record);
+  ++tick_;
+  if (options_.ticks > 0 && tick_ >= options_.ticks) stop_.Request();
+  // 6. Record the tick; the caller waits for the next (or the end of the run, or a stop).
+  const auto tick_end = Clock::now();
+  record.duration_ms = std::chrono::duration<double, std::milli>(tick_end - tick_start).count();
+  const double next_s =
+      pacer_.Next(std::chrono::duration<double>(tick_end - start_).count(), overrun);
+  stats_.Add(record, *overrun);
+  if (web_ && web_->WantsState()) PublishWebState(record, SinceStart());
+  if (hooks_.web_state) {
+    const bool due = tick_time_s_ >= recorded_samples_due_s_;
+    if (due) recorded_samples_due_s_ = tick_time_s_ + hooks_.web_samples_every_s;
+    hooks_.web_state(WebState(record, due));
+  }
+  KeepOriginNearRobot();  // between ticks: the next tick's rays see the new origin
+  return next_s;
+}
+
+int SandboxLoop::Finish() {
   if (frames_) frames_->Finish();  // queues drained, videos and indexes closed
   scan_files_.Finish();
   link_.FinishRecording();
-  return Report(seconds_since_start(Clock::now())) ? 0 : kExitOutputLost;
+  return Report(SinceStart()) ? 0 : kExitOutputLost;
+}
+
+void SandboxLoop::BeginSteps() {
+  if (!options_.lockstep || log_) throw CommandError("stepping needs --lockstep and no --replay");
+  Start(0.0, "");
+}
+
+bool SandboxLoop::Step(const std::vector<bridge::LogEvent>& events) {
+  if (stop_.requested()) return false;
+  for (const bridge::LogEvent& event : events) {
+    link_.Inject(event.channel, event.data.data(), unsigned(event.data.size()));
+    link_.Drain();
+  }
+  if (!has_pose()) return false;
+  bool overrun = false;
+  TickAndRecord(SinceStart(), 0.001, &overrun);
+  return true;
 }
 
 void SandboxLoop::Tick(double wall_s, double drain_budget_s, TickRecord* record) {
@@ -276,7 +302,7 @@ bool SandboxLoop::TakeViewKeys(double drain_budget_s) {
 
 bool SandboxLoop::NextLockstepInput(double wall_s, bool* wait) {
   *wait = false;
-  if (!log_ && !hooks_.lockstep_inputs) {  // from the network: wait for a pose message
+  if (!log_) {  // from the network: wait for a pose message
     link_.Drain();
     if (!has_pose()) {
       link_.Wait(100);
@@ -284,35 +310,28 @@ bool SandboxLoop::NextLockstepInput(double wall_s, bool* wait) {
     }
     return true;
   }
-  while (!has_pose() && NextInputEvents()) {
+  std::string channel;
+  std::vector<std::uint8_t> data;
+  std::int64_t utime = 0;
+  while (!has_pose() && log_->Next(&channel, &data, &utime)) {
+    log_feed_.clear();
+    const std::string refused = log_states_->Translate(channel, data, &log_feed_);
+    if (!refused.empty()) reject_log_.Note(channel, refused);
     for (const bridge::LogEvent& event : log_feed_) {
       link_.Inject(event.channel, event.data.data(), unsigned(event.data.size()));
       link_.Drain();
     }
   }
-  for (const std::string& prefix :
-       log_ ? log_states_->TakeNewRobotsFromStates() : std::vector<std::string>{}) {
+  for (const std::string& prefix : log_states_->TakeNewRobotsFromStates()) {
     err_ << "\rsandbox: " << options_.replay_file << " holds what a run applied (" << prefix
          << "/STATE before any " << prefix << "/POSE): its states are replayed as " << prefix
          << "'s POSE and BONES\n";
   }
   if (!has_pose()) return false;  // the log has ended
-  if (log_ && wall_s >= next_progress_s_) {
+  if (wall_s >= next_progress_s_) {
     next_progress_s_ = wall_s + 0.25;
     PrintReplayProgress(*log_, tick_, wall_s, err_);
   }
-  return true;
-}
-
-bool SandboxLoop::NextInputEvents() {
-  log_feed_.clear();
-  if (!log_) return hooks_.lockstep_inputs(&log_feed_);
-  std::string channel;
-  std::vector<std::uint8_t> data;
-  std::int64_t utime = 0;
-  if (!log_->Next(&channel, &data, &utime)) return false;
-  const std::string refused = log_states_->Translate(channel, data, &log_feed_);
-  if (!refused.empty()) reject_log_.Note(channel, refused);
   return true;
 }
 
@@ -477,88 +496,6 @@ void SandboxLoop::ReportRecordingFailure() {
   if (recording_failure_reported_ || link_.record_error().empty()) return;
   recording_failure_reported_ = true;
   err_ << "sandbox run: recording stopped: " << link_.record_error() << "\n";
-}
-
-void SandboxLoop::ShowCameraFrame(const std::string& camera, std::int64_t tick,
-                                  const render::CameraView& view, const render::Frame& frame,
-                                  const std::filesystem::path& color_file) {
-  if (!web_ || web_->counts().clients == 0 || frame.rgb.empty()) return;
-  const auto now = Clock::now();
-  Clock::time_point& due = web_camera_due_[camera];
-  if (now < due) return;
-  due = now + std::chrono::milliseconds(int(1000.0 / kWebCameraHz));
-  web::CameraFrame shown{camera, tick, view.X_WC, view.fov_y_rad, frame.width, frame.height, {}};
-  if (color_file.extension() == ".jpg") {  // the writer's own JPEG
-    std::ifstream in(color_file, std::ios::binary);
-    std::ostringstream bytes;
-    bytes << in.rdbuf();
-    shown.jpeg = bytes.str();
-  }
-  if (shown.jpeg.empty()) shown.jpeg = EncodeJpeg(frame);
-  web_->SetCameraFrame(shown);
-}
-
-void SandboxLoop::PublishWebState(const TickRecord& record, double wall_s) {
-  // Samples a few times a second of the run's time and of the wall's (a
-  // replay runs faster than its clock: they are most of the bytes).
-  const bool due = tick_time_s_ >= web_samples_due_s_ && wall_s >= web_samples_wall_due_s_;
-  if (due) {
-    web_samples_due_s_ = tick_time_s_ + 1.0 / kWebSamplesHz;
-    web_samples_wall_due_s_ = wall_s + 1.0 / kWebSamplesHz;
-  }
-  web_->Publish([state = WebState(record, due)] {
-    return web::EncodedState(web::EncodeState(state), web::EncodeSamples(state));
-  });
-}
-
-web::StreamState SandboxLoop::WebState(const TickRecord& record, bool with_samples) {
-  web::StreamState state;
-  state.tick = record.tick;
-  state.time_s = tick_time_s_;
-  state.tick_ms = record.duration_ms;
-  state.late_ms = record.lateness_ms;
-  for (std::size_t r = 0; r < robots_.size(); ++r) {
-    web::StreamState::Robot robot;
-    robot.name = level_.robots[r].name;
-    const bridge::RobotFeed& feed = *robots_[r].feed;
-    robot.has_pose = feed.input().seq >= 0 || feed.input().utime >= 0;
-    const Eigen::Isometry3d& X_WB = robots_[r].state->pose();
-    robot.p_W = X_WB.translation();
-    robot.q_W = Eigen::Quaterniond(X_WB.linear());
-    const scene::RobotState& robot_state = *robots_[r].state;
-    robot.bone_values = robot_state.bone_values();
-    const std::vector<scene::SkinJoint>& joints = robot_state.model().joints;
-    robot.joints.reserve(12 * joints.size());
-    for (const scene::SkinJoint& joint : joints) {
-      const Eigen::Matrix<double, 3, 4> X_BN =
-          robot_state.node_poses_B()[std::size_t(joint.node)].matrix().topRows<3>();
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 4; ++j) robot.joints.push_back(X_BN(i, j));
-    }
-    for (const bridge::ChannelStatus& channel : feed.Channels(tick_utime_)) {
-      robot.received += channel.received;
-      robot.rejected += channel.rejected;
-      if (channel.stale) robot.stale.push_back(channel.channel);
-    }
-    state.robots.push_back(std::move(robot));
-  }
-  for (std::size_t a = 0; a < level_.actors.size(); ++a) {
-    if (!level_.actors[a].movable) continue;
-    const Eigen::Isometry3d& X_WA = world_.actor_pose(int(a));
-    state.actors.push_back(
-        {level_.actors[a].name, X_WA.translation(), Eigen::Quaterniond(X_WA.linear())});
-  }
-  if (with_samples) {
-    state.has_samples = true;
-    state.samples_tick = state.tick;
-    state.samples_origin = world_.origin();
-    for (const sensors::Sensor& sensor : sensors_) {
-      state.samples.push_back(ViewSamples(sensor,
-                                          level_.robots[std::size_t(sensor.mounted().robot)].name,
-                                          state.samples_origin, kWebSamplesPerSensor));
-    }
-  }
-  return state;
 }
 
 bool SandboxLoop::Report(double elapsed_s) {

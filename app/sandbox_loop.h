@@ -12,13 +12,16 @@
 //   6.   the tick recorded (TickStats); then the wait for the next.
 // A late tick is followed at once by the next; ticks are never bunched to
 // catch up. The end of the run is reported by ReportRun (run_summary.h).
+// sandbox_loop_web.cc holds the loop's part in the browser view.
 //
-// Threads: everything here runs on the loop thread (the caller of Run). It
-// starts the render and encoder threads (FramePipeline) and the scan-file
-// writer, and takes real-time priority for itself when asked and allowed. The
-// live view's window is run by the caller on the main thread.
+// Threads: everything here runs on the loop thread (the caller of Run, or of
+// BeginSteps, Step and Finish). It starts the render and encoder threads
+// (FramePipeline) and the scan-file writer, and takes real-time priority for
+// itself when asked and allowed. The live view's window is run by the caller
+// on the main thread.
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -36,6 +39,7 @@
 #include "app/run_options.h"
 #include "app/scan_files.h"
 #include "app/stop_request.h"
+#include "app/tick_pacer.h"
 #include "app/tick_stats.h"
 #include "bridge/lcm_link.h"
 #include "bridge/outputs.h"
@@ -76,6 +80,15 @@ class SandboxLoop {
   // live view's q or RequestStop(); then finishes the files and prints the
   // summary to `out`. Returns 0, or kExitOutputLost.
   int Run();
+  // Stepped instead of Run() (lock-step options without --replay; the
+  // caller's thread is the loop thread): BeginSteps() once; Step() a tick,
+  // with the messages that arrive for it (false: no tick ran, because no
+  // robot has a pose waiting or the run has ended, see ended()); then
+  // Finish() once, which returns as Run() does.
+  void BeginSteps();
+  bool Step(const std::vector<bridge::LogEvent>& events);
+  bool ended() const { return stop_.requested(); }
+  int Finish();
   // Any thread: ends Run() after the current tick (or at once from a wait).
   void RequestStop() { stop_.Request(); }
   // The live view when asked for (its window is the caller's to run), or null.
@@ -96,9 +109,12 @@ class SandboxLoop {
   // Lock-step: makes the next pose available (reading the replayed log up to
   // it). False: stop (the log has ended); *wait: nothing yet, try again.
   bool NextLockstepInput(double wall_s, bool* wait);
-  // The replayed log's next events (or RunHooks::lockstep_inputs') into
-  // log_feed_; false when there are no more.
-  bool NextInputEvents();
+  // The banner printed, the clock and the pacer started.
+  void Start(double period_s, const std::string& priority);
+  double SinceStart() const;  // seconds since Start()
+  // A tick (Tick) recorded (6, and what follows a tick); returns when the
+  // next tick is due and sets *overrun when this one ran past it.
+  double TickAndRecord(double wall_s, double drain_budget_s, bool* overrun);
   // The live view's keys; false when the tick is skipped (paused or quit).
   bool TakeViewKeys(double drain_budget_s);
   // Steps 1-5 of a tick, each below in order; the caller records it (6).
@@ -169,6 +185,8 @@ class SandboxLoop {
   std::mutex web_keys_mutex_;
   std::vector<ViewKey> web_keys_;  // --web-control's camera commands, not yet applied
 
+  std::chrono::steady_clock::time_point start_;
+  TickPacer pacer_{0.0, 0.0};
   std::int64_t tick_{0};
   double tick_time_s_{0.0};              // the last tick's time (lock-step: its input's)
   std::int64_t tick_utime_{0};           // and its clock, as inputs are stamped

@@ -1,22 +1,18 @@
-// _Lockstep: `sandbox run --lockstep` in-process, on a thread of its own,
-// ticked from Python. Each step hands the loop its inputs (as if they had
-// arrived on LCM, through RunHooks::lockstep_inputs), waits for the tick to
-// end and returns every message the tick published (RunHooks::published).
-// The loop is the program's own: outputs, files and recordings are those of
-// `sandbox run --replay` on the same inputs.
+// _Lockstep: `sandbox run --lockstep` in-process, ticked from Python. Each
+// step hands the loop (app::SandboxLoop, stepped: BeginSteps, Step, Finish)
+// its inputs as if they had arrived on LCM, runs the tick on the calling
+// thread with the GIL released, and returns every message the tick published
+// (RunHooks::published). The loop is the program's own: outputs, files and
+// recordings are those of `sandbox run --replay` on the same inputs.
 
 #include <pybind11/stl.h>
 
-#include <chrono>
-#include <condition_variable>
 #include <cstdint>
-#include <exception>
 #include <memory>
 #include <mutex>
 #include <sstream>
 #include <streambuf>
 #include <string>
-#include <thread>
 #include <tuple>
 #include <vector>
 
@@ -32,7 +28,8 @@ namespace {
 
 using Message = std::tuple<std::string, py::bytes>;
 
-// A text stream several threads may write and read (the loop's error stream).
+// A text stream several threads may write and read (the loop's error
+// stream: the frame threads write to it too).
 class SharedText : public std::streambuf {
  public:
   std::string str() {
@@ -73,7 +70,7 @@ class Lockstep {
     std::ostringstream usage_error;
     const auto parsed = app::ParseArgs(args, "run", app::kRunValueOptions, app::kRunFlags,
                                        "(the options of sandbox run --help)\n", usage_error);
-    if (!parsed) throw py::value_error(FirstLine(usage_error.str()));
+    if (!parsed) throw py::value_error(usage_error.str().substr(0, usage_error.str().find('\n')));
     app::RunOptions options;
     try {
       options = app::ParseRunOptions(*parsed);
@@ -82,40 +79,18 @@ class Lockstep {
     }
     app::RunHooks hooks;
     hooks.route_signals = false;
-    hooks.lockstep_inputs = [this](std::vector<bridge::LogEvent>* events) {
-      return TakeInputs(events);
-    };
     hooks.published = [this](const std::string& channel, const void* data, unsigned size) {
       const auto* bytes = static_cast<const std::uint8_t*>(data);
-      std::lock_guard<std::mutex> lock(mutex_);
       published_.emplace_back(channel, std::vector<std::uint8_t>(bytes, bytes + size));
     };
-    hooks.end_of_tick = [this](std::int64_t tick) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      tick_ = tick;
-      tick_ended_ = true;
-      handed_ = false;
-      changed_.notify_all();
-    };
-    {
-      py::gil_scoped_release release;
-      loop_ = std::make_unique<app::SandboxLoop>(options, std::move(hooks), out_, err_);
-    }
-    thread_ = std::thread([this] {
-      try {
-        code_ = loop_->Run();
-      } catch (...) {
-        failure_ = std::current_exception();
-      }
-      std::lock_guard<std::mutex> lock(mutex_);
-      finished_ = true;
-      changed_.notify_all();
-    });
+    py::gil_scoped_release release;
+    loop_ = std::make_unique<app::SandboxLoop>(options, std::move(hooks), out_, err_);
+    loop_->BeginSteps();
   }
 
   ~Lockstep() {
     try {
-      Finish();
+      Close();
     } catch (...) {  // a destructor does not throw; close() says it
     }
   }
@@ -140,55 +115,45 @@ class Lockstep {
   // One tick: the inputs in, the tick's outputs back (channel, bytes).
   std::tuple<std::int64_t, std::vector<Message>> Step(
       const std::vector<std::tuple<std::string, py::bytes>>& inputs) {
+    std::lock_guard<std::mutex> lock(step_mutex_);  // (taken with the GIL held: no deadlock)
+    if (closed_ || loop_->ended()) throw py::value_error("the run has ended");
     std::vector<bridge::LogEvent> events;
+    events.reserve(inputs.size());
     for (const auto& [channel, data] : inputs) {
       const std::string_view bytes = data;
       events.push_back({channel, std::vector<std::uint8_t>(bytes.begin(), bytes.end())});
     }
-    std::vector<std::pair<std::string, std::vector<std::uint8_t>>> published;
-    std::int64_t tick = -1;
-    std::string refused;
+    const std::size_t said_before = err_text_.str().size();
+    published_.clear();
+    bool ticked = false;
     {
       py::gil_scoped_release release;
-      std::unique_lock<std::mutex> lock(mutex_);
-      if (finished_ || closing_) {
-        refused = "the run has ended";
-      } else {
-        const std::size_t err_before = ErrSize();
-        inputs_ = std::move(events);
-        has_inputs_ = true;
-        tick_ended_ = no_pose_ = false;
-        changed_.notify_all();
-        changed_.wait(lock, [this] { return tick_ended_ || no_pose_ || finished_; });
-        if (tick_ended_) {
-          published.swap(published_);
-          tick = tick_;
-        } else if (no_pose_) {
-          refused = "the inputs gave no robot a pose it accepted (a lock-step tick needs one: "
-                    "its time is the pose's utime)" +
-                    Said(err_before);
-        } else {
-          refused = "the run has ended" + Said(err_before);
-        }
-      }
+      ticked = loop_->Step(events);
     }
-    if (!refused.empty()) throw py::value_error(refused);
+    if (!ticked) {
+      const std::string said = err_text_.str().substr(said_before);
+      throw py::value_error(
+          "the inputs gave no robot a pose it accepted (a lock-step tick needs one: its time is "
+          "the pose's utime)" +
+          (said.empty() ? std::string() : ":\n" + said));
+    }
     std::vector<Message> outputs;
-    outputs.reserve(published.size());
-    for (const auto& [channel, data] : published) {
+    outputs.reserve(published_.size());
+    for (const auto& [channel, data] : published_) {
       outputs.emplace_back(channel,
                            py::bytes(reinterpret_cast<const char*>(data.data()), data.size()));
     }
-    return {tick, std::move(outputs)};
+    published_.clear();
+    return {tick_++, std::move(outputs)};
   }
 
   // Ends the run: files closed, the summary returned (what sandbox run prints).
   std::string Close() {
-    Finish();
-    if (failure_) {
-      std::exception_ptr failure = failure_;
-      failure_ = nullptr;
-      std::rethrow_exception(failure);
+    std::lock_guard<std::mutex> lock(step_mutex_);
+    if (!closed_) {
+      closed_ = true;
+      py::gil_scoped_release release;
+      code_ = loop_->Finish();
     }
     return out_.str();
   }
@@ -196,55 +161,15 @@ class Lockstep {
   std::string messages() { return err_text_.str(); }
 
  private:
-  static std::string FirstLine(const std::string& text) {
-    return text.substr(0, text.find('\n'));
-  }
-  std::size_t ErrSize() { return err_text_.str().size(); }
-  std::string Said(std::size_t from) {
-    const std::string text = err_text_.str().substr(from);
-    return text.empty() ? std::string() : ":\n" + text;
-  }
-
-  // On the loop thread: waits for step()'s inputs (false: the run ends).
-  bool TakeInputs(std::vector<bridge::LogEvent>* events) {
-    std::unique_lock<std::mutex> lock(mutex_);
-    if (handed_) {  // the last inputs did not make a tick
-      no_pose_ = true;
-      changed_.notify_all();
-    }
-    changed_.wait(lock, [this] { return has_inputs_ || closing_; });
-    if (closing_) return false;
-    *events = std::move(inputs_);
-    has_inputs_ = false;
-    handed_ = true;
-    return true;
-  }
-
-  void Finish() {
-    if (!thread_.joinable()) return;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      closing_ = true;
-      changed_.notify_all();
-    }
-    py::gil_scoped_release release;
-    thread_.join();
-  }
-
-  std::ostringstream out_;  // the loop thread's until it has ended
+  std::ostringstream out_;
   SharedText err_text_;
   std::ostream err_{&err_text_};
   std::unique_ptr<app::SandboxLoop> loop_;
-  std::thread thread_;
-  std::mutex mutex_;
-  std::condition_variable changed_;
-  std::vector<bridge::LogEvent> inputs_;
-  bool has_inputs_{false}, handed_{false}, tick_ended_{false}, no_pose_{false};
-  bool finished_{false}, closing_{false};
-  std::int64_t tick_{-1};
+  std::mutex step_mutex_;  // one step (or the close) at a time, whichever thread
   std::vector<std::pair<std::string, std::vector<std::uint8_t>>> published_;
+  std::int64_t tick_{0};
+  bool closed_{false};
   int code_{0};
-  std::exception_ptr failure_;
 };
 
 }  // namespace

@@ -2,16 +2,14 @@
 
 from collections.abc import Mapping
 
-import numpy as np
-
 from . import _sandbox
 from .messages import actors_message, bones_message, decode, joints_message, pose_message
 
 
 def _split_pose(pose):
     """(position, orientation), or a position alone (the identity orientation)."""
-    if len(pose) == 2 and np.ndim(pose[0]) == 1:
-        return pose
+    if len(pose) == 2 and hasattr(pose[0], "__len__"):
+        return pose[0], pose[1]
     return pose, (1.0, 0.0, 0.0, 0.0)
 
 
@@ -70,8 +68,7 @@ class Lockstep:
         self.name = self._run.name
         self._period_us = round(1e6 / rate_hz)
         self._utime = None
-        self._seq = {}
-        self._poses = {}
+        self._seq, self._poses, self._channel_names = {}, {}, {}
         self.summary = None
 
     def __enter__(self):
@@ -80,10 +77,17 @@ class Lockstep:
     def __exit__(self, *exc):
         self.close()
 
-    def _channel(self, robot, kind):
-        if robot not in self._prefix:
-            raise KeyError(f"no robot {robot!r}; the level has {', '.join(self.robots) or 'none'}")
-        return f"{self._prefix[robot]}/{kind}"
+    def _channels(self, robot):
+        """The robot's input channels, {kind: name}; KeyError for an unknown robot."""
+        channels = self._channel_names.get(robot)
+        if channels is None:
+            if robot not in self._prefix:
+                raise KeyError(f"no robot {robot!r}; the level has "
+                               f"{', '.join(self.robots) or 'none'}")
+            channels = self._channel_names[robot] = {
+                kind: f"{self._prefix[robot]}/{kind}" for kind in ("POSE", "BONES", "JOINTS",
+                                                                    "ACTORS")}
+        return channels
 
     def _seq_of(self, channel):
         seq = self._seq.get(channel, 0)
@@ -104,27 +108,37 @@ class Lockstep:
             utime = 0 if self._utime is None else self._utime + self._period_us
         utime = int(utime)
         inputs = []
-        for robot, value in (bones or {}).items():
-            channel = self._channel(robot, "BONES")
-            inputs.append((channel, bones_message(value, utime, self._seq_of(channel))))
-        for robot, value in (joints or {}).items():
-            channel = self._channel(robot, "JOINTS")
-            inputs.append((channel, joints_message(value, utime, self._seq_of(channel))))
+        if bones:
+            for robot, value in bones.items():
+                channel = self._channels(robot)["BONES"]
+                inputs.append((channel, bones_message(value, utime, self._seq_of(channel))))
+        if joints:
+            for robot, value in joints.items():
+                channel = self._channels(robot)["JOINTS"]
+                inputs.append((channel, joints_message(value, utime, self._seq_of(channel))))
         if actors:
-            channel = self._channel(self.robots[0], "ACTORS")
+            channel = self._channels(self.robots[0])["ACTORS"]
             inputs.append((channel, actors_message(actors, utime, self._seq_of(channel))))
-        poses = dict(poses or {})
-        for robot in poses:
-            self._channel(robot, "POSE")  # a KeyError before anything is encoded
-        for robot, pose in {**self._poses, **poses}.items():
-            position, orientation = _split_pose(pose)
-            channel = self._channel(robot, "POSE")
-            inputs.append((channel, pose_message(position, orientation, utime, self._seq_of(channel))))
-            self._poses[robot] = (position, orientation)
-        if not self._poses:
+        sent = dict(self._poses)
+        if poses:
+            for robot, pose in poses.items():
+                self._channels(robot)  # a KeyError before anything is sent
+                sent[robot] = _split_pose(pose)
+        if not sent:
             raise ValueError("the first step needs a pose for at least one robot (poses=...)")
+        for robot, (position, orientation) in sent.items():
+            channel = self._channels(robot)["POSE"]
+            inputs.append((channel, pose_message(position, orientation, utime,
+                                                 self._seq_of(channel))))
         tick, published = self._run.step(inputs)
-        self._utime = utime
+        self._utime, self._poses = utime, sent
+        return Outputs(tick, published)
+
+    def step_messages(self, inputs):
+        """Runs one tick on messages encoded by the caller, `[(channel, bytes)]`
+        in arrival order (the fast path: nothing encoded here, no last pose
+        re-sent); returns its `Outputs`."""
+        tick, published = self._run.step(inputs if isinstance(inputs, list) else list(inputs))
         return Outputs(tick, published)
 
     @property

@@ -24,7 +24,8 @@ class Message(types.SimpleNamespace):
 def decode(data):
     """The message in `data` (bytes) as a `Message`; ValueError when its
     fingerprint is not a sandbox type or it does not decode."""
-    data = bytes(data)
+    if data.__class__ is not bytes:
+        data = bytes(data)
     cls = _BY_FINGERPRINT.get(data[:8])
     if cls is None:
         raise ValueError(f"not a sandbox message (fingerprint {data[:8].hex() or 'missing'})")
@@ -35,12 +36,8 @@ def decode(data):
     fields = {}
     for name in cls.__slots__:
         value = getattr(raw, name)
-        if isinstance(value, (tuple, list)):
-            if value and isinstance(value[0], str):
-                value = list(value)
-            else:
-                value = np.asarray(value, dtype=np.float64 if value and isinstance(value[0], float)
-                                   else np.int64)
+        if value.__class__ is tuple or value.__class__ is list:
+            value = list(value) if value and value[0].__class__ is str else np.array(value)
         fields[name] = value
     return Message(lcm_type=cls.__name__, **fields)
 
@@ -48,14 +45,20 @@ def decode(data):
 def finite(value, count, argument):
     """`value` as `count` finite floats (a tuple), else ValueError naming `argument`."""
     try:
-        array = np.asarray(value, dtype=np.float64).reshape(-1)
+        if isinstance(value, (tuple, list)):  # the common case, without numpy
+            kinds = set(map(type, value))
+            if str in kinds or bytes in kinds:  # float() would read "1.5"
+                raise TypeError
+            values = tuple(map(float, value))
+        else:
+            values = tuple(np.asarray(value, dtype=np.float64).reshape(-1).tolist())
     except (TypeError, ValueError):
-        raise ValueError(f"{argument} must be {count} numbers, got {value!r}") from None
-    if count is not None and array.size != count:
-        raise ValueError(f"{argument} must be {count} numbers, got {array.size}")
-    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{argument} must be {count or 'some'} numbers, got {value!r}") from None
+    if count is not None and len(values) != count:
+        raise ValueError(f"{argument} must be {count} numbers, got {len(values)}")
+    if not all(map(math.isfinite, values)):
         raise ValueError(f"{argument} must be finite, got {value!r}")
-    return tuple(float(v) for v in array)
+    return values
 
 
 def pose_message(position, orientation, utime, seq):
