@@ -9,6 +9,7 @@
 
 #include <cctype>
 #include <cerrno>
+#include <cstdio>
 #include <chrono>
 #include <cstring>
 #include <new>
@@ -42,6 +43,11 @@ scene::LoadLimits LimitsOf(const std::string& file) {
   return extension == ".toml" ? scene::ParseManifest(file).limits : scene::LoadLimits{};
 }
 
+std::string& LoaderProgram() {
+  static std::string program;  // empty: this program
+  return program;
+}
+
 std::string SignalName(int signal) {
   const char* name = strsignal(signal);
   return std::string(name != nullptr ? name : "a signal") + ", signal " + std::to_string(signal);
@@ -49,12 +55,20 @@ std::string SignalName(int signal) {
 
 }  // namespace
 
+void SetIsolatedLoader(const std::string& program) { LoaderProgram() = program; }
+
 void CheckLoadsInIsolation(const std::string& file, const scene::AssetConversion& conversion) {
   const scene::LoadLimits limits = LimitsOf(file);
   char self[4096];
-  const ssize_t length = readlink("/proc/self/exe", self, sizeof(self) - 1);
-  if (length <= 0) throw scene::LevelError(file + ": cannot find this program to load it apart");
-  self[length] = '\0';
+  if (LoaderProgram().empty()) {
+    const ssize_t length = readlink("/proc/self/exe", self, sizeof(self) - 1);
+    if (length <= 0) throw scene::LevelError(file + ": cannot find this program to load it apart");
+    self[length] = '\0';
+  } else if (LoaderProgram().size() < sizeof(self)) {
+    std::snprintf(self, sizeof(self), "%s", LoaderProgram().c_str());
+  } else {
+    throw scene::LevelError(file + ": the loader's path is too long");
+  }
   std::vector<std::string> argv_strings = {self, "__load-level", file};
   if (conversion.up)
     argv_strings.insert(argv_strings.end(), {"--up", scene::ToString(*conversion.up)});

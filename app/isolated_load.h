@@ -19,6 +19,11 @@
 
 namespace sandbox::app {
 
+// The program run as the child: by default this program (/proc/self/exe);
+// a host that is not `sandbox` (the Python module) names the sandbox binary.
+// Set before any load, from one thread.
+void SetIsolatedLoader(const std::string& program);
+
 // Throws scene::LevelError when the child fails, naming the file.
 void CheckLoadsInIsolation(const std::string& file, const scene::AssetConversion& conversion);
 

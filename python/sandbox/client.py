@@ -4,7 +4,8 @@
 import time
 
 from . import _sandbox
-from .messages import actors_message, bones_message, decode, joints_message, pose_message
+from .messages import (actors_message, bones_message, decode, joints_message, pose_message,
+                       utime_of)
 
 
 class Client:
@@ -31,7 +32,7 @@ class Client:
     def _next(self, channel, utime):
         seq = self._seq.get(channel, 0)
         self._seq[channel] = seq + 1
-        return (int(time.time() * 1e6) if utime is None else int(utime)), seq
+        return (int(time.time() * 1e6) if utime is None else utime_of(utime)), seq
 
     def publish(self, channel, data):
         """Publishes an encoded message (bytes, or an lcm-gen object with encode())."""

@@ -3,7 +3,8 @@
 from collections.abc import Mapping
 
 from . import _sandbox
-from .messages import actors_message, bones_message, decode, joints_message, pose_message
+from .messages import (actors_message, bones_message, decode, joints_message, pose_message,
+                       utime_of)
 
 
 def _split_pose(pose):
@@ -106,7 +107,7 @@ class Lockstep:
         microseconds (default: the last plus one period of rate_hz)."""
         if utime is None:
             utime = 0 if self._utime is None else self._utime + self._period_us
-        utime = int(utime)
+        utime = utime_of(utime)
         inputs = []
         if bones:
             for robot, value in bones.items():

@@ -52,13 +52,24 @@ def finite(value, count, argument):
             values = tuple(map(float, value))
         else:
             values = tuple(np.asarray(value, dtype=np.float64).reshape(-1).tolist())
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ValueError(f"{argument} must be {count or 'some'} numbers, got {value!r}") from None
     if count is not None and len(values) != count:
         raise ValueError(f"{argument} must be {count} numbers, got {len(values)}")
     if not all(map(math.isfinite, values)):
         raise ValueError(f"{argument} must be finite, got {value!r}")
     return values
+
+
+def utime_of(value):
+    """`value` as microseconds that fit LCM's int64, else ValueError."""
+    try:
+        utime = int(value)
+    except (TypeError, ValueError, OverflowError):
+        raise ValueError(f"utime must be whole microseconds, got {value!r}") from None
+    if not -2**63 <= utime < 2**63:
+        raise ValueError(f"utime must fit in 64 bits, got {utime}")
+    return utime
 
 
 def pose_message(position, orientation, utime, seq):

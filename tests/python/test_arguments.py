@@ -85,3 +85,102 @@ def test_renders_take_any_argument(camera, position, orientation, robot, size, f
     call(WORLD.render, camera, position, orientation, robot, size, size, fov, kinds, quality)
     call(WORLD.render, camera, position, orientation, robot, 16, 12, 60.0, "color", quality)
     assert WORLD.ray((0, 0, 80)) == REFERENCE
+
+
+@settings(max_examples=150, deadline=None, database=None)
+@given(name=st.text(max_size=10), robot=st.one_of(st.none(), st.text(max_size=6)),
+       position=anything, orientation=anything,
+       joints=st.dictionaries(st.one_of(st.text(max_size=6), st.sampled_from(["E1", "E2"])),
+                              anything, max_size=3))
+def test_sensors_cameras_joints_and_actors_take_any_argument(name, robot, position, orientation,
+                                                            joints):
+    call(WORLD.scan, name, robot)
+    call(WORLD.render_camera, name, robot)
+    call(WORLD.set_joints, "ELAHA", joints)
+    call(WORLD.set_joints, name, joints)
+    call(WORLD.joints, name)
+    call(WORLD.set_actor, name, position, orientation)
+    call(WORLD.actor_pose, name)
+    WORLD.set_bones("ELAHA", [0.0] * len(WORLD.bones("ELAHA")))
+    assert WORLD.ray((0, 0, 80)) == REFERENCE
+
+
+@settings(max_examples=300, deadline=None, database=None)
+@given(data=st.one_of(st.binary(max_size=200),
+                      st.sampled_from(list(sandbox.message_types.values())).flatmap(
+                          lambda cls: st.binary(max_size=120).map(
+                              lambda tail: cls._get_packed_fingerprint() + tail))))
+def test_decode_takes_any_bytes(data):
+    """Bytes with a sandbox type's fingerprint and any body: a Message or ValueError."""
+    try:
+        message = sandbox.decode(data)
+    except ValueError:
+        return
+    assert message.lcm_type in sandbox.message_types
+
+
+@settings(max_examples=100, deadline=None, database=None)
+@given(data=st.binary(max_size=300), prefix=st.booleans())
+def test_read_log_takes_any_file(tmp_path_factory, data, prefix):
+    path = tmp_path_factory.mktemp("log") / "any.lcmlog"
+    path.write_bytes((b"\xed\xa1\xda\x01" if prefix else b"") + data)
+    try:
+        log = sandbox.read_log(path)
+    except RuntimeError as error:
+        assert "any.lcmlog" in str(error)
+        return
+    assert log.events >= sum(len(c) for c in log.channels.values())
+
+
+LOCKSTEP = sandbox.Lockstep(args=["--no-sensors"])
+STEP = [0]
+
+
+@settings(max_examples=150, deadline=None, database=None)
+@given(poses=st.one_of(st.none(), st.dictionaries(st.sampled_from(["ELAHA", "X"]), anything,
+                                                  max_size=2)),
+       bones=st.one_of(st.none(), st.dictionaries(st.sampled_from(["ELAHA", "X"]), anything,
+                                                  max_size=1)),
+       joints=st.one_of(st.none(), st.dictionaries(st.sampled_from(["ELAHA"]), anything,
+                                                   max_size=1)),
+       actors=st.one_of(st.none(), anything), utime=st.one_of(st.none(), st.integers(-10**30, 10**30), anything),
+       args=st.lists(st.sampled_from(["--rate", "max", "--ticks", "x", "--web", "--replay",
+                                      "--no-sensors", "--out", "", "7"]), max_size=3))
+def test_lockstep_takes_any_argument(poses, bones, joints, actors, utime, args):
+    """Inputs of any shape: a tick or a Python exception, and the run goes on."""
+    call(LOCKSTEP.step, poses, bones, joints, actors, utime)
+    if args and "--out" not in args and "--web" not in args:
+        try:
+            sandbox.Lockstep(args=args).close()
+        except EXPECTED:
+            pass
+    STEP[0] += 1
+    outputs = LOCKSTEP.step(poses={"ELAHA": ((0, 0, 50), (1, 0, 0, 0))},
+                            utime=10**13 + STEP[0] * 10000)
+    assert outputs["ELAHA/STATE"][0].position.tolist() == [0, 0, 50]
+
+
+CLIENT = sandbox.Client("memq://")
+
+
+@settings(max_examples=150, deadline=None, database=None)
+@given(robot=st.text(max_size=6), position=anything, orientation=anything, values=anything,
+       utime=st.one_of(st.none(), st.integers(-10**30, 10**30), anything))
+def test_client_takes_any_argument(robot, position, orientation, values, utime):
+    """What is published decodes as what was given; anything else is a ValueError."""
+    published = []
+    for publish, args in ((CLIENT.publish_pose, (robot, position, orientation)),
+                          (CLIENT.publish_bones, (robot, values)),
+                          (CLIENT.publish_joints, (robot, values)),
+                          (CLIENT.publish_actors, (robot, values))):
+        try:
+            publish(*args, utime=utime)
+            published.append(publish.__name__)
+        except ValueError:
+            pass
+    received = CLIENT.receive(timeout=0.5 if published else 0.0)
+    assert len(received) == len(published)
+    for channel, message in received:
+        assert channel.startswith(robot + "/") and not isinstance(message, bytes)
+        if utime is not None:
+            assert message.utime == int(utime)

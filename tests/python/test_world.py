@@ -206,3 +206,83 @@ def test_render_equals_the_command_lines(world, tmp_path):
     assert np.array_equal(frame.segmentation, read_png(tmp_path / "look_seg.png"))
     robot = {s["id"] for s in world.surfaces() if s["robot"] == "ELAHA"}
     assert np.isin(frame.segmentation, list(robot)).sum() > 50  # the wing is in the picture
+
+
+ARM = os.path.join(os.path.dirname(__file__), "..", "..", "assets", "arm", "arm.urdf")
+
+
+def test_joints_by_name_are_drawn_as_sandbox_render_draws_them(tmp_path):
+    arm = sandbox.World(ARM)  # a URDF alone: loaded apart first, by the sandbox program
+    assert arm.robots == ["arm"]
+    assert list(arm.joints("arm")) == ["base_yaw", "shoulder", "elbow", "extend", "wrist_roll"]
+    arm.set_joints("arm", {"shoulder": math.radians(30), "elbow": math.radians(-45)})
+    assert arm.joints("arm")["shoulder"] == math.radians(30)
+    out = tmp_path / "arm.png"
+    subprocess.run([SANDBOX, "render", ARM, "--camera", "fixed", "--at", "1.4,0.3,0.5,0,0,190",
+                    "--bones", "shoulder 30; elbow -45", "--width", "160", "--height", "120",
+                    "--kind", "color,segmentation", "--out", str(out)],
+                   check=True, stdout=subprocess.DEVNULL)
+    frame = arm.render("fixed", (1.4, 0.3, 0.5), yaw(190), width=160, height=120,
+                       kinds="color,segmentation")
+    assert np.array_equal(frame.color, read_png(out)[:, :, :3])
+    assert np.array_equal(frame.segmentation, read_png(tmp_path / "arm_seg.png"))
+    assert (frame.segmentation > 0).sum() > 500  # the arm is in the picture
+    rest = sandbox.World(ARM).render("fixed", (1.4, 0.3, 0.5), yaw(190), width=160, height=120,
+                                     kinds="segmentation")
+    assert (rest.segmentation != frame.segmentation).sum() > 100  # and the joints moved it
+    with pytest.raises(KeyError, match="base_yaw, shoulder"):
+        arm.set_joints("arm", {"knee": 0.1})
+    with pytest.raises(ValueError, match="limits"):
+        arm.set_joints("arm", {"shoulder": 0.2, "extend": 1.0})
+    assert arm.joints("arm")["shoulder"] == math.radians(30)  # all or none
+
+
+def test_declared_sensors_run_as_the_loop_runs_them(world):
+    """The altimeter equals a ray from its mount; the scanner's scan equals an ad-hoc face
+    scan of its settings at the robot's pose, without its own robot."""
+    assert world.sensors == [("ELAHA", "scanner", "face"), ("ELAHA", "altimeter", "ray")]
+    world.set_pose("ELAHA", (10, 20, 40), yaw(30))
+    altimeter = world.scan("altimeter")
+    assert altimeter == world.ray((10, 20, 40), yaw(30), range=200)
+    assert abs(altimeter["point"][2] - terrain_height(10, 20)) < 0.05
+    scan = world.scan("scanner")
+    alone = world.face_scan((10, 20, 40), yaw(30), resolution=1, half_extent=25)
+    for face in range(6):
+        assert np.array_equal(scan.distance[face], alone.distance[face])
+    with pytest.raises(KeyError, match="scanner, altimeter"):
+        world.scan("camera")
+    with pytest.raises(KeyError, match="ELAHA"):
+        world.scan("scanner", robot="NOBODY")
+
+
+def test_movable_actors_are_placed(world):
+    assert world.actors == ["gate"]
+    before = world.ray((0, 0, 150), range=200)
+    world.set_actor("gate", (0, 0, 100))
+    hit = world.ray((0, 0, 150), range=200)
+    assert hit["hit"] and hit["point"][2] > 100 > before["point"][2]
+    gate = [s["id"] for s in world.surfaces() if s["name"] == "gate"]
+    assert hit["surface"] in gate
+    assert world.actor_pose("gate") == ((0.0, 0.0, 100.0), (1.0, 0.0, 0.0, 0.0))
+    with pytest.raises(KeyError, match="gate"):
+        world.set_actor("terrain", (0, 0, 0))
+
+
+def test_declared_cameras_equal_the_loops_frames(tmp_path):
+    """The loop's own first frames (Lockstep --out) and render_camera at that pose."""
+    world = sandbox.World()
+    assert [c[1] for c in world.cameras] == ["chase", "trailing", "belly"]
+    with sandbox.Lockstep(args=["--out", str(tmp_path), "--frames", "png"]) as run:
+        run.step(poses={"ELAHA": ((10, -40, 45), yaw(20))})
+    world.set_pose("ELAHA", (10, -40, 45), yaw(20))
+    chase = world.render_camera("chase")
+    assert np.array_equal(chase.color, read_png(tmp_path / "chase/chase_000000.png")[:, :, :3])
+    belly = world.render_camera("belly")
+    assert (belly.width, belly.height) == (320, 240)
+    assert np.array_equal(belly.color, read_png(tmp_path / "belly/belly_000000.png")[:, :, :3])
+    millimetres = read_png(tmp_path / "belly/belly_000000_depth.png").astype(np.int64)
+    near = np.isfinite(belly.depth) & (belly.depth < 60)
+    assert near.sum() > 1000
+    assert np.abs(np.round(belly.depth[near] * 1000) - millimetres[near]).max() <= 1
+    with pytest.raises(KeyError, match="chase, trailing, belly"):
+        world.render_camera("nose")
