@@ -3,8 +3,7 @@
 from collections.abc import Mapping
 
 from . import _sandbox
-from .messages import (actors_message, bones_message, decode, joints_message, pose_message,
-                       utime_of)
+from .messages import actors_message, decode, joints_message, utime_of
 
 
 def _split_pose(pose):
@@ -18,13 +17,14 @@ class Outputs(Mapping):
     """What one tick published: {channel: [Message, ...]} in publishing order
     (a face scanner's six faces are six messages on one channel); `tick`.
     A channel's messages are decoded when first asked for (`raw(channel)`:
-    their bytes)."""
+    their bytes, as read-only memoryviews of the tick's one buffer)."""
 
-    def __init__(self, tick, published):
+    def __init__(self, tick, buffer, published):
         self.tick = tick
         self._raw, self._decoded = {}, {}
-        for channel, data in published:
-            self._raw.setdefault(channel, []).append(data)
+        view = memoryview(buffer)
+        for channel, offset, size in published:
+            self._raw.setdefault(channel, []).append(view[offset:offset + size])
 
     def __getitem__(self, channel):
         messages = self._decoded.get(channel)
@@ -108,18 +108,17 @@ class Lockstep:
         if utime is None:
             utime = 0 if self._utime is None else self._utime + self._period_us
         utime = utime_of(utime)
-        inputs = []
+        bone_inputs, encoded, pose_inputs = [], [], []
         if bones:
             for robot, value in bones.items():
-                channel = self._channels(robot)["BONES"]
-                inputs.append((channel, bones_message(value, utime, self._seq_of(channel))))
+                bone_inputs.append((self._channels(robot)["BONES"], value))
         if joints:
             for robot, value in joints.items():
                 channel = self._channels(robot)["JOINTS"]
-                inputs.append((channel, joints_message(value, utime, self._seq_of(channel))))
+                encoded.append((channel, joints_message(value, utime, self._seq_of(channel))))
         if actors:
             channel = self._channels(self.robots[0])["ACTORS"]
-            inputs.append((channel, actors_message(actors, utime, self._seq_of(channel))))
+            encoded.append((channel, actors_message(actors, utime, self._seq_of(channel))))
         sent = dict(self._poses)
         if poses:
             for robot, pose in poses.items():
@@ -128,19 +127,17 @@ class Lockstep:
         if not sent:
             raise ValueError("the first step needs a pose for at least one robot (poses=...)")
         for robot, (position, orientation) in sent.items():
-            channel = self._channels(robot)["POSE"]
-            inputs.append((channel, pose_message(position, orientation, utime,
-                                                 self._seq_of(channel))))
-        tick, published = self._run.step(inputs)
+            pose_inputs.append((self._channels(robot)["POSE"], position, orientation))
+        # Bone values and poses checked and encoded in C++ (BONES, then JOINTS and ACTORS, then POSE).
+        published = self._run.step_values(bone_inputs, encoded, pose_inputs, utime)
         self._utime, self._poses = utime, sent
-        return Outputs(tick, published)
+        return Outputs(*published)
 
     def step_messages(self, inputs):
         """Runs one tick on messages encoded by the caller, `[(channel, bytes)]`
         in arrival order (the fast path: nothing encoded here, no last pose
         re-sent); returns its `Outputs`."""
-        tick, published = self._run.step(inputs if isinstance(inputs, list) else list(inputs))
-        return Outputs(tick, published)
+        return Outputs(*self._run.step(inputs if isinstance(inputs, list) else list(inputs)))
 
     @property
     def messages(self):

@@ -27,7 +27,7 @@ class ChannelLog:
         if not self.messages:
             return np.empty(0)
         if not hasattr(self.messages[0], field):
-            known = ", ".join(vars(self.messages[0]))
+            known = ", ".join(self.messages[0].fields())
             raise KeyError(f"{self.name} ({self.lcm_type}) has no field {field!r}; it has {known}")
         values = [getattr(message, field) for message in self.messages]
         shapes = {np.shape(value) for value in values}

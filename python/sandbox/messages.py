@@ -3,7 +3,6 @@
 arrays as numpy, and the input messages encoded from Python values."""
 
 import math
-import types
 
 import numpy as np
 
@@ -15,10 +14,40 @@ message_types = {name: getattr(sandbox_msgs, name) for name in dir(sandbox_msgs)
 _BY_FINGERPRINT = {cls._get_packed_fingerprint(): cls for cls in message_types.values()}
 
 
-class Message(types.SimpleNamespace):
+def _converted(value):
+    """A numeric array as numpy, a string array as a list, a scalar as it is."""
+    if value.__class__ is tuple or value.__class__ is list:
+        return list(value) if value and value[0].__class__ is str else np.array(value)
+    return value
+
+
+class Message:
     """A decoded message: its fields as attributes (as in bridge/lcmtypes/*.lcm,
-    flat), numeric arrays as numpy arrays, string arrays as lists;
-    `lcm_type` is the type's name."""
+    flat), numeric arrays as numpy arrays, string arrays as lists, each made
+    when first read; `lcm_type` is the type's name, `fields()` all of them."""
+
+    def __init__(self, lcm_type, raw):
+        self.__dict__["lcm_type"] = lcm_type
+        self.__dict__["_raw"] = raw
+
+    def __getattr__(self, name):  # a field not read before
+        raw = self.__dict__["_raw"]
+        if name.startswith("_") or name not in raw.__slots__:
+            raise AttributeError(f"{self.lcm_type} has no field {name!r}; it has "
+                                 f"{', '.join(raw.__slots__)}")
+        value = self.__dict__[name] = _converted(getattr(raw, name))
+        return value
+
+    def fields(self):
+        """{field: value} of every field, in the type's order."""
+        return {name: getattr(self, name) for name in self._raw.__slots__}
+
+    def __dir__(self):
+        return ["lcm_type", "fields", *self._raw.__slots__]
+
+    def __repr__(self):
+        shown = ", ".join(f"{name}={value!r}" for name, value in self.fields().items())
+        return f"{self.lcm_type}({shown})"
 
 
 def decode(data):
@@ -33,13 +62,7 @@ def decode(data):
         raw = cls.decode(data)
     except Exception as error:  # struct.error on a short message
         raise ValueError(f"{cls.__name__} does not decode: {error}") from None
-    fields = {}
-    for name in cls.__slots__:
-        value = getattr(raw, name)
-        if value.__class__ is tuple or value.__class__ is list:
-            value = list(value) if value and value[0].__class__ is str else np.array(value)
-        fields[name] = value
-    return Message(lcm_type=cls.__name__, **fields)
+    return Message(cls.__name__, raw)
 
 
 def finite(value, count, argument):

@@ -52,7 +52,8 @@ def encoded_inputs():
 
 def same(a, b):
     assert a.lcm_type == b.lcm_type
-    for field, value in vars(a).items():
+    assert a.fields().keys() == b.fields().keys()
+    for field, value in a.fields().items():
         other = getattr(b, field)
         if isinstance(value, np.ndarray):
             assert np.array_equal(value, other, equal_nan=True), field
