@@ -16,19 +16,12 @@ import sys
 import pytest
 
 import sandbox
+from sample_terrain import terrain_height
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SANDBOX = os.environ.get("SANDBOX", "sandbox")
 URL = "udpm://239.255.76.67:7667?ttl=0"
 STEPS = 300
-
-
-def terrain_height(x, y):
-    hill = (x - 110.0) ** 2 + (y - 90.0) ** 2
-    lake = (x + 70.0) ** 2 + (y + 60.0) ** 2
-    return (14.0 + 6.0 * math.sin(x / 31.0) * math.cos(y / 43.0)
-            + 4.0 * math.sin((x - 0.5 * y) / 57.0) + 30.0 * math.exp(-hill / (2.0 * 40.0 ** 2))
-            - 14.0 * math.exp(-lake / (2.0 * 45.0 ** 2)))
 
 
 def in_namespace():

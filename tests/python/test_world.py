@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 import sandbox
+from sample_terrain import terrain_height
 
 SANDBOX = os.environ.get("SANDBOX", "sandbox")
 
@@ -39,14 +40,6 @@ def scan_csv(tmp_path, *args):
                    stdout=subprocess.DEVNULL)
     with open(out) as f:
         return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
-
-
-def terrain_height(x, y):
-    hill = (x - 110.0) ** 2 + (y - 90.0) ** 2
-    lake = (x + 70.0) ** 2 + (y + 60.0) ** 2
-    return (14.0 + 6.0 * math.sin(x / 31.0) * math.cos(y / 43.0)
-            + 4.0 * math.sin((x - 0.5 * y) / 57.0) + 30.0 * math.exp(-hill / (2.0 * 40.0 ** 2))
-            - 14.0 * math.exp(-lake / (2.0 * 45.0 ** 2)))
 
 
 def test_face_scan_equals_the_command_lines(world, tmp_path):
