@@ -9,7 +9,6 @@
 
 #include <cctype>
 #include <cerrno>
-#include <cstdio>
 #include <chrono>
 #include <cstring>
 #include <new>
@@ -59,15 +58,12 @@ void SetIsolatedLoader(const std::string& program) { LoaderProgram() = program; 
 
 void CheckLoadsInIsolation(const std::string& file, const scene::AssetConversion& conversion) {
   const scene::LoadLimits limits = LimitsOf(file);
-  char self[4096];
-  if (LoaderProgram().empty()) {
-    const ssize_t length = readlink("/proc/self/exe", self, sizeof(self) - 1);
+  std::string self = LoaderProgram();
+  if (self.empty()) {
+    char path[4096];
+    const ssize_t length = readlink("/proc/self/exe", path, sizeof(path) - 1);
     if (length <= 0) throw scene::LevelError(file + ": cannot find this program to load it apart");
-    self[length] = '\0';
-  } else if (LoaderProgram().size() < sizeof(self)) {
-    std::snprintf(self, sizeof(self), "%s", LoaderProgram().c_str());
-  } else {
-    throw scene::LevelError(file + ": the loader's path is too long");
+    self.assign(path, std::size_t(length));
   }
   std::vector<std::string> argv_strings = {self, "__load-level", file};
   if (conversion.up)
@@ -97,7 +93,7 @@ void CheckLoadsInIsolation(const std::string& file, const scene::AssetConversion
       const rlimit memory{bytes, bytes};
       setrlimit(RLIMIT_AS, &memory);
     }
-    execv(self, argv.data());
+    execv(argv[0], argv.data());
     _exit(127);
   }
   close(out[1]);

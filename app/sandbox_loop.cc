@@ -249,14 +249,18 @@ void SandboxLoop::BeginSteps() {
 
 bool SandboxLoop::Step(const std::vector<bridge::LogEvent>& events) {
   if (stop_.requested()) return false;
-  for (const bridge::LogEvent& event : events) {
-    link_.Inject(event.channel, event.data.data(), unsigned(event.data.size()));
-    link_.Drain();
-  }
+  Arrive(events);
   if (!has_pose()) return false;
   bool overrun = false;
   TickAndRecord(SinceStart(), 0.001, &overrun);
   return true;
+}
+
+void SandboxLoop::Arrive(const std::vector<bridge::LogEvent>& events) {
+  for (const bridge::LogEvent& event : events) {
+    link_.Inject(event.channel, event.data.data(), unsigned(event.data.size()));
+    link_.Drain();
+  }
 }
 
 void SandboxLoop::Tick(double wall_s, double drain_budget_s, TickRecord* record) {
@@ -317,10 +321,7 @@ bool SandboxLoop::NextLockstepInput(double wall_s, bool* wait) {
     log_feed_.clear();
     const std::string refused = log_states_->Translate(channel, data, &log_feed_);
     if (!refused.empty()) reject_log_.Note(channel, refused);
-    for (const bridge::LogEvent& event : log_feed_) {
-      link_.Inject(event.channel, event.data.data(), unsigned(event.data.size()));
-      link_.Drain();
-    }
+    Arrive(log_feed_);
   }
   for (const std::string& prefix : log_states_->TakeNewRobotsFromStates()) {
     err_ << "\rsandbox: " << options_.replay_file << " holds what a run applied (" << prefix

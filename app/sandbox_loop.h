@@ -109,6 +109,9 @@ class SandboxLoop {
   // Lock-step: makes the next pose available (reading the replayed log up to
   // it). False: stop (the log has ended); *wait: nothing yet, try again.
   bool NextLockstepInput(double wall_s, bool* wait);
+  // Lock-step inputs (a replay's, or a step's) handed to the robots as if
+  // they had arrived, one at a time.
+  void Arrive(const std::vector<bridge::LogEvent>& events);
   // The banner printed, the clock and the pacer started.
   void Start(double period_s, const std::string& priority);
   double SinceStart() const;  // seconds since Start()
