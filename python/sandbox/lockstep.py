@@ -21,31 +21,42 @@ class Outputs(Mapping):
 
     def __init__(self, tick, buffer, published):
         self.tick = tick
-        self._raw, self._decoded = {}, {}
-        view = memoryview(buffer)
-        for channel, offset, size in published:
-            self._raw.setdefault(channel, []).append(view[offset:offset + size])
+        self._buffer, self._published = buffer, published
+        self._index, self._decoded = None, {}
+
+    def _channels(self):
+        """{channel: [(offset, size), ...]}, made when first needed."""
+        if self._index is None:
+            self._index = {}
+            for channel, offset, size in self._published:
+                self._index.setdefault(channel, []).append((offset, size))
+        return self._index
 
     def __getitem__(self, channel):
         messages = self._decoded.get(channel)
         if messages is None:
-            if channel not in self._raw:
+            spans = self._channels().get(channel)
+            if spans is None:
                 raise KeyError(f"tick {self.tick} published nothing on {channel!r}; it published "
-                               f"on {', '.join(sorted(self._raw)) or 'no channel'}")
-            messages = self._decoded[channel] = [decode(data) for data in self._raw[channel]]
+                               f"on {', '.join(sorted(self._index)) or 'no channel'}")
+            buffer = memoryview(self._buffer)
+            messages = self._decoded[channel] = [decode(buffer[offset:offset + size])
+                                                 for offset, size in spans]
         return messages
 
     def raw(self, channel):
-        return self._raw[channel]
+        view = memoryview(self._buffer)
+        return [view[offset:offset + size] for offset, size in self._channels()[channel]]
 
     def __iter__(self):
-        return iter(self._raw)
+        return iter(self._channels())
 
     def __len__(self):
-        return len(self._raw)
+        return len(self._channels())
 
     def __repr__(self):
-        return f"Outputs(tick {self.tick}, {', '.join(f'{c}: {len(m)}' for c, m in self._raw.items())})"
+        shown = ", ".join(f"{c}: {len(m)}" for c, m in self._channels().items())
+        return f"Outputs(tick {self.tick}, {shown})"
 
 
 class Lockstep:
