@@ -4,6 +4,7 @@ world answers the same afterwards."""
 import math
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -111,12 +112,18 @@ def test_sensors_cameras_joints_and_actors_take_any_argument(name, robot, positi
                           lambda cls: st.binary(max_size=120).map(
                               lambda tail: cls._get_packed_fingerprint() + tail))))
 def test_decode_takes_any_bytes(data):
-    """Bytes with a sandbox type's fingerprint and any body: a Message or ValueError."""
+    """Bytes with a sandbox type's fingerprint and any body: a Message or ValueError;
+    the same from a memoryview or a uint8 array of those bytes."""
     try:
         message = sandbox.decode(data)
     except ValueError:
+        for view in (memoryview(data), np.frombuffer(data, dtype=np.uint8)):
+            with pytest.raises(ValueError):
+                sandbox.decode(view)
         return
     assert message.lcm_type in sandbox.message_types
+    for view in (memoryview(data), np.frombuffer(data, dtype=np.uint8)):
+        assert repr(sandbox.decode(view)) == repr(message)
 
 
 @settings(max_examples=100, deadline=None, database=None)
