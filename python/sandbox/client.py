@@ -8,6 +8,9 @@ from .messages import (actors_message, bones_message, decode, joints_message, po
                        utime_of)
 
 
+_MAX_CHANNEL_BYTES = 63  # LCM_MAX_CHANNEL_NAME_LENGTH (lcm/lcm.h)
+
+
 class Client:
     """An LCM link to a running sandbox. `url` as the C++ tools take it (empty:
     LCM's default; multicast URLs get a 4 MB receive buffer). Hears every
@@ -36,7 +39,11 @@ class Client:
 
     def publish(self, channel, data):
         """Publishes an encoded message (bytes, or an lcm-gen object with encode())."""
-        self._link.publish(str(channel), data if isinstance(data, bytes) else data.encode())
+        channel = str(channel)
+        if not 0 < len(channel.encode()) <= _MAX_CHANNEL_BYTES or "\0" in channel:
+            raise ValueError(f"channel {channel!r}: an LCM channel is 1 to {_MAX_CHANNEL_BYTES} "
+                             "bytes, without NUL")
+        self._link.publish(channel, data if isinstance(data, bytes) else data.encode())
 
     def publish_pose(self, robot, position, orientation=(1.0, 0.0, 0.0, 0.0), utime=None):
         """<robot>/POSE: position m, unit quaternion (w, x, y, z), in the robot's pose convention."""

@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 import sandbox
@@ -173,6 +173,8 @@ CLIENT = sandbox.Client("memq://")
 @settings(max_examples=150, deadline=None, database=None)
 @given(robot=st.text(max_size=6), position=anything, orientation=anything, values=anything,
        utime=st.one_of(st.none(), st.integers(-10**30, 10**30), anything))
+@example(robot="\x00", position=None, orientation=None, values=0, utime=None)  # LCM cuts at NUL
+@example(robot="r" * 60, position=(0, 0, 1), orientation=(1, 0, 0, 0), values=[], utime=1)
 def test_client_takes_any_argument(robot, position, orientation, values, utime):
     """What is published decodes as what was given; anything else is a ValueError."""
     published = []
