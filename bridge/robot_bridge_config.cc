@@ -1,6 +1,7 @@
 #include "bridge/robot_bridge_config.h"
 
 #include <arpa/inet.h>
+#include <lcm/lcm.h>
 
 #include <set>
 
@@ -124,6 +125,23 @@ std::vector<RobotBridgeConfig> RobotBridgeConfigs(const scene::Level& level) {
       read.Fail("channel_prefix", "robot '" + model.name + "' would use the channel prefix '" +
                                       config.channel_prefix + "' of robot '" + it->second +
                                       "'; give one of them its own 'channel_prefix'");
+    }
+    // LCM carries channel names of at most LCM_MAX_CHANNEL_NAME_LENGTH bytes, without NUL.
+    auto too_long = [&](const std::string& topic) -> std::string {
+      const std::string channel = config.channel_prefix + "/" + topic;
+      if (channel.size() <= LCM_MAX_CHANNEL_NAME_LENGTH && channel.find('\0') == std::string::npos)
+        return "";
+      return "robot '" + model.name + "' would use the channel '" + channel + "' (" +
+             std::to_string(channel.size()) + " bytes); LCM carries names of at most " +
+             std::to_string(LCM_MAX_CHANNEL_NAME_LENGTH) + " bytes, without NUL";
+    };
+    for (const char* topic : {"POSE", "BONES", "JOINTS", "ACTORS", "CAMERA", "STATE", "STATUS"}) {
+      if (const std::string why = too_long(topic); !why.empty())
+        read.Fail("channel_prefix", why + ": give it a shorter 'channel_prefix'");
+    }
+    for (const scene::SensorSpec& spec : model.sensors) {
+      if (const std::string why = too_long(sensors::OutputChannel(spec)); !why.empty())
+        throw scene::LevelError(spec.Where() + why + ": give the sensor a shorter 'channel'");
     }
     for (const auto& [key, value] :
          {std::pair<const char*, int>{"net_fdm_port", config.net_fdm_port},

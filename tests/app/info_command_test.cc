@@ -170,6 +170,18 @@ TEST(InfoCommandTest, WhatRunRefusesInfoRefusesWithTheSameMessage) {
              robot("A", "") + robot("B", "[robot.bridge]\nchannel_prefix = \"A\"\n")),
        ":8: robot 'B' bridge: robot 'B' would use the channel prefix 'A' of robot 'A'; give one "
        "of them its own 'channel_prefix'"},
+      // Channels longer than LCM carries (63 bytes): the robot's, a sensor's.
+      {level("long_prefix.toml",
+             robot("A", "[robot.bridge]\nchannel_prefix = \"" + std::string(59, 'P') + "\"\n")),
+       ":5: robot 'A' bridge: robot 'A' would use the channel '" + std::string(59, 'P') +
+           "/POSE' (64 bytes); LCM carries names of at most 63 bytes, without NUL: give it a "
+           "shorter 'channel_prefix'"},
+      {level("long_sensor.toml",
+             robot("A", "[[robot.sensor]]\nname = \"s\"\ntype = \"ray\"\nchannel = \"" +
+                            std::string(62, 'S') + "\"\n")),
+       ":4: sensor 's': robot 'A' would use the channel 'A/" + std::string(62, 'S') +
+           "' (64 bytes); LCM carries names of at most 63 bytes, without NUL: give the sensor a "
+           "shorter 'channel'"},
       // A port taken by another robot, and a bind address that is none.
       {level("ports.toml", robot("A", "[robot.bridge]\nnet_fdm_port = 5600\n") +
                                robot("B", "[robot.bridge]\nudp_doubles_port = 5600\n")),
