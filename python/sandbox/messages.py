@@ -3,7 +3,6 @@
 arrays as numpy, and the input messages encoded from Python values."""
 
 import math
-from io import BytesIO
 
 import numpy as np
 
@@ -54,11 +53,13 @@ class Message:
 def decode(data):
     """The message in `data` (bytes, or any bytes-like object) as a `Message`;
     ValueError when its fingerprint is not a sandbox type or it does not decode."""
-    cls = _BY_FINGERPRINT.get(bytes(data[:8]))
+    if data.__class__ is not bytes:
+        data = bytes(data)
+    cls = _BY_FINGERPRINT.get(data[:8])
     if cls is None:
-        raise ValueError(f"not a sandbox message (fingerprint {bytes(data[:8]).hex() or 'missing'})")
+        raise ValueError(f"not a sandbox message (fingerprint {data[:8].hex() or 'missing'})")
     try:
-        raw = cls._decode_one(BytesIO(data[8:]))  # the fingerprint checked above
+        raw = cls.decode(data)
     except Exception as error:  # struct.error on a short message
         raise ValueError(f"{cls.__name__} does not decode: {error}") from None
     return Message(cls.__name__, raw)
