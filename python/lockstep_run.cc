@@ -11,9 +11,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <map>
+#include <array>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <streambuf>
 #include <string>
@@ -35,10 +36,9 @@ namespace {
 
 // What a tick published: its number, one buffer holding every message (a
 // read-only uint8 array that owns it: nothing copied), and where each is in
-// it: (channel, offset, size).
-using Published =
-    std::tuple<std::int64_t, py::array_t<std::uint8_t>,
-               std::vector<std::tuple<std::string, std::size_t, std::size_t>>>;
+// it: {channel: [(offset, size), ...]}, channels in the order they first
+// published, messages in publishing order.
+using Published = std::tuple<std::int64_t, py::array_t<std::uint8_t>, py::dict>;
 
 // A text stream several threads may write and read (the loop's error
 // stream: the frame threads write to it too).
@@ -103,6 +103,11 @@ class Lockstep {
     py::gil_scoped_release release;
     loop_ = std::make_unique<app::SandboxLoop>(options, std::move(hooks), out_, err_);
     loop_->BeginSteps();
+    const app::LoadedLevel& loaded = loop_->loaded_level();
+    for (std::size_t r = 0; r < loaded.level.robots.size(); ++r) {
+      const std::string& prefix = loaded.bridges[r].channel_prefix;
+      robots_.push_back({loaded.level.robots[r].name, prefix + "/POSE", prefix + "/BONES"});
+    }
   }
 
   ~Lockstep() {
@@ -138,42 +143,66 @@ class Lockstep {
     return Tick(std::move(events));
   }
 
-  // One tick on bone values, messages encoded by the caller and poses, in
-  // that order; the bone values and poses are checked and encoded here
-  // (BONES and POSE at `utime`, each channel's seq counting from 0).
-  Published StepValues(
-      const std::vector<std::tuple<std::string, py::handle>>& bones,
-      const std::vector<std::tuple<std::string, py::bytes>>& encoded,
-      const std::vector<std::tuple<std::string, py::handle, py::handle>>& poses,
-      std::int64_t utime) {
+  // One tick of Lockstep.step(): bone values {robot: values}, messages
+  // encoded by the caller [(channel, bytes)] (joints, actors) and poses
+  // {robot: (position, orientation) or a position}, given to the loop in
+  // that order (BONES, the encoded ones, POSE), at `utime` (None: the last
+  // plus `period_us`). A robot without a pose here keeps its last one,
+  // re-sent at this time. Everything is checked before the tick runs.
+  Published StepRobots(const py::object& poses, const py::object& bones,
+                       const std::vector<std::tuple<std::string, py::bytes>>& encoded,
+                       const py::object& utime_value, std::int64_t period_us) {
+    const std::int64_t utime = utime_value.is_none()
+                                   ? (last_utime_ ? *last_utime_ + period_us : 0)
+                                   : Utime(utime_value);
     std::vector<bridge::LogEvent> events;
-    events.reserve(bones.size() + encoded.size() + poses.size());
-    for (const auto& [channel, values] : bones) {
-      sandbox_msgs::bone_values_t message;
-      message.utime = utime;
-      message.seq = NextSeq(channel);
-      message.values = FiniteVector(values, 0, "bones");
-      message.num_values = int(message.values.size());
-      events.push_back({channel, Encode(message)});
+    if (!bones.is_none()) {
+      for (const auto& [robot, values] : DictArg(bones, "bones", "values")) {
+        const Robot& r = RobotNamed(robot);
+        sandbox_msgs::bone_values_t message;
+        message.utime = utime;
+        message.seq = r.bones_seq;
+        message.values = FiniteVector(values, 0, "bones");
+        message.num_values = int(message.values.size());
+        events.push_back({r.bones, Encode(message)});
+      }
     }
     AddEncoded(encoded, &events);
-    for (const auto& [channel, position, orientation] : poses) {
-      const std::vector<double> p = FiniteVector(position, 3, "position");
-      const std::vector<double> q = FiniteVector(orientation, 4, "orientation");
-      const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-      if (std::abs(norm - 1.0) > 1e-6) {
-        throw py::value_error("orientation must be a unit quaternion (w, x, y, z), its norm is " +
-                              std::to_string(norm));
+    std::vector<std::pair<std::size_t, LastPose>> sent;
+    if (!poses.is_none()) {
+      for (const auto& [robot, pose] : DictArg(poses, "poses", "pose")) {
+        sent.emplace_back(std::size_t(&RobotNamed(robot) - robots_.data()), PoseOf(pose));
       }
+    }
+    for (std::size_t r = 0; r < robots_.size(); ++r) {  // the others' last poses
+      const bool given = std::any_of(sent.begin(), sent.end(),
+                                     [r](const auto& p) { return p.first == r; });
+      if (!given && robots_[r].last) sent.emplace_back(r, *robots_[r].last);
+    }
+    if (sent.empty()) {
+      throw py::value_error("the first step needs a pose for at least one robot (poses=...)");
+    }
+    for (const auto& [r, pose] : sent) {
       sandbox_msgs::robot_pose_t message;
       message.utime = utime;
-      message.seq = NextSeq(channel);
-      std::copy(p.begin(), p.end(), message.position);
-      std::copy(q.begin(), q.end(), message.orientation);
-      events.push_back({channel, Encode(message)});
+      message.seq = robots_[r].pose_seq;
+      std::copy(pose.position.begin(), pose.position.end(), message.position);
+      std::copy(pose.orientation.begin(), pose.orientation.end(), message.orientation);
+      events.push_back({robots_[r].pose, Encode(message)});
     }
-    return Tick(std::move(events));
+    Published published = Tick(std::move(events));
+    for (const auto& [r, pose] : sent) {
+      robots_[r].last = pose;
+      ++robots_[r].pose_seq;
+    }
+    if (!bones.is_none()) {
+      for (const auto& [robot, values] : DictArg(bones, "bones", "values")) ++RobotNamed(robot).bones_seq;
+    }
+    last_utime_ = utime;
+    return published;
   }
+
+  std::optional<std::int64_t> last_utime() const { return last_utime_; }
 
   // Ends the run: files closed, the summary returned (what sandbox run prints).
   std::string Close() {
@@ -214,7 +243,90 @@ class Lockstep {
     py::array_t<std::uint8_t> buffer({py::ssize_t(arena->size())}, {py::ssize_t(1)}, arena->data(),
                                      owner);
     py::detail::array_proxy(buffer.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
-    return {tick_++, std::move(buffer), std::move(published_)};
+    py::dict index;
+    for (const auto& [channel, offset, size] : published_) {
+      const py::str key(channel);
+      PyObject* spans = PyDict_GetItemWithError(index.ptr(), key.ptr());  // borrowed
+      if (spans == nullptr) {
+        if (PyErr_Occurred()) throw py::error_already_set();
+        index[key] = py::list();
+        spans = PyDict_GetItemWithError(index.ptr(), key.ptr());
+      }
+      if (PyList_Append(spans, py::make_tuple(offset, size).ptr()) != 0) {
+        throw py::error_already_set();
+      }
+    }
+    return {tick_++, std::move(buffer), std::move(index)};
+  }
+
+  struct LastPose {
+    std::array<double, 3> position;
+    std::array<double, 4> orientation;
+  };
+  struct Robot {
+    std::string name, pose, bones;  // its name and input channels
+    std::int64_t pose_seq{0}, bones_seq{0};
+    std::optional<LastPose> last;
+  };
+
+  Robot& RobotNamed(const py::handle& name) {
+    if (PyUnicode_Check(name.ptr())) {
+      const std::string wanted = name.cast<std::string>();
+      for (Robot& robot : robots_) {
+        if (robot.name == wanted) return robot;
+      }
+    }
+    std::string known;
+    for (const Robot& robot : robots_) known += (known.empty() ? "" : ", ") + robot.name;
+    throw py::key_error("no robot " + std::string(py::repr(name)) + "; the level has " +
+                        (known.empty() ? std::string("none") : known));
+  }
+
+  static py::dict DictArg(const py::object& value, const char* argument, const char* what) {
+    if (!PyDict_Check(value.ptr())) {
+      throw py::value_error(std::string(argument) + " must be a dict {robot: " + what + "}, got " +
+                            std::string(py::repr(value)));
+    }
+    return py::reinterpret_borrow<py::dict>(value);
+  }
+
+  // (position, orientation), or a position alone (the identity orientation).
+  static LastPose PoseOf(const py::handle& pose) {
+    py::object position = py::reinterpret_borrow<py::object>(pose);
+    py::object orientation = py::make_tuple(1.0, 0.0, 0.0, 0.0);
+    if (PySequence_Check(pose.ptr()) && PySequence_Size(pose.ptr()) == 2) {
+      py::object first = py::reinterpret_borrow<py::sequence>(pose)[0];
+      if (py::hasattr(first, "__len__")) {
+        position = std::move(first);
+        orientation = py::reinterpret_borrow<py::sequence>(pose)[1];
+      }
+    }
+    PyErr_Clear();  // PySequence_Size of a sequence without a length
+    const std::vector<double> p = FiniteVector(position, 3, "position");
+    const std::vector<double> q = FiniteVector(orientation, 4, "orientation");
+    const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (std::abs(norm - 1.0) > 1e-6) {
+      throw py::value_error("orientation must be a unit quaternion (w, x, y, z), its norm is " +
+                            std::to_string(norm));
+    }
+    return {{p[0], p[1], p[2]}, {q[0], q[1], q[2], q[3]}};
+  }
+
+  // Whole microseconds that fit LCM's int64, as Python's int() reads them.
+  static std::int64_t Utime(const py::handle& value) {
+    PyObject* number = PyNumber_Long(value.ptr());
+    if (number == nullptr) {
+      PyErr_Clear();
+      throw py::value_error("utime must be whole microseconds, got " +
+                            std::string(py::repr(value)));
+    }
+    const py::object owned = py::reinterpret_steal<py::object>(number);
+    int overflow = 0;
+    const long long utime = PyLong_AsLongLongAndOverflow(number, &overflow);
+    if (overflow != 0) {
+      throw py::value_error("utime must fit in 64 bits, got " + std::string(py::str(owned)));
+    }
+    return std::int64_t(utime);
   }
 
   static void AddEncoded(const std::vector<std::tuple<std::string, py::bytes>>& inputs,
@@ -230,9 +342,8 @@ class Lockstep {
     message.encode(data.data(), 0, int(data.size()));
     return data;
   }
-  std::int64_t NextSeq(const std::string& channel) { return seq_[channel]++; }
-
-  std::map<std::string, std::int64_t> seq_;  // per channel encoded here
+  std::vector<Robot> robots_;
+  std::optional<std::int64_t> last_utime_;
   std::ostringstream out_;
   SharedText err_text_;
   std::ostream err_{&err_text_};
@@ -257,12 +368,13 @@ void BindLockstep(py::module_& module) {
       .def_property_readonly("actors", &Lockstep::Actors, "the movable actors' names")
       .def_property_readonly("name", &Lockstep::LevelName)
       .def("step", &Lockstep::Step, py::arg("inputs"),
-           "(tick, buffer, [(channel, offset, size)]): the inputs given to the loop, one tick run")
-      .def("step_values", &Lockstep::StepValues, py::arg("bones"), py::arg("encoded"),
-           py::arg("poses"), py::arg("utime"),
-           "(tick, buffer, [(channel, offset, size)]): bone values [(channel, values)], encoded messages "
-           "[(channel, bytes)] and poses [(channel, position, orientation)] given to the loop, "
-           "one tick run")
+           "(tick, buffer, {channel: [(offset, size)]}): the inputs given to the loop, one tick run")
+      .def("step_robots", &Lockstep::StepRobots, py::arg("poses"), py::arg("bones"),
+           py::arg("encoded"), py::arg("utime"), py::arg("period_us"),
+           "(tick, buffer, {channel: [(offset, size)]}): Lockstep.step()'s tick: bone values "
+           "{robot: values}, encoded messages [(channel, bytes)], poses {robot: pose}, utime or "
+           "None (the last plus period_us)")
+      .def_property_readonly("last_utime", &Lockstep::last_utime, "the last step's utime (None before)")
       .def("close", &Lockstep::Close, "ends the run; its summary")
       .def_property_readonly("exit_code", &Lockstep::exit_code)
       .def_property_readonly("messages", &Lockstep::messages,

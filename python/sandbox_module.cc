@@ -1,6 +1,6 @@
 // The Python extension `sandbox._sandbox` (pybind11): World (world.cc), the
-// results' types (results.cc), LCM access (lcm_access.cc) and the stepped
-// loop (lockstep_run.cc). docs/reference/python.md.
+// results' types (results.cc), LCM access (lcm_access.cc), the stepped
+// loop (lockstep_run.cc) and the messages' decoder (message_decode.cc). docs/reference/python.md.
 
 #include <pybind11/pybind11.h>
 
@@ -27,4 +27,5 @@ PYBIND11_MODULE(_sandbox, module) {
   BindWorld(module);
   BindLcm(module);
   BindLockstep(module);
+  BindDecode(module);
 }

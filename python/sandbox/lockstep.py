@@ -3,14 +3,7 @@
 from collections.abc import Mapping
 
 from . import _sandbox
-from .messages import actors_message, decode, joints_message, utime_of
-
-
-def _split_pose(pose):
-    """(position, orientation), or a position alone (the identity orientation)."""
-    if len(pose) == 2 and hasattr(pose[0], "__len__"):
-        return pose[0], pose[1]
-    return pose, (1.0, 0.0, 0.0, 0.0)
+from .messages import actors_message, joints_message, utime_of
 
 
 class Outputs(Mapping):
@@ -19,43 +12,32 @@ class Outputs(Mapping):
     A channel's messages are decoded when first asked for (`raw(channel)`:
     their bytes, as read-only memoryviews of the tick's one buffer)."""
 
-    def __init__(self, tick, buffer, published):
+    def __init__(self, tick, buffer, index):
         self.tick = tick
-        self._buffer, self._published = buffer, published
-        self._index, self._decoded = None, {}
-
-    def _channels(self):
-        """{channel: [(offset, size), ...]}, made when first needed."""
-        if self._index is None:
-            self._index = {}
-            for channel, offset, size in self._published:
-                self._index.setdefault(channel, []).append((offset, size))
-        return self._index
+        self._buffer, self._index, self._decoded = buffer, index, {}
 
     def __getitem__(self, channel):
         messages = self._decoded.get(channel)
         if messages is None:
-            spans = self._channels().get(channel)
+            spans = self._index.get(channel)
             if spans is None:
                 raise KeyError(f"tick {self.tick} published nothing on {channel!r}; it published "
                                f"on {', '.join(sorted(self._index)) or 'no channel'}")
-            buffer = memoryview(self._buffer)
-            messages = self._decoded[channel] = [decode(buffer[offset:offset + size])
-                                                 for offset, size in spans]
+            messages = self._decoded[channel] = _sandbox._decode_spans(self._buffer, spans)
         return messages
 
     def raw(self, channel):
         view = memoryview(self._buffer)
-        return [view[offset:offset + size] for offset, size in self._channels()[channel]]
+        return [view[offset:offset + size] for offset, size in self._index[channel]]
 
     def __iter__(self):
-        return iter(self._channels())
+        return iter(self._index)
 
     def __len__(self):
-        return len(self._channels())
+        return len(self._index)
 
     def __repr__(self):
-        shown = ", ".join(f"{c}: {len(m)}" for c, m in self._channels().items())
+        shown = ", ".join(f"{c}: {len(m)}" for c, m in self._index.items())
         return f"Outputs(tick {self.tick}, {shown})"
 
 
@@ -79,8 +61,7 @@ class Lockstep:
         self.actors = self._run.actors
         self.name = self._run.name
         self._period_us = round(1e6 / rate_hz)
-        self._utime = None
-        self._seq, self._poses, self._channel_names = {}, {}, {}
+        self._seq, self._channel_names = {}, {}
         self.summary = None
 
     def __enter__(self):
@@ -97,8 +78,7 @@ class Lockstep:
                 raise KeyError(f"no robot {robot!r}; the level has "
                                f"{', '.join(self.robots) or 'none'}")
             channels = self._channel_names[robot] = {
-                kind: f"{self._prefix[robot]}/{kind}" for kind in ("POSE", "BONES", "JOINTS",
-                                                                    "ACTORS")}
+                kind: f"{self._prefix[robot]}/{kind}" for kind in ("JOINTS", "ACTORS")}
         return channels
 
     def _seq_of(self, channel):
@@ -116,33 +96,20 @@ class Lockstep:
         {robot: {joint: value} or every value}; actors: {movable actor:
         (position, orientation)}, world. utime: this tick's time in
         microseconds (default: the last plus one period of rate_hz)."""
-        if utime is None:
-            utime = 0 if self._utime is None else self._utime + self._period_us
-        utime = utime_of(utime)
-        bone_inputs, encoded, pose_inputs = [], [], []
-        if bones:
-            for robot, value in bones.items():
-                bone_inputs.append((self._channels(robot)["BONES"], value))
-        if joints:
-            for robot, value in joints.items():
-                channel = self._channels(robot)["JOINTS"]
-                encoded.append((channel, joints_message(value, utime, self._seq_of(channel))))
-        if actors:
-            channel = self._channels(self.robots[0])["ACTORS"]
-            encoded.append((channel, actors_message(actors, utime, self._seq_of(channel))))
-        sent = dict(self._poses)
-        if poses:
-            for robot, pose in poses.items():
-                self._channels(robot)  # a KeyError before anything is sent
-                sent[robot] = _split_pose(pose)
-        if not sent:
-            raise ValueError("the first step needs a pose for at least one robot (poses=...)")
-        for robot, (position, orientation) in sent.items():
-            pose_inputs.append((self._channels(robot)["POSE"], position, orientation))
-        # Bone values and poses checked and encoded in C++ (BONES, then JOINTS and ACTORS, then POSE).
-        published = self._run.step_values(bone_inputs, encoded, pose_inputs, utime)
-        self._utime, self._poses = utime, sent
-        return Outputs(*published)
+        encoded = []
+        if joints or actors:  # encoded here; bone values and poses are, in C++
+            if utime is None:
+                last = self._run.last_utime
+                utime = 0 if last is None else last + self._period_us
+            utime = utime_of(utime)
+            if joints:
+                for robot, value in joints.items():
+                    channel = self._channels(robot)["JOINTS"]
+                    encoded.append((channel, joints_message(value, utime, self._seq_of(channel))))
+            if actors:
+                channel = self._channels(self.robots[0])["ACTORS"]
+                encoded.append((channel, actors_message(actors, utime, self._seq_of(channel))))
+        return Outputs(*self._run.step_robots(poses, bones, encoded, utime, self._period_us))
 
     def step_messages(self, inputs):
         """Runs one tick on messages encoded by the caller, `[(channel, bytes)]`

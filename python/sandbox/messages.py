@@ -1,68 +1,28 @@
-"""The sandbox's LCM messages in Python: decoded by lcm-gen's Python types
-(generated at build time into sandbox/sandbox_msgs/, pure Python), their
-arrays as numpy, and the input messages encoded from Python values."""
+"""The sandbox's LCM messages in Python: decoded in C++ (`_sandbox._decode`:
+lcm-gen's C++ types; a field becomes a Python value, an array a numpy array,
+when first read), and the
+input messages encoded from Python values by lcm-gen's Python types
+(generated at build time into sandbox/sandbox_msgs/, pure Python)."""
 
 import math
 
 import numpy as np
 
-from . import sandbox_msgs
+from . import _sandbox, sandbox_msgs
 
-# Every message type, by its name and by its fingerprint (the first 8 bytes).
+# Every message type, by its name.
 message_types = {name: getattr(sandbox_msgs, name) for name in dir(sandbox_msgs)
                  if name.endswith("_t")}
-_BY_FINGERPRINT = {cls._get_packed_fingerprint(): cls for cls in message_types.values()}
 
 
-def _converted(value):
-    """A numeric array as numpy, a string array as a list, a scalar as it is."""
-    if value.__class__ is tuple or value.__class__ is list:
-        return list(value) if value and value[0].__class__ is str else np.array(value)
-    return value
-
-
-class Message:
-    """A decoded message: its fields as attributes (as in bridge/lcmtypes/*.lcm,
-    flat), numeric arrays as numpy arrays, string arrays as lists, each made
-    when first read; `lcm_type` is the type's name, `fields()` all of them."""
-
-    def __init__(self, lcm_type, raw):
-        self.__dict__["lcm_type"] = lcm_type
-        self.__dict__["_raw"] = raw
-
-    def __getattr__(self, name):  # a field not read before
-        raw = self.__dict__["_raw"]
-        if name.startswith("_") or name not in raw.__slots__:
-            raise AttributeError(f"{self.lcm_type} has no field {name!r}; it has "
-                                 f"{', '.join(raw.__slots__)}")
-        value = self.__dict__[name] = _converted(getattr(raw, name))
-        return value
-
-    def fields(self):
-        """{field: value} of every field, in the type's order."""
-        return {name: getattr(self, name) for name in self._raw.__slots__}
-
-    def __dir__(self):
-        return ["lcm_type", "fields", *self._raw.__slots__]
-
-    def __repr__(self):
-        shown = ", ".join(f"{name}={value!r}" for name, value in self.fields().items())
-        return f"{self.lcm_type}({shown})"
+Message = _sandbox.Message
 
 
 def decode(data):
     """The message in `data` (bytes, or any bytes-like object) as a `Message`;
-    ValueError when its fingerprint is not a sandbox type or it does not decode."""
-    if data.__class__ is not bytes:
-        data = bytes(data)
-    cls = _BY_FINGERPRINT.get(data[:8])
-    if cls is None:
-        raise ValueError(f"not a sandbox message (fingerprint {data[:8].hex() or 'missing'})")
-    try:
-        raw = cls.decode(data)
-    except Exception as error:  # struct.error on a short message
-        raise ValueError(f"{cls.__name__} does not decode: {error}") from None
-    return Message(cls.__name__, raw)
+    ValueError when it is not exactly one message of a sandbox type (naming
+    the type and the field that does not fit)."""
+    return _sandbox._decode(data)
 
 
 def finite(value, count, argument):
