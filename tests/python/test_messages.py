@@ -20,7 +20,8 @@ PRIMITIVES = {
     "int64_t": (np.int64, st.integers(-2**63, 2**63 - 1)),
     "float": (np.float32, st.floats(width=32)),
     "double": (np.float64, st.floats()),
-    "string": (None, st.text(st.characters(blacklist_characters="\0"), max_size=12)),
+    "string": (None, st.text(st.characters(blacklist_categories=("Cs",), blacklist_characters="\0"),
+                             max_size=12)),
 }
 
 
