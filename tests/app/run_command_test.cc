@@ -259,9 +259,11 @@ void CheckStopsCleanlyOn(const std::string& signal) {
   const auto run = sandbox::testing::RunCommand(
       std::string(SANDBOX_BINARY) + " run --lcm-url memq:// --frames jpg,mp4 --out " + out +
       " & pid=$!; for i in $(seq 1200); do [ $(ls " + out +
-      " | grep -c '^chase_.*jpg$') -ge 3 ] && break; sleep 0.05; done; kill -" + signal +
+      "/chase 2> /dev/null | grep -c '^chase_.*jpg$') -ge 3 ] && break; sleep 0.05; done; "
+      "[ $i -lt 1200 ] || echo 'no third chase frame in " + out + "/chase'; kill -" + signal +
       " $pid; wait $pid");
   ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_EQ(run.out.find("no third chase frame"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find(" ticks in "), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("statistics: "), std::string::npos) << run.out;
   const long indexed = long(ReadIndex(dir.path() / "chase.csv").size());
