@@ -5,14 +5,39 @@
 namespace sandbox::python {
 namespace {
 
-// A read-only array over `data` (owned by `owner`, which it keeps alive).
+// A read-only array over `data` (owned by `owner`, which it keeps alive),
+// C order. Made through numpy's C API directly: py::array's constructor
+// (shape and stride vectors, flags read back) costs about twice as much, and
+// a face scan hands out 24 of these.
 template <typename T>
-py::array View(const T* data, std::vector<py::ssize_t> shape, py::handle owner) {
-  py::array array(py::dtype::of<T>(), std::move(shape), data, owner);
-  // numpy's flag cleared directly (setting array.flags.writeable from C++
-  // costs a microsecond a view through Python's attribute machinery).
-  py::detail::array_proxy(array.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+py::array View(const T* data, std::initializer_list<py::ssize_t> shape, py::handle owner) {
+  auto& api = py::detail::npy_api::get();
+  Py_intptr_t extents[3], strides[3];
+  const int ndim = int(shape.size());
+  std::copy(shape.begin(), shape.end(), extents);
+  Py_intptr_t stride = Py_intptr_t(sizeof(T));
+  for (int d = ndim - 1; d >= 0; --d) strides[d] = stride, stride *= extents[d];
+  PyObject* descr = api.PyArray_DescrFromType_(py::detail::npy_format_descriptor<T>::value);
+  if (descr == nullptr) throw py::error_already_set();
+  auto array = py::reinterpret_steal<py::array>(api.PyArray_NewFromDescr_(
+      api.PyArray_Type_, descr, ndim, extents, strides, const_cast<T*>(data), 0, nullptr));
+  if (!array) throw py::error_already_set();
+  if (api.PyArray_SetBaseObject_(array.ptr(), owner.inc_ref().ptr()) != 0) {
+    throw py::error_already_set();
+  }
   return array;
+}
+
+// The six faces' (n, n) views of one of a scan's fields ((n, n, 3) for a vector).
+template <typename T, typename Field>
+py::list FaceViews(const py::object& self, Field field, bool vector = false) {
+  const auto& s = self.cast<const FaceScanResult&>().scan;
+  py::list faces(s.faces.size());
+  for (std::size_t f = 0; f < s.faces.size(); ++f) {
+    const T* data = field(s.faces[f]);
+    faces[f] = vector ? View(data, {s.n, s.n, 3}, self) : View(data, {s.n, s.n}, self);
+  }
+  return faces;
 }
 
 }  // namespace
@@ -27,43 +52,30 @@ void BindResults(py::module_& module) {
                              [](const FaceScanResult& s) { return s.scan.half_extent_m; })
       .def_property_readonly(
           "occupancy",
-          [](py::object self) {
-            const auto& s = self.cast<const FaceScanResult&>().scan;
-            py::list faces;
-            for (const auto& face : s.faces)
-              faces.append(View(face.occupancy.data(), {s.n, s.n}, self));
-            return faces;
+          [](const py::object& self) {
+            return FaceViews<std::int8_t>(
+                self, [](const auto& face) { return face.occupancy.data(); });
           },
           "6 int8 (n, n) views: 1 occupied, 0 free (sensors.md, Occupancy)")
       .def_property_readonly(
           "distance",
-          [](py::object self) {
-            const auto& s = self.cast<const FaceScanResult&>().scan;
-            py::list faces;
-            for (const auto& face : s.faces)
-              faces.append(View(face.distance_m.data(), {s.n, s.n}, self));
-            return faces;
+          [](const py::object& self) {
+            return FaceViews<float>(
+                self, [](const auto& face) { return face.distance_m.data(); });
           },
           "6 float32 (n, n) views: metres from the ray's start along the face's axis")
       .def_property_readonly(
           "surface",
-          [](py::object self) {
-            const auto& s = self.cast<const FaceScanResult&>().scan;
-            py::list faces;
-            for (const auto& face : s.faces)
-              faces.append(View(face.surface.data(), {s.n, s.n}, self));
-            return faces;
+          [](const py::object& self) {
+            return FaceViews<std::int32_t>(
+                self, [](const auto& face) { return face.surface.data(); });
           },
           "6 int32 (n, n) views: the surface id hit (World.surfaces()), 0 none")
       .def_property_readonly(
           "normal",
-          [](py::object self) {
-            const auto& s = self.cast<const FaceScanResult&>().scan;
-            py::list faces;
-            for (const auto& face : s.faces) {
-              faces.append(View(face.normal_W.data()->data(), {s.n, s.n, 3}, self));
-            }
-            return faces;
+          [](const py::object& self) {
+            return FaceViews<float>(
+                self, [](const auto& face) { return face.normal_W.data()->data(); }, true);
           },
           "6 float32 (n, n, 3) views: the unit normal at the hit, world frame; 0 free")
       .def(
