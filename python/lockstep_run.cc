@@ -34,11 +34,92 @@ namespace py = pybind11;
 namespace sandbox::python {
 namespace {
 
-// What a tick published: its number, one buffer holding every message (a
-// read-only uint8 array that owns it: nothing copied), and where each is in
-// it: {channel: [(offset, size), ...]}, channels in the order they first
-// published, messages in publishing order.
-using Published = std::tuple<std::int64_t, py::array_t<std::uint8_t>, py::dict>;
+// What a tick published (sandbox.Outputs): its number, one buffer holding
+// every message (a read-only uint8 array that owns it: nothing copied), and
+// where each is in it, by channel (channels in the order they first
+// published, messages in publishing order); a channel's messages decoded
+// when first asked for. A Mapping {channel: [Message, ...]}.
+class Outputs {
+ public:
+  using Spans = std::vector<std::pair<std::size_t, std::size_t>>;
+  Outputs(std::int64_t tick, py::array_t<std::uint8_t> buffer,
+          std::vector<std::pair<std::string, Spans>> channels)
+      : tick_(tick), buffer_(std::move(buffer)), channels_(std::move(channels)),
+        decoded_(channels_.size()) {}
+
+  std::int64_t tick() const { return tick_; }
+
+  py::list Get(const std::string& channel) {
+    const std::size_t c = Find(channel);
+    if (!decoded_[c]) decoded_[c] = DecodeSpans(buffer_, channels_[c].second);
+    return py::reinterpret_borrow<py::list>(decoded_[c]);
+  }
+  py::object GetOr(const py::handle& channel, const py::object& otherwise) {
+    return Has(channel) ? py::object(Get(channel.cast<std::string>())) : otherwise;
+  }
+  bool Has(const py::handle& channel) const {
+    if (!PyUnicode_Check(channel.ptr())) return false;
+    const std::string name = channel.cast<std::string>();
+    return std::any_of(channels_.begin(), channels_.end(),
+                       [&](const auto& c) { return c.first == name; });
+  }
+  // The messages' bytes, read-only memoryviews of the one buffer.
+  py::list Raw(const std::string& channel) const {
+    const Spans& spans = channels_[Find(channel)].second;
+    const py::memoryview whole(buffer_);
+    py::list views(spans.size());
+    for (std::size_t i = 0; i < spans.size(); ++i) {
+      const auto [offset, size] = spans[i];
+      views[i] = whole[py::slice(py::ssize_t(offset), py::ssize_t(offset + size), 1)];
+    }
+    return views;
+  }
+  py::list Channels() const {
+    py::list names(channels_.size());
+    for (std::size_t c = 0; c < channels_.size(); ++c) names[c] = channels_[c].first;
+    return names;
+  }
+  py::list Values() {
+    py::list values(channels_.size());
+    for (std::size_t c = 0; c < channels_.size(); ++c) values[c] = Get(channels_[c].first);
+    return values;
+  }
+  py::list Items() {
+    py::list items(channels_.size());
+    for (std::size_t c = 0; c < channels_.size(); ++c) {
+      items[c] = py::make_tuple(channels_[c].first, Get(channels_[c].first));
+    }
+    return items;
+  }
+  std::size_t size() const { return channels_.size(); }
+  std::string Repr() const {
+    std::string shown;
+    for (const auto& [channel, spans] : channels_) {
+      shown += (shown.empty() ? "" : ", ") + channel + ": " + std::to_string(spans.size());
+    }
+    return "Outputs(tick " + std::to_string(tick_) + ", " + shown + ")";
+  }
+
+ private:
+  std::size_t Find(const std::string& channel) const {
+    for (std::size_t c = 0; c < channels_.size(); ++c) {
+      if (channels_[c].first == channel) return c;
+    }
+    std::vector<std::string> names;
+    for (const auto& c : channels_) names.push_back(c.first);
+    std::sort(names.begin(), names.end());
+    std::string known;
+    for (const std::string& name : names) known += (known.empty() ? "" : ", ") + name;
+    throw py::key_error("tick " + std::to_string(tick_) + " published nothing on '" + channel +
+                        "'; it published on " + (known.empty() ? "no channel" : known));
+  }
+
+  std::int64_t tick_;
+  py::array_t<std::uint8_t> buffer_;
+  std::vector<std::pair<std::string, Spans>> channels_;
+  std::vector<py::object> decoded_;  // null until asked for
+};
+
 
 // A text stream several threads may write and read (the loop's error
 // stream: the frame threads write to it too).
@@ -135,7 +216,7 @@ class Lockstep {
   std::string LevelName() const { return loop_->level().name; }
 
   // One tick: the inputs in, the tick's outputs back (channel, bytes).
-  Published Step(
+  Outputs Step(
       const std::vector<std::tuple<std::string, py::bytes>>& inputs) {
     std::vector<bridge::LogEvent> events;
     events.reserve(inputs.size());
@@ -149,7 +230,7 @@ class Lockstep {
   // that order (BONES, the encoded ones, POSE), at `utime` (None: the last
   // plus `period_us`). A robot without a pose here keeps its last one,
   // re-sent at this time. Everything is checked before the tick runs.
-  Published StepRobots(const py::object& poses, const py::object& bones,
+  Outputs StepRobots(const py::object& poses, const py::object& bones,
                        const std::vector<std::tuple<std::string, py::bytes>>& encoded,
                        const py::object& utime_value, std::int64_t period_us) {
     const std::int64_t utime = utime_value.is_none()
@@ -190,7 +271,7 @@ class Lockstep {
       std::copy(pose.orientation.begin(), pose.orientation.end(), message.orientation);
       events.push_back({robots_[r].pose, Encode(message)});
     }
-    Published published = Tick(std::move(events));
+    Outputs published = Tick(std::move(events));
     for (const auto& [r, pose] : sent) {
       robots_[r].last = pose;
       ++robots_[r].pose_seq;
@@ -218,7 +299,7 @@ class Lockstep {
   std::string messages() { return err_text_.str(); }
 
  private:
-  Published Tick(std::vector<bridge::LogEvent> events) {
+  Outputs Tick(std::vector<bridge::LogEvent> events) {
     std::lock_guard<std::mutex> lock(step_mutex_);  // (taken with the GIL held: no deadlock)
     if (closed_ || loop_->ended()) throw py::value_error("the run has ended");
     const std::size_t said_before = err_text_.size();
@@ -243,20 +324,14 @@ class Lockstep {
     py::array_t<std::uint8_t> buffer({py::ssize_t(arena->size())}, {py::ssize_t(1)}, arena->data(),
                                      owner);
     py::detail::array_proxy(buffer.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
-    py::dict index;
+    std::vector<std::pair<std::string, Outputs::Spans>> channels;
     for (const auto& [channel, offset, size] : published_) {
-      const py::str key(channel);
-      PyObject* spans = PyDict_GetItemWithError(index.ptr(), key.ptr());  // borrowed
-      if (spans == nullptr) {
-        if (PyErr_Occurred()) throw py::error_already_set();
-        index[key] = py::list();
-        spans = PyDict_GetItemWithError(index.ptr(), key.ptr());
-      }
-      if (PyList_Append(spans, py::make_tuple(offset, size).ptr()) != 0) {
-        throw py::error_already_set();
-      }
+      auto c = std::find_if(channels.begin(), channels.end(),
+                            [&](const auto& known) { return known.first == channel; });
+      if (c == channels.end()) c = channels.insert(channels.end(), {channel, {}});
+      c->second.emplace_back(offset, size);
     }
-    return {tick_++, std::move(buffer), std::move(index)};
+    return Outputs(tick_++, std::move(buffer), std::move(channels));
   }
 
   struct LastPose {
@@ -360,6 +435,23 @@ class Lockstep {
 }  // namespace
 
 void BindLockstep(py::module_& module) {
+  py::class_<Outputs>(module, "Outputs",
+                      "What one tick published: {channel: [Message, ...]} in publishing order (a "
+                      "face scanner's six faces are six messages on one channel); `tick`. A "
+                      "channel's messages are decoded when first asked for (`raw(channel)`: their "
+                      "bytes, as read-only memoryviews of the tick's one buffer).")
+      .def_property_readonly("tick", &Outputs::tick)
+      .def("__getitem__", &Outputs::Get, py::arg("channel"))
+      .def("get", &Outputs::GetOr, py::arg("channel"), py::arg("default") = py::none())
+      .def("__contains__", &Outputs::Has, py::arg("channel"))
+      .def("raw", &Outputs::Raw, py::arg("channel"),
+           "the channel's messages undecoded: read-only memoryviews of the tick's buffer")
+      .def("keys", &Outputs::Channels)
+      .def("values", &Outputs::Values)
+      .def("items", &Outputs::Items)
+      .def("__iter__", [](const Outputs& outputs) { return py::iter(outputs.Channels()); })
+      .def("__len__", &Outputs::size)
+      .def("__repr__", &Outputs::Repr);
   py::class_<Lockstep>(module, "_Lockstep",
                        "sandbox run --lockstep in-process, stepped (sandbox.Lockstep is the "
                        "interface).")
@@ -368,10 +460,10 @@ void BindLockstep(py::module_& module) {
       .def_property_readonly("actors", &Lockstep::Actors, "the movable actors' names")
       .def_property_readonly("name", &Lockstep::LevelName)
       .def("step", &Lockstep::Step, py::arg("inputs"),
-           "(tick, buffer, {channel: [(offset, size)]}): the inputs given to the loop, one tick run")
+           "Outputs: the inputs given to the loop, one tick run")
       .def("step_robots", &Lockstep::StepRobots, py::arg("poses"), py::arg("bones"),
            py::arg("encoded"), py::arg("utime"), py::arg("period_us"),
-           "(tick, buffer, {channel: [(offset, size)]}): Lockstep.step()'s tick: bone values "
+           "Outputs: Lockstep.step()'s tick: bone values "
            "{robot: values}, encoded messages [(channel, bytes)], poses {robot: pose}, utime or "
            "None (the last plus period_us)")
       .def_property_readonly("last_utime", &Lockstep::last_utime, "the last step's utime (None before)")

@@ -203,7 +203,8 @@ py::dict Fields(const py::object& self) {
   return fields;
 }
 
-// The messages at `spans` [(offset, size)] of `buffer`, in that order.
+}  // namespace
+
 py::list DecodeSpans(const py::handle& buffer,
                      const std::vector<std::pair<std::size_t, std::size_t>>& spans) {
   Py_buffer view;
@@ -219,8 +220,6 @@ py::list DecodeSpans(const py::handle& buffer,
   }
   return messages;
 }
-
-}  // namespace
 
 void BindDecode(py::module_& module) {
   py::class_<Decoded>(module, "Message", py::dynamic_attr(),

@@ -6,39 +6,8 @@ from . import _sandbox
 from .messages import actors_message, joints_message, utime_of
 
 
-class Outputs(Mapping):
-    """What one tick published: {channel: [Message, ...]} in publishing order
-    (a face scanner's six faces are six messages on one channel); `tick`.
-    A channel's messages are decoded when first asked for (`raw(channel)`:
-    their bytes, as read-only memoryviews of the tick's one buffer)."""
-
-    def __init__(self, tick, buffer, index):
-        self.tick = tick
-        self._buffer, self._index, self._decoded = buffer, index, {}
-
-    def __getitem__(self, channel):
-        messages = self._decoded.get(channel)
-        if messages is None:
-            spans = self._index.get(channel)
-            if spans is None:
-                raise KeyError(f"tick {self.tick} published nothing on {channel!r}; it published "
-                               f"on {', '.join(sorted(self._index)) or 'no channel'}")
-            messages = self._decoded[channel] = _sandbox._decode_spans(self._buffer, spans)
-        return messages
-
-    def raw(self, channel):
-        view = memoryview(self._buffer)
-        return [view[offset:offset + size] for offset, size in self._index[channel]]
-
-    def __iter__(self):
-        return iter(self._index)
-
-    def __len__(self):
-        return len(self._index)
-
-    def __repr__(self):
-        shown = ", ".join(f"{c}: {len(m)}" for c, m in self._index.items())
-        return f"Outputs(tick {self.tick}, {shown})"
+Outputs = _sandbox.Outputs  # what one tick published (lockstep_run.cc)
+Mapping.register(Outputs)
 
 
 class Lockstep:
@@ -109,13 +78,13 @@ class Lockstep:
             if actors:
                 channel = self._channels(self.robots[0])["ACTORS"]
                 encoded.append((channel, actors_message(actors, utime, self._seq_of(channel))))
-        return Outputs(*self._run.step_robots(poses, bones, encoded, utime, self._period_us))
+        return self._run.step_robots(poses, bones, encoded, utime, self._period_us)
 
     def step_messages(self, inputs):
         """Runs one tick on messages encoded by the caller, `[(channel, bytes)]`
         in arrival order (the fast path: nothing encoded here, no last pose
         re-sent); returns its `Outputs`."""
-        return Outputs(*self._run.step(inputs if isinstance(inputs, list) else list(inputs)))
+        return self._run.step(inputs if isinstance(inputs, list) else list(inputs))
 
     @property
     def messages(self):
