@@ -96,6 +96,8 @@ class SandboxLoop {
   const scene::Level& level() const { return level_; }
   // The level with its sensors, cameras and robots' channels.
   const LoadedLevel& loaded_level() const { return loaded_; }
+  // The browser view's address (--web), or "".
+  std::string web_url() const { return web_ ? web_->url() : std::string(); }
 
  private:
   // A robot: its state, what drives it and what it publishes.

@@ -214,6 +214,7 @@ class Lockstep {
     return names;
   }
   std::string LevelName() const { return loop_->level().name; }
+  std::string WebUrl() const { return loop_->web_url(); }
 
   // One tick: the inputs in, the tick's outputs back (channel, bytes).
   Outputs Step(
@@ -459,6 +460,7 @@ void BindLockstep(py::module_& module) {
       .def_property_readonly("robots", &Lockstep::Robots, "[(name, channel prefix)]")
       .def_property_readonly("actors", &Lockstep::Actors, "the movable actors' names")
       .def_property_readonly("name", &Lockstep::LevelName)
+      .def_property_readonly("web_url", &Lockstep::WebUrl, "the browser view's address (--web), or ''")
       .def("step", &Lockstep::Step, py::arg("inputs"),
            "Outputs: the inputs given to the loop, one tick run")
       .def("step_robots", &Lockstep::StepRobots, py::arg("poses"), py::arg("bones"),

@@ -29,6 +29,7 @@ class Lockstep:
         self.robots = list(self._prefix)
         self.actors = self._run.actors
         self.name = self._run.name
+        self.web_url = self._run.web_url or None  # `--web PORT`: the browser view's address
         self._period_us = round(1e6 / rate_hz)
         self._seq, self._channel_names = {}, {}
         self.summary = None

@@ -164,3 +164,68 @@ def test_bad_steps_say_what_is_wrong():
         sandbox.Lockstep(args=["--rate", "fast"])
     with pytest.raises(sandbox.LevelError, match="missing.toml"):
         sandbox.Lockstep("missing.toml")
+
+
+def frames(data):
+    """The whole WebSocket messages at the start of `data` (the server's:
+    unmasked, unfragmented) as [(opcode, payload)], and the bytes after them."""
+    found = []
+    while len(data) >= 2:
+        length, at = data[1] & 0x7F, 2
+        if length >= 126:
+            at = 4 if length == 126 else 10
+            if len(data) < at:
+                break
+            length = int.from_bytes(data[2:at], "big")
+        if len(data) < at + length:
+            break
+        found.append((data[0] & 0x0F, data[at:at + length]))
+        data = data[at + length:]
+    return found, data
+
+
+def test_a_stepped_run_serves_its_ticks_to_the_browser_view():
+    """--web on a Lockstep: the page is served, and the stream's states carry
+    each step's tick and the pose it was given."""
+    import json
+    import socket
+    import time
+    import urllib.request
+
+    with sandbox.Lockstep(args=["--web", "0"]) as run:
+        assert run.web_url.startswith("http://127.0.0.1:"), run.web_url
+        with urllib.request.urlopen(run.web_url, timeout=30) as page:
+            assert page.status == 200 and b"<html" in page.read().lower()
+        host, port = run.web_url[len("http://"):].rstrip("/").rsplit(":", 1)
+        connection = socket.create_connection((host, int(port)), timeout=30)
+        connection.sendall(("GET /stream HTTP/1.1\r\nHost: %s:%s\r\nUpgrade: websocket\r\n"
+                            "Connection: Upgrade\r\nSec-WebSocket-Version: 13\r\n"
+                            "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n\r\n"
+                            % (host, port)).encode())
+        data = b""
+        while b"\r\n\r\n" not in data:
+            data += connection.recv(4096)
+        head, data = data.split(b"\r\n\r\n", 1)
+        assert head.startswith(b"HTTP/1.1 101"), head
+        connection.settimeout(0.02)
+        received, given, shown = [], {}, 0
+        deadline = time.monotonic() + 60
+        while shown < 3 and time.monotonic() < deadline:  # states go out at most 60 a second
+            position = (float(len(given)), -100.0, 40.0)
+            given[run.step(poses={"ELAHA": (position, (1.0, 0.0, 0.0, 0.0))}).tick] = position
+            try:
+                data += connection.recv(1 << 20)
+            except socket.timeout:
+                continue
+            found, data = frames(data)
+            received += found
+            for opcode, payload in found:
+                if opcode == 1 and json.loads(payload)["type"] == "state":
+                    state = json.loads(payload)
+                    assert state["robots"][0]["p"] == pytest.approx(given[state["tick"]],
+                                                                    abs=1e-6), state["tick"]
+                    shown += 1
+        connection.close()
+        assert received[0][0] == 1 and json.loads(received[0][1])["type"] == "level"
+        assert received[1][0] == 2  # the level's glTF
+        assert shown >= 3, "fewer than 3 states in 60 s"
