@@ -187,7 +187,11 @@ class Lockstep {
     const app::LoadedLevel& loaded = loop_->loaded_level();
     for (std::size_t r = 0; r < loaded.level.robots.size(); ++r) {
       const std::string& prefix = loaded.bridges[r].channel_prefix;
-      robots_.push_back({loaded.level.robots[r].name, prefix + "/POSE", prefix + "/BONES"});
+      Robot robot;
+      robot.name = loaded.level.robots[r].name;
+      robot.pose = prefix + "/POSE";
+      robot.bones = prefix + "/BONES";
+      robots_.push_back(std::move(robot));
     }
   }
 
