@@ -1,4 +1,4 @@
-// _decode: one message of a sandbox LCM type into Python values, in C++.
+// sandbox.Message and _decode: one message of a sandbox LCM type, in C++.
 // The bytes are checked (bridge::DecodeChecked: counts and lengths against
 // the bytes, exactly one message) and decoded by lcm-gen's C++ types; each
 // field becomes a Python value: numbers as int or float, arrays as numpy
