@@ -9,9 +9,9 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
-#include <array>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -120,7 +120,6 @@ class Outputs {
   std::vector<py::object> decoded_;  // null until asked for
 };
 
-
 // A text stream several threads may write and read (the loop's error
 // stream: the frame threads write to it too).
 class SharedText : public std::streambuf {
@@ -189,6 +188,7 @@ class Lockstep {
       const std::string& prefix = loaded.bridges[r].channel_prefix;
       Robot robot;
       robot.name = loaded.level.robots[r].name;
+      robot.prefix = prefix;
       robot.pose = prefix + "/POSE";
       robot.bones = prefix + "/BONES";
       robots_.push_back(std::move(robot));
@@ -204,10 +204,7 @@ class Lockstep {
 
   std::vector<std::tuple<std::string, std::string>> Robots() const {
     std::vector<std::tuple<std::string, std::string>> robots;
-    const app::LoadedLevel& loaded = loop_->loaded_level();
-    for (std::size_t r = 0; r < loaded.level.robots.size(); ++r) {
-      robots.emplace_back(loaded.level.robots[r].name, loaded.bridges[r].channel_prefix);
-    }
+    for (const Robot& robot : robots_) robots.emplace_back(robot.name, robot.prefix);
     return robots;
   }
   std::vector<std::string> Actors() const {
@@ -242,9 +239,11 @@ class Lockstep {
                                    ? (last_utime_ ? *last_utime_ + period_us : 0)
                                    : Utime(utime_value);
     std::vector<bridge::LogEvent> events;
+    std::vector<Robot*> bones_sent;
     if (!bones.is_none()) {
       for (const auto& [robot, values] : DictArg(bones, "bones", "values")) {
-        const Robot& r = RobotNamed(robot);
+        Robot& r = RobotNamed(robot);
+        bones_sent.push_back(&r);
         sandbox_msgs::bone_values_t message;
         message.utime = utime;
         message.seq = r.bones_seq;
@@ -281,9 +280,7 @@ class Lockstep {
       robots_[r].last = pose;
       ++robots_[r].pose_seq;
     }
-    if (!bones.is_none()) {
-      for (const auto& [robot, values] : DictArg(bones, "bones", "values")) ++RobotNamed(robot).bones_seq;
-    }
+    for (Robot* r : bones_sent) ++r->bones_seq;
     last_utime_ = utime;
     return published;
   }
@@ -344,7 +341,7 @@ class Lockstep {
     std::array<double, 4> orientation;
   };
   struct Robot {
-    std::string name, pose, bones;  // its name and input channels
+    std::string name, prefix, pose, bones;  // its name, channel prefix and input channels
     std::int64_t pose_seq{0}, bones_seq{0};
     std::optional<LastPose> last;
   };
