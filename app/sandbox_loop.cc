@@ -50,6 +50,8 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
   if (!options_.record_file.empty()) link_.RecordTo(options_.record_file);
   if (hooks_.published) link_.set_publish_tap(hooks_.published);
   if (level_.terrain) terrain_ = std::make_unique<scene::TerrainStreamer>(level_);
+  // The world's geodetic anchor, for the instruments.
+  if (const auto anchor = bridge::WorldAnchor(level_, loaded_.bridges)) geodetic_.emplace(*anchor);
   robots_.resize(level_.robots.size());
   for (std::size_t r = 0; r < level_.robots.size(); ++r) {
     RobotRun& robot = robots_[r];
@@ -71,7 +73,7 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
   }
   for (const sensors::MountedSensor& mounted : loaded_.sensors) {
     sensors_.emplace_back(mounted);
-    sensor_schedules_.emplace_back(mounted.spec.rate_hz);
+    sensor_schedules_.emplace_back(mounted.RunsEveryTick() ? 0.0 : mounted.spec.rate_hz);
     RobotRun& robot = robots_[std::size_t(mounted.robot)];
     // Poses kept as far back as the robot's sensors look (and a tick more).
     robot.history =
@@ -382,7 +384,8 @@ void SandboxLoop::RunDueSensors(double t, std::int64_t now_utime) {
     sensors::RayFilter filter;
     filter.ignore_robot = mounted.robot;
     sensor.Run({world_, caster, filter, mounted.Pose(*robot.state), robot.state->pose(),
-                &robot.history, t, tick_});
+                &robot.history, t, tick_, robot.feed->input().utime,
+                geodetic_ ? &*geodetic_ : nullptr});
   };
   if (caster_.threads() > 1 && int(due_.size()) > caster_.threads()) {
     // More sensors than threads: whole sensors over the caster's threads, each casting

@@ -26,6 +26,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <ostream>
 #include <vector>
 
@@ -48,6 +49,7 @@
 #include "bridge/robot_feed.h"
 #include "bridge/unknown_robots.h"
 #include "scene/collision_world.h"
+#include "scene/geodetic.h"
 #include "scene/level.h"
 #include "scene/robot_state.h"
 #include "scene/terrain_streamer.h"
@@ -165,6 +167,7 @@ class SandboxLoop {
   const scene::Level& level_{loaded_.level};
   scene::CollisionWorld world_;
   std::unique_ptr<scene::TerrainStreamer> terrain_;  // when the level has [[terrain]]
+  std::optional<scene::LocalTangentPlane> geodetic_;  // its anchor, for the instruments
   std::vector<Eigen::Vector3d> robot_positions_;
   sensors::RayCaster caster_;
   bridge::RejectLog reject_log_;

@@ -5,9 +5,11 @@
 
 #include "sandbox_msgs/actor_placements_t.hpp"
 #include "sandbox_msgs/bone_values_t.hpp"
-#include "sandbox_msgs/joint_values_t.hpp"
 #include "sandbox_msgs/camera_command_t.hpp"
+#include "sandbox_msgs/gnss_t.hpp"
 #include "sandbox_msgs/ground_map_t.hpp"
+#include "sandbox_msgs/imu_t.hpp"
+#include "sandbox_msgs/joint_values_t.hpp"
 #include "sandbox_msgs/lidar_scan_t.hpp"
 #include "sandbox_msgs/range_t.hpp"
 #include "sandbox_msgs/robot_pose_t.hpp"
@@ -137,6 +139,26 @@ void Layout(const ground_map_t*, WireReader& r) {
   r.Array(r.Count("num_normal"), 4, "normal");
 }
 
+void Layout(const gnss_t*, WireReader& r) {
+  r.Fixed(8 * 4, "the header");
+  r.Strings(1, "sensor");
+  const std::int64_t fixes = r.Count("num_fixes");
+  r.Array(fixes, 8, "fix_utime");
+  r.Array(fixes, 8, "latitude_deg");
+  r.Array(fixes, 8, "longitude_deg");
+  r.Array(fixes, 8, "height_m");
+  r.Array(r.Count("num_ned"), 8, "velocity_ned");
+}
+
+void Layout(const imu_t*, WireReader& r) {
+  r.Fixed(8 * 4, "the header");
+  r.Strings(1, "sensor");
+  r.Array(r.Count("num_samples"), 8, "sample_utime");
+  const std::int64_t xyz = r.Count("num_xyz");
+  r.Array(xyz, 8, "specific_force");
+  r.Array(xyz, 8, "angular_rate");
+}
+
 void Layout(const lidar_scan_t*, WireReader& r) {
   r.Fixed(8 * 4 + 4, "the header");
   const std::int64_t steps = r.Count("steps");
@@ -239,7 +261,9 @@ std::string DecodeChecked(const std::uint8_t* data, std::size_t size, Message* m
 SANDBOX_CHECKED_DECODE(actor_placements_t)
 SANDBOX_CHECKED_DECODE(bone_values_t)
 SANDBOX_CHECKED_DECODE(camera_command_t)
+SANDBOX_CHECKED_DECODE(gnss_t)
 SANDBOX_CHECKED_DECODE(ground_map_t)
+SANDBOX_CHECKED_DECODE(imu_t)
 SANDBOX_CHECKED_DECODE(joint_values_t)
 SANDBOX_CHECKED_DECODE(lidar_scan_t)
 SANDBOX_CHECKED_DECODE(range_t)

@@ -4,7 +4,9 @@
 #include <variant>
 
 #include "bridge/face_points.h"
+#include "sandbox_msgs/gnss_t.hpp"
 #include "sandbox_msgs/ground_map_t.hpp"
+#include "sandbox_msgs/imu_t.hpp"
 #include "sandbox_msgs/lidar_scan_t.hpp"
 #include "sandbox_msgs/range_t.hpp"
 #include "sandbox_msgs/robot_state_t.hpp"
@@ -197,6 +199,52 @@ void PublishOutput(const sensors::RangeReading& reading, const Header& header, S
   message.hit = reading.hit ? 1 : 0;
   message.range_m = reading.range_m;
   message.surface = reading.surface;
+  send(message);
+}
+
+// Several IMUs may share a channel: the message names its sensor. Nothing
+// when no sample was due (no new pose).
+template <typename Send>
+void PublishOutput(const sensors::ImuSamples& samples, const Header& header, Send&& send) {
+  if (samples.utime.empty()) return;
+  sandbox_msgs::imu_t message{};
+  header.Stamp(&message);
+  message.sensor = header.sensor;
+  const std::size_t n = samples.utime.size();
+  message.num_samples = int(n);
+  message.sample_utime = samples.utime;
+  message.num_xyz = int(3 * n);
+  message.specific_force.resize(3 * n);
+  message.angular_rate.resize(3 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      message.specific_force[3 * i + std::size_t(k)] = samples.specific_force_S[i][k];
+      message.angular_rate[3 * i + std::size_t(k)] = samples.angular_rate_S[i][k];
+    }
+  }
+  send(message);
+}
+
+// Several receivers may share a channel: the message names its sensor.
+// Nothing when no fix was released.
+template <typename Send>
+void PublishOutput(const sensors::GnssFixes& released, const Header& header, Send&& send) {
+  if (released.fixes.empty()) return;
+  sandbox_msgs::gnss_t message{};
+  header.Stamp(&message);
+  message.sensor = header.sensor;
+  const std::size_t n = released.fixes.size();
+  message.num_fixes = int(n);
+  message.num_ned = int(3 * n);
+  message.velocity_ned.resize(3 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const sensors::GnssFix& fix = released.fixes[i];
+    message.fix_utime.push_back(fix.utime);
+    message.latitude_deg.push_back(fix.latitude_deg);
+    message.longitude_deg.push_back(fix.longitude_deg);
+    message.height_m.push_back(fix.height_m);
+    for (int k = 0; k < 3; ++k) message.velocity_ned[3 * i + std::size_t(k)] = fix.velocity_ned[k];
+  }
   send(message);
 }
 

@@ -154,7 +154,28 @@ std::vector<RobotBridgeConfig> RobotBridgeConfigs(const scene::Level& level) {
     configs.push_back(std::move(config));
   }
   CheckOutputChannels(level);
+  if (!WorldAnchor(level, configs)) {
+    for (const scene::RobotModel& model : level.robots) {
+      for (const scene::SensorSpec& spec : model.sensors) {
+        if (sensors::ParseSensorKind(spec) != sensors::SensorKind::kGnss) continue;
+        throw scene::LevelError(spec.settings.Where("type") +
+                                "a gnss sensor needs the world's geodetic anchor: give the level "
+                                "a [[terrain]] (its anchor) or a robot a geodetic_origin");
+      }
+    }
+  }
   return configs;
+}
+
+std::optional<scene::GeodeticPoint> WorldAnchor(const scene::Level& level,
+                                                const std::vector<RobotBridgeConfig>& configs) {
+  if (level.terrain) return level.terrain->anchor;
+  for (const RobotBridgeConfig& config : configs) {
+    if (!config.geodetic_origin_given) continue;
+    const GeodeticOrigin& origin = config.pose.origin;
+    return scene::GeodeticPoint{origin.latitude_deg, origin.longitude_deg, origin.altitude_m};
+  }
+  return std::nullopt;
 }
 
 }  // namespace sandbox::bridge

@@ -18,10 +18,13 @@
 //   udp_doubles_big_endian = false
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "bridge/translation.h"
+#include "scene/geodetic.h"
+#include "scene/level.h"
 #include "scene/robot_model.h"
 
 namespace sandbox::bridge {
@@ -52,6 +55,12 @@ struct RobotBridgeConfig {
 // them: each robot's own, no two robots on one channel prefix, no UDP port
 // taken twice, no two sensors of a robot on one channel
 // (CheckOutputChannels). Throws scene::LevelError naming both sides.
+// A gnss sensor on a level without a geodetic anchor is refused here too.
 std::vector<RobotBridgeConfig> RobotBridgeConfigs(const scene::Level& level);
+
+// The world's geodetic anchor (the world origin's WGS84 point): the
+// [[terrain]]'s, else the first robot's geodetic_origin; none without either.
+std::optional<scene::GeodeticPoint> WorldAnchor(const scene::Level& level,
+                                                const std::vector<RobotBridgeConfig>& configs);
 
 }  // namespace sandbox::bridge

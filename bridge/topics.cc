@@ -10,7 +10,9 @@
 #include "sandbox_msgs/actor_placements_t.hpp"
 #include "sandbox_msgs/bone_values_t.hpp"
 #include "sandbox_msgs/camera_command_t.hpp"
+#include "sandbox_msgs/gnss_t.hpp"
 #include "sandbox_msgs/ground_map_t.hpp"
+#include "sandbox_msgs/imu_t.hpp"
 #include "sandbox_msgs/lidar_scan_t.hpp"
 #include "sandbox_msgs/range_t.hpp"
 #include "sandbox_msgs/robot_pose_t.hpp"
@@ -37,6 +39,8 @@ std::string TypeOf(const std::uint8_t* data, std::uint32_t size) {
       {scan_face_t::getHash(), "scan_face_t"},
       {scan_face_compact_t::getHash(), "scan_face_compact_t"},
       {ground_map_t::getHash(), "ground_map_t"},
+      {imu_t::getHash(), "imu_t"},
+      {gnss_t::getHash(), "gnss_t"},
       {lidar_scan_t::getHash(), "lidar_scan_t"},
       {range_t::getHash(), "range_t"},
       {robot_state_t::getHash(), "robot_state_t"},

@@ -5,6 +5,8 @@
 // one-thread caster of its own), poses and renders wait for them.
 // docs/reference/python.md.
 
+#include "python/world.h"
+
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -28,7 +30,6 @@
 #include "app/loaded_level.h"
 #include "python/arguments.h"
 #include "python/results.h"
-#include "python/world.h"
 #include "scene/collision_world.h"
 #include "scene/robot_state.h"
 #include "scene/terrain_streamer.h"
@@ -301,6 +302,11 @@ class World {
     if (found.size() > 1) {
       throw py::value_error("sensor '" + sensor + "' is on several robots: give robot");
     }
+    if (found.front()->kind == sensors::SensorKind::kImu) {
+      throw py::value_error("sensor '" + sensor +
+                            "' is an imu: it measures the robot's motion, not the world; "
+                            "read it from Lockstep.step()'s outputs");
+    }
     sensors::MountedSensor full = *found.front();
     std::visit(
         [](auto& config) {
@@ -308,7 +314,11 @@ class World {
           if constexpr (std::is_same_v<Config, sensors::FaceScannerConfig>) {
             config.refresh = sensors::Refresh::kFull;
           }
-          if constexpr (!std::is_same_v<Config, sensors::RangeSensorConfig>) config.normals = true;
+          if constexpr (std::is_same_v<Config, sensors::FaceScannerConfig> ||
+                        std::is_same_v<Config, sensors::GroundScannerConfig> ||
+                        std::is_same_v<Config, sensors::LidarConfig>) {
+            config.normals = true;
+          }
         },
         full.config);
     Eigen::Isometry3d X_WS, X_WR;
@@ -428,7 +438,8 @@ class World {
 
   int MovableActor(const std::string& name) const {
     const int a = loaded_.level.FindActor(name);
-    if (a < 0 || !loaded_.level.actors[std::size_t(a)].movable) Unknown("movable actor", name, Actors());
+    if (a < 0 || !loaded_.level.actors[std::size_t(a)].movable)
+      Unknown("movable actor", name, Actors());
     return a;
   }
 
@@ -599,7 +610,6 @@ void BindWorld(py::module_& module) {
            py::arg("orientation") = std::vector<double>{1, 0, 0, 0},
            "Places a movable actor: position m, orientation (w, x, y, z), world.")
       .def("actor_pose", &World::ActorPose, py::arg("actor"), "((x, y, z), (w, x, y, z))");
-
 }
 
 }  // namespace sandbox::python

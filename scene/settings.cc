@@ -98,7 +98,10 @@ void ReportKeys(const std::string& table, const std::set<std::string>& keys) {
 void SettingsReader::RejectUnknownKeys(const std::string& kind) const {
   ReportKeys(kind, read_);
   for (const auto& [key, value] : table_.values) {
-    if (read_.count(key) == 0) Fail(key, "unknown key '" + key + "' for a " + kind);
+    if (read_.count(key) == 0) {
+      const bool vowel = !kind.empty() && std::string("aeiou").find(kind[0]) != std::string::npos;
+      Fail(key, "unknown key '" + key + "' for " + (vowel ? "an " : "a ") + kind);
+    }
   }
 }
 

@@ -57,6 +57,12 @@ struct HistoryOf<Class, std::void_t<decltype(std::declval<const Class&>().histor
   static double Of(const Class& sensor) { return sensor.history_s(); }
 };
 
+// A config with rate_hz samples on its own clock.
+template <typename Config, typename = void>
+struct OwnRate : std::false_type {};
+template <typename Config>
+struct OwnRate<Config, std::void_t<decltype(Config::rate_hz)>> : std::true_type {};
+
 }  // namespace
 
 const SensorKindInfo& Info(SensorKind kind) { return kSensorKinds[std::size_t(kind)]; }
@@ -84,6 +90,11 @@ std::string MountedSensor::Describe() const {
   return out.str();
 }
 
+bool MountedSensor::RunsEveryTick() const {
+  return std::visit([](const auto& c) { return OwnRate<std::decay_t<decltype(c)>>::value; },
+                    config);
+}
+
 std::vector<MountedSensor> MakeRobotSensors(const scene::Level& level) {
   std::vector<MountedSensor> sensors;
   for (std::size_t r = 0; r < level.robots.size(); ++r) {
@@ -95,6 +106,11 @@ std::vector<MountedSensor> MakeRobotSensors(const scene::Level& level) {
       sensor.channel = OutputChannel(spec);
       scene::SettingsReader read(spec.settings);
       sensor.config = ReadConfig(sensor.kind, read, kAlternatives);
+      std::visit(
+          [&](auto& c) {
+            if constexpr (OwnRate<std::decay_t<decltype(c)>>::value) c.rate_hz = spec.rate_hz;
+          },
+          sensor.config);
       read.RejectUnknownKeys(spec.type + " sensor");
       // The config's own checks, named with the sensor, at the line of the
       // key the message begins with (else the table's).
@@ -119,7 +135,7 @@ Sensor::Sensor(const MountedSensor& mounted)
 
 const SensorOutput& Sensor::Run(const SensorContext& at) {
   std::visit(
-      [&](const auto& sensor) {
+      [&](auto& sensor) {
         using Output = typename std::decay_t<decltype(sensor)>::Output;
         sensor.Run(at, &std::get<Output>(output_));
       },

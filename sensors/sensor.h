@@ -21,7 +21,9 @@
 #include "scene/robot_model.h"
 #include "scene/robot_state.h"
 #include "sensors/face_scanner.h"
+#include "sensors/gnss.h"
 #include "sensors/ground_scanner.h"
+#include "sensors/imu.h"
 #include "sensors/lidar.h"
 #include "sensors/range_sensor.h"
 #include "sensors/sensor_context.h"
@@ -29,19 +31,21 @@
 namespace sandbox::sensors {
 
 // The kinds, in the order of SensorClasses.
-enum class SensorKind { kFace, kGround, kLidar, kRange };
+enum class SensorKind { kFace, kGround, kLidar, kRange, kImu, kGnss };
 
 // One class a kind. Each has `kType` (its manifest name), `Config` (with
 // static Read, Summary and ValidateOrThrow), `Output` (a type of its own) and
-// `void Run(const SensorContext&, Output*) const`; `double history_s() const`
-// when it needs its robot's earlier poses.
+// `void Run(const SensorContext&, Output*)` (const, or not for a kind that
+// keeps state between runs); `double history_s() const` when it needs its
+// robot's earlier poses. A Config with a `rate_hz` member samples on its own
+// clock: it is given the table's rate_hz and run every tick.
 template <typename... Classes>
 struct SensorClassList {
   using Any = std::variant<Classes...>;
   using Config = std::variant<typename Classes::Config...>;
   using Output = std::variant<typename Classes::Output...>;
 };
-using SensorClasses = SensorClassList<FaceScanner, GroundScanner, Lidar, RangeSensor>;
+using SensorClasses = SensorClassList<FaceScanner, GroundScanner, Lidar, RangeSensor, Imu, Gnss>;
 
 // How the manifest names each kind and where it publishes.
 struct SensorKindInfo {
@@ -50,11 +54,13 @@ struct SensorKindInfo {
   std::string_view channel;  // after "<ROBOT>/", unless the table sets `channel`
   bool shares_channel;       // several on one robot may share it (messages name the sensor)
 };
-inline constexpr std::array<SensorKindInfo, 4> kSensorKinds{{
+inline constexpr std::array<SensorKindInfo, 6> kSensorKinds{{
     {SensorKind::kFace, FaceScanner::kType, "SCAN_FACE", false},
     {SensorKind::kGround, GroundScanner::kType, "GROUND", false},
     {SensorKind::kLidar, Lidar::kType, "LIDAR", false},
     {SensorKind::kRange, RangeSensor::kType, "RANGE", true},
+    {SensorKind::kImu, Imu::kType, "IMU", true},
+    {SensorKind::kGnss, Gnss::kType, "GNSS", true},
 }};
 
 using SensorConfig = SensorClasses::Config;
@@ -78,6 +84,8 @@ struct MountedSensor {
   Eigen::Isometry3d Pose(const scene::RobotState& state) const { return state.MountPose(spec); }
   // "face 51x51x6 at 1 m on body at 10 Hz"
   std::string Describe() const;
+  // Run every tick whatever its rate (it samples on its own clock).
+  bool RunsEveryTick() const;
 };
 
 // Every robot's sensors. Throws scene::LevelError naming the manifest, the line,

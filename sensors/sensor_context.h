@@ -1,12 +1,14 @@
 #pragma once
 // What one run of a sensor is given (Sensor::Run in sensors/sensor.h): the
 // world and the caster, where the sensor and its robot are now, the robot's
-// recent poses, and the loop's time and tick.
+// recent poses, the loop's time and tick, the newest pose's own time stamp,
+// and the level's geodetic frame.
 
 #include <Eigen/Geometry>
 #include <cstdint>
 
 #include "scene/collision_world.h"
+#include "scene/geodetic.h"
 #include "sensors/pose_history.h"
 #include "sensors/ray_caster.h"
 
@@ -21,6 +23,8 @@ struct SensorContext {
   const PoseHistory* history;  // its robot's recent poses; null: none kept
   double t_s{0.0};             // loop time
   std::int64_t tick{0};
+  std::int64_t pose_utime{-1};  // its robot's newest pose's time stamp; -1: none yet
+  const scene::LocalTangentPlane* geodetic{nullptr};  // the level's anchor; null: none
 };
 
 }  // namespace sandbox::sensors

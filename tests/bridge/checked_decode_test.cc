@@ -16,7 +16,9 @@
 #include "sandbox_msgs/actor_placements_t.hpp"
 #include "sandbox_msgs/bone_values_t.hpp"
 #include "sandbox_msgs/camera_command_t.hpp"
+#include "sandbox_msgs/gnss_t.hpp"
 #include "sandbox_msgs/ground_map_t.hpp"
+#include "sandbox_msgs/imu_t.hpp"
 #include "sandbox_msgs/lidar_scan_t.hpp"
 #include "sandbox_msgs/range_t.hpp"
 #include "sandbox_msgs/robot_pose_t.hpp"
@@ -83,6 +85,23 @@ struct Samples {
     ground.n = 3, ground.num_points = 9, ground.height.assign(9, 1.0f);
     ground.num_surface = 9, ground.surface.assign(9, 4);
     Add("ground_map_t", ground);
+    for (int n : {0, 1, 4}) {
+      imu_t imu{};
+      imu.sensor = "imu";
+      imu.num_samples = n, imu.sample_utime.assign(std::size_t(n), 1000);
+      imu.num_xyz = 3 * n;
+      imu.specific_force.assign(std::size_t(3 * n), 9.8);
+      imu.angular_rate.assign(std::size_t(3 * n), 0.1);
+      Add("imu_t", imu);
+      gnss_t gnss{};
+      gnss.sensor = "gps";
+      gnss.num_fixes = n, gnss.fix_utime.assign(std::size_t(n), 2000);
+      gnss.latitude_deg.assign(std::size_t(n), 47.0);
+      gnss.longitude_deg.assign(std::size_t(n), 8.0);
+      gnss.height_m.assign(std::size_t(n), 500.0);
+      gnss.num_ned = 3 * n, gnss.velocity_ned.assign(std::size_t(3 * n), 1.5);
+      Add("gnss_t", gnss);
+    }
     lidar_scan_t lidar{};
     lidar.channels = 2, lidar.steps = 3, lidar.num_beams = 6;
     lidar.range_m.assign(6, 10.0f), lidar.hit.assign(6, 1);
@@ -158,6 +177,8 @@ Decoded Decode(const std::string& type, const std::uint8_t* data, std::size_t si
       {"actor_placements_t", DecodeAs<actor_placements_t>},
       {"camera_command_t", DecodeAs<camera_command_t>},
       {"ground_map_t", DecodeAs<ground_map_t>},
+      {"imu_t", DecodeAs<imu_t>},
+      {"gnss_t", DecodeAs<gnss_t>},
       {"lidar_scan_t", DecodeAs<lidar_scan_t>},
       {"range_t", DecodeAs<range_t>},
       {"robot_state_t", DecodeAs<robot_state_t>},

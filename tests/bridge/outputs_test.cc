@@ -14,7 +14,10 @@
 #include "bridge/checked_decode.h"
 #include "bridge/face_points.h"
 #include "bridge/lcm_link.h"
+#include "bridge/robot_bridge_config.h"
+#include "sandbox_msgs/gnss_t.hpp"
 #include "sandbox_msgs/ground_map_t.hpp"
+#include "sandbox_msgs/imu_t.hpp"
 #include "sandbox_msgs/lidar_scan_t.hpp"
 #include "sandbox_msgs/range_t.hpp"
 #include "sandbox_msgs/robot_state_t.hpp"
@@ -196,6 +199,69 @@ TEST(RobotOutputsTest, EachChannelCountsItsOwnMessages) {
   }
   EXPECT_EQ(range_seqs, (std::vector<std::int64_t>{1, 3, 5}));  // the newest of each two
   EXPECT_EQ(state_seqs, (std::vector<std::int64_t>{0, 1, 2}));
+}
+
+// The instruments: a message a run that brought samples (none for a run
+// without), every sample in it, the sensor named.
+TEST(RobotOutputsTest, InstrumentsPublishTheirSamplesBatched) {
+  LcmLink link("memq://");
+  LatestInput imu_in(link, "W/IMU"), gnss_in(link, "W/GNSS");
+  RobotOutputs outputs(link, "W");
+  sensors::ImuSamples samples;
+  outputs.Publish(samples, {"imu1", "IMU"}, 0, InputTag{3, 30}, 40);
+  samples.utime = {10, 20};
+  samples.specific_force_S = {Eigen::Vector3d(1, 2, 3), Eigen::Vector3d(4, 5, 6)};
+  samples.angular_rate_S = {Eigen::Vector3d(0.1, 0.2, 0.3), Eigen::Vector3d(0.4, 0.5, 0.6)};
+  outputs.Publish(samples, {"imu1", "IMU"}, 1, InputTag{4, 40}, 50);
+  sensors::GnssFixes fixes;
+  fixes.fixes.push_back({7, 47.5, 8.25, 612.5, Eigen::Vector3d(1.0, -2.0, 0.5)});
+  outputs.Publish(fixes, {"gps", "GNSS"}, 1, InputTag{4, 40}, 50);
+  link.Drain();
+  sandbox_msgs::imu_t imu;
+  const std::vector<std::uint8_t>* bytes = imu_in.TakeNewest();
+  ASSERT_NE(bytes, nullptr);
+  ASSERT_EQ(DecodeChecked(bytes->data(), bytes->size(), &imu), "");
+  EXPECT_EQ(imu_in.received(), 1);  // the empty run sent nothing
+  EXPECT_EQ(imu.sensor, "imu1");
+  EXPECT_EQ(imu.input_utime, 40);
+  EXPECT_EQ(imu.sample_utime, (std::vector<std::int64_t>{10, 20}));
+  EXPECT_EQ(imu.specific_force, (std::vector<double>{1, 2, 3, 4, 5, 6}));
+  EXPECT_EQ(imu.angular_rate, (std::vector<double>{0.1, 0.2, 0.3, 0.4, 0.5, 0.6}));
+  sandbox_msgs::gnss_t gnss;
+  bytes = gnss_in.TakeNewest();
+  ASSERT_NE(bytes, nullptr);
+  ASSERT_EQ(DecodeChecked(bytes->data(), bytes->size(), &gnss), "");
+  EXPECT_EQ(gnss.sensor, "gps");
+  EXPECT_EQ(gnss.fix_utime, (std::vector<std::int64_t>{7}));
+  EXPECT_EQ(gnss.latitude_deg[0], 47.5);
+  EXPECT_EQ(gnss.longitude_deg[0], 8.25);
+  EXPECT_EQ(gnss.height_m[0], 612.5);
+  EXPECT_EQ(gnss.velocity_ned, (std::vector<double>{1.0, -2.0, 0.5}));
+}
+
+// A GNSS receiver needs the world's geodetic anchor: refused at load without
+// one, naming the line of its type; a robot's geodetic_origin gives one.
+TEST(RobotOutputsTest, AGnssWithoutAGeodeticAnchorIsRefusedAtLoad) {
+  testing::TempDir dir;
+  const std::string gnss = "[[robot.sensor]]\nname = \"gps\"\ntype = \"gnss\"\n";
+  try {
+    RobotBridgeConfigs(WingWith(dir, gnss));
+    ADD_FAILURE() << "a gnss sensor without an anchor was accepted";
+  } catch (const scene::LevelError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("level.toml:7: sensor 'gps': a gnss sensor needs the world's geodetic "
+                           "anchor: give the level a [[terrain]] (its anchor) or a robot a "
+                           "geodetic_origin"),
+              std::string::npos)
+        << message;
+  }
+  const scene::Level level =
+      WingWith(dir, gnss + "[robot.bridge]\ngeodetic_origin = [47.0, 8.0, 500.0]\n");
+  const std::vector<RobotBridgeConfig> configs = RobotBridgeConfigs(level);
+  const auto anchor = WorldAnchor(level, configs);
+  ASSERT_TRUE(anchor.has_value());
+  EXPECT_EQ(anchor->latitude_deg, 47.0);
+  EXPECT_EQ(anchor->height_m, 500.0);
 }
 
 TEST(RobotOutputsTest, TwoSensorsOfATypeNeedTheirOwnChannels) {

@@ -15,7 +15,9 @@
 #include "sandbox_msgs/actor_placements_t.hpp"
 #include "sandbox_msgs/bone_values_t.hpp"
 #include "sandbox_msgs/camera_command_t.hpp"
+#include "sandbox_msgs/gnss_t.hpp"
 #include "sandbox_msgs/ground_map_t.hpp"
+#include "sandbox_msgs/imu_t.hpp"
 #include "sandbox_msgs/lidar_scan_t.hpp"
 #include "sandbox_msgs/range_t.hpp"
 #include "sandbox_msgs/robot_pose_t.hpp"
@@ -66,6 +68,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   DecodeExactly<actor_placements_t>(data, size);
   DecodeExactly<camera_command_t>(data, size);
   DecodeExactly<ground_map_t>(data, size);
+  DecodeExactly<imu_t>(data, size);
+  DecodeExactly<gnss_t>(data, size);
   DecodeExactly<lidar_scan_t>(data, size);
   DecodeExactly<range_t>(data, size);
   DecodeExactly<robot_state_t>(data, size);

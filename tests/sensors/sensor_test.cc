@@ -217,7 +217,16 @@ TEST(SensorTest, MistakesNameTheSensorAndField) {
   EXPECT_EQ(Error("type = \"face\"\nrefresh = 6\n"),
             "level.toml:9: sensor 's': 'refresh' must be a string");
   EXPECT_EQ(Error("type = \"sonar\"\n"),
-            "level.toml:8: sensor 's': 'type' must be face, ground, lidar or ray, got 'sonar'");
+            "level.toml:8: sensor 's': 'type' must be face, ground, lidar, ray, imu or gnss, got "
+            "'sonar'");
+  EXPECT_EQ(Error("type = \"imu\"\naccel_noise_density = -0.1\n"),
+            "level.toml:9: sensor 's': accel_noise_density must be zero or positive, got -0.1");
+  EXPECT_EQ(Error("type = \"imu\"\ngyro_saturation = nan\n"),
+            "level.toml:9: sensor 's': 'gyro_saturation' must be finite, got nan");
+  EXPECT_EQ(Error("type = \"imu\"\nseed = -3\n"),
+            "level.toml:9: sensor 's': 'seed' must be zero or positive");
+  EXPECT_EQ(Error("type = \"imu\"\nrange_m = 3\n"),
+            "level.toml:9: sensor 's': unknown key 'range_m' for an imu sensor");
   EXPECT_EQ(Error("type = \"lidar\"\nchannels = 0\n"),
             "level.toml:9: sensor 's': 'channels' must be at least 1");
   // A removed key names what replaced it.
