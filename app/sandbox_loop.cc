@@ -385,7 +385,7 @@ void SandboxLoop::RunDueSensors(double t, std::int64_t now_utime) {
     filter.ignore_robot = mounted.robot;
     sensor.Run({world_, caster, filter, mounted.Pose(*robot.state), robot.state->pose(),
                 &robot.history, t, tick_, robot.feed->input().utime,
-                geodetic_ ? &*geodetic_ : nullptr});
+                geodetic_ ? &*geodetic_ : nullptr, level_.wind ? &*level_.wind : nullptr});
   };
   if (caster_.threads() > 1 && int(due_.size()) > caster_.threads()) {
     // More sensors than threads: whole sensors over the caster's threads, each casting

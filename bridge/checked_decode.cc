@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "sandbox_msgs/actor_placements_t.hpp"
+#include "sandbox_msgs/air_data_t.hpp"
 #include "sandbox_msgs/bone_values_t.hpp"
 #include "sandbox_msgs/camera_command_t.hpp"
 #include "sandbox_msgs/gnss_t.hpp"
@@ -139,6 +140,18 @@ void Layout(const ground_map_t*, WireReader& r) {
   r.Array(r.Count("num_normal"), 4, "normal");
 }
 
+void Layout(const air_data_t*, WireReader& r) {
+  r.Fixed(8 * 4, "the header");
+  r.Strings(1, "sensor");
+  const std::int64_t n = r.Count("num_samples");
+  for (const char* field :
+       {"sample_utime", "static_pressure_pa", "temperature_k", "density_kg_m3",
+        "pressure_altitude_m", "impact_pressure_pa", "true_airspeed_m_s", "indicated_airspeed_m_s",
+        "mach", "angle_of_attack_rad", "sideslip_rad"}) {
+    r.Array(n, 8, field);
+  }
+}
+
 void Layout(const gnss_t*, WireReader& r) {
   r.Fixed(8 * 4, "the header");
   r.Strings(1, "sensor");
@@ -259,6 +272,7 @@ std::string DecodeChecked(const std::uint8_t* data, std::size_t size, Message* m
   template std::string DecodeChecked<Type>(const std::uint8_t*, std::size_t, Type*);
 
 SANDBOX_CHECKED_DECODE(actor_placements_t)
+SANDBOX_CHECKED_DECODE(air_data_t)
 SANDBOX_CHECKED_DECODE(bone_values_t)
 SANDBOX_CHECKED_DECODE(camera_command_t)
 SANDBOX_CHECKED_DECODE(gnss_t)

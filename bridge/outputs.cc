@@ -4,6 +4,7 @@
 #include <variant>
 
 #include "bridge/face_points.h"
+#include "sandbox_msgs/air_data_t.hpp"
 #include "sandbox_msgs/gnss_t.hpp"
 #include "sandbox_msgs/ground_map_t.hpp"
 #include "sandbox_msgs/imu_t.hpp"
@@ -244,6 +245,31 @@ void PublishOutput(const sensors::GnssFixes& released, const Header& header, Sen
     message.longitude_deg.push_back(fix.longitude_deg);
     message.height_m.push_back(fix.height_m);
     for (int k = 0; k < 3; ++k) message.velocity_ned[3 * i + std::size_t(k)] = fix.velocity_ned[k];
+  }
+  send(message);
+}
+
+// Several air data computers may share a channel: the message names its
+// sensor. Nothing when no sample was due.
+template <typename Send>
+void PublishOutput(const sensors::AirDataSamples& taken, const Header& header, Send&& send) {
+  if (taken.samples.empty()) return;
+  sandbox_msgs::air_data_t message{};
+  header.Stamp(&message);
+  message.sensor = header.sensor;
+  message.num_samples = int(taken.samples.size());
+  for (const sensors::AirDataSample& s : taken.samples) {
+    message.sample_utime.push_back(s.utime);
+    message.static_pressure_pa.push_back(s.static_pressure_pa);
+    message.temperature_k.push_back(s.temperature_k);
+    message.density_kg_m3.push_back(s.density_kg_m3);
+    message.pressure_altitude_m.push_back(s.pressure_altitude_m);
+    message.impact_pressure_pa.push_back(s.impact_pressure_pa);
+    message.true_airspeed_m_s.push_back(s.true_airspeed_m_s);
+    message.indicated_airspeed_m_s.push_back(s.indicated_airspeed_m_s);
+    message.mach.push_back(s.mach);
+    message.angle_of_attack_rad.push_back(s.angle_of_attack_rad);
+    message.sideslip_rad.push_back(s.sideslip_rad);
   }
   send(message);
 }

@@ -8,6 +8,7 @@
 
 #include "bridge/lcm_link_impl.h"
 #include "sandbox_msgs/actor_placements_t.hpp"
+#include "sandbox_msgs/air_data_t.hpp"
 #include "sandbox_msgs/bone_values_t.hpp"
 #include "sandbox_msgs/camera_command_t.hpp"
 #include "sandbox_msgs/gnss_t.hpp"
@@ -41,6 +42,7 @@ std::string TypeOf(const std::uint8_t* data, std::uint32_t size) {
       {ground_map_t::getHash(), "ground_map_t"},
       {imu_t::getHash(), "imu_t"},
       {gnss_t::getHash(), "gnss_t"},
+      {air_data_t::getHash(), "air_data_t"},
       {lidar_scan_t::getHash(), "lidar_scan_t"},
       {range_t::getHash(), "range_t"},
       {robot_state_t::getHash(), "robot_state_t"},

@@ -23,6 +23,7 @@
 #include "bridge/checked_decode.h"
 #include "python/lcm_access.h"
 #include "sandbox_msgs/actor_placements_t.hpp"
+#include "sandbox_msgs/air_data_t.hpp"
 #include "sandbox_msgs/bone_values_t.hpp"
 #include "sandbox_msgs/camera_command_t.hpp"
 #include "sandbox_msgs/gnss_t.hpp"

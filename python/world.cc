@@ -302,9 +302,9 @@ class World {
     if (found.size() > 1) {
       throw py::value_error("sensor '" + sensor + "' is on several robots: give robot");
     }
-    if (found.front()->kind == sensors::SensorKind::kImu) {
-      throw py::value_error("sensor '" + sensor +
-                            "' is an imu: it measures the robot's motion, not the world; "
+    if (found.front()->RunsEveryTick()) {  // an instrument
+      throw py::value_error("sensor '" + sensor + "' is a " + found.front()->spec.type +
+                            " instrument: it measures the robot's motion, not the world; "
                             "read it from Lockstep.step()'s outputs");
     }
     sensors::MountedSensor full = *found.front();

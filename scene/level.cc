@@ -201,6 +201,7 @@ Level LoadManifest(const fs::path& file, const LoadOptions& options) {
     level.horizon->rgb = manifest.horizon->rgb;
     level.horizon->visibility_m = manifest.horizon->visibility_m;
   }
+  level.wind = manifest.wind;
   for (const RobotSpec& spec : manifest.robots) {
     level.robots.push_back(LoadRobotModel(spec, file, &level, options.on_file));
     CheckTriangles(spec.file, level);

@@ -20,6 +20,7 @@
 #include "scene/placement.h"
 #include "scene/robot_model.h"
 #include "scene/terrain_tile.h"
+#include "scene/wind.h"
 
 namespace sandbox::scene {
 
@@ -63,6 +64,7 @@ struct Level {
   std::optional<TerrainSpec> terrain;  // elevation rasters streamed in tiles ([[terrain]])
   int terrain_actor{-1};               // the actor terrain tiles belong to (no meshes of its own)
   std::optional<Horizon> horizon;
+  std::optional<WindSpec> wind;  // [wind]; none: still air
   std::vector<std::string> warnings;  // problems that were handled, e.g. dropped faces
   LoadLimits limits;                  // what it was loaded within (textures are decoded later)
 

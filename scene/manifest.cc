@@ -356,8 +356,9 @@ RobotSpec ParseRobot(const fs::path& file, const toml::table& table, int index) 
     read.Fail(nullptr, "'file' (a model) or 'description' (URDF, SDF) is required");
   robot.file = AssetPath(file, model ? *model : *description);
   if (description && !IsRobotDescription(robot.file)) {
-    read.Fail(read.Find("description"),
-              "'description' must be a robot description (.urdf, .sdf), got '" + *description + "'");
+    read.Fail(
+        read.Find("description"),
+        "'description' must be a robot description (.urdf, .sdf), got '" + *description + "'");
   }
   robot.placement = ParsePlacement(read);
   robot.collision = read.Flag("collision").value_or(true);
@@ -640,6 +641,38 @@ LevelManifest ParseManifestText(std::string_view text, const fs::path& file) {
     }
     read.RejectUnknownKeys("[horizon]");
     manifest.horizon = spec;
+  }
+  if (const toml::node* wind = top.Find("wind")) {
+    if (!wind->is_table()) top.Fail(wind, "'wind' must be a table: [wind]");
+    TableReader read(file, *wind->as_table(), "[wind]: ");
+    WindSpec spec;
+    if (const auto velocity = read.Numbers("velocity", 3)) spec.velocity = *velocity;
+    spec.shear_velocity = spec.velocity;
+    const auto shear = read.Numbers("shear_velocity", 3);
+    const auto bottom = read.Number("shear_bottom_m");
+    const auto top_m = read.Number("shear_top_m");
+    if (shear || bottom || top_m) {
+      if (!(shear && bottom && top_m)) {
+        read.Fail(nullptr, "a shear layer takes shear_velocity, shear_bottom_m and shear_top_m");
+      }
+      if (!(*top_m > *bottom)) {
+        read.Fail(read.Find("shear_top_m"), "'shear_top_m' must be above 'shear_bottom_m'");
+      }
+      spec.shear_velocity = *shear, spec.shear_bottom_m = *bottom, spec.shear_top_m = *top_m;
+    }
+    if (const auto sigma = read.Number("gust_sigma_m_s")) {
+      if (*sigma < 0.0)
+        read.Fail(read.Find("gust_sigma_m_s"), "'gust_sigma_m_s' must be zero or positive");
+      spec.gust_sigma_m_s = *sigma;
+    }
+    if (const auto length = read.Number("gust_length_m")) {
+      if (!(*length > 0.0))
+        read.Fail(read.Find("gust_length_m"), "'gust_length_m' must be positive");
+      spec.gust_length_m = *length;
+    }
+    if (const auto seed = read.Whole("seed", 0, std::int64_t(1) << 53)) spec.seed = *seed;
+    read.RejectUnknownKeys("[wind]");
+    manifest.wind = spec;
   }
   top.RejectUnknownKeys("(the file's top level)");
   if (manifest.actors.empty() && manifest.robots.empty() && !manifest.terrain) {

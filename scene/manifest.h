@@ -15,6 +15,7 @@
 #include "scene/robot_model.h"
 #include "scene/settings.h"
 #include "scene/terrain_tile.h"
+#include "scene/wind.h"
 
 namespace sandbox::scene {
 
@@ -50,6 +51,7 @@ struct LevelManifest {
   std::vector<RobotSpec> robots;
   std::optional<TerrainSpec> terrain;  // [[terrain]] (at most one)
   std::optional<HorizonSpec> horizon;  // [horizon]
+  std::optional<WindSpec> wind;        // [wind]
 };
 
 // The largest manifest read (a manifest is a few KB; this is no LoadLimits key).

@@ -20,6 +20,7 @@
 #include "scene/level.h"
 #include "scene/robot_model.h"
 #include "scene/robot_state.h"
+#include "sensors/air_data.h"
 #include "sensors/face_scanner.h"
 #include "sensors/gnss.h"
 #include "sensors/ground_scanner.h"
@@ -31,7 +32,7 @@
 namespace sandbox::sensors {
 
 // The kinds, in the order of SensorClasses.
-enum class SensorKind { kFace, kGround, kLidar, kRange, kImu, kGnss };
+enum class SensorKind { kFace, kGround, kLidar, kRange, kImu, kGnss, kAirData };
 
 // One class a kind. Each has `kType` (its manifest name), `Config` (with
 // static Read, Summary and ValidateOrThrow), `Output` (a type of its own) and
@@ -45,7 +46,8 @@ struct SensorClassList {
   using Config = std::variant<typename Classes::Config...>;
   using Output = std::variant<typename Classes::Output...>;
 };
-using SensorClasses = SensorClassList<FaceScanner, GroundScanner, Lidar, RangeSensor, Imu, Gnss>;
+using SensorClasses =
+    SensorClassList<FaceScanner, GroundScanner, Lidar, RangeSensor, Imu, Gnss, AirData>;
 
 // How the manifest names each kind and where it publishes.
 struct SensorKindInfo {
@@ -54,13 +56,14 @@ struct SensorKindInfo {
   std::string_view channel;  // after "<ROBOT>/", unless the table sets `channel`
   bool shares_channel;       // several on one robot may share it (messages name the sensor)
 };
-inline constexpr std::array<SensorKindInfo, 6> kSensorKinds{{
+inline constexpr std::array<SensorKindInfo, 7> kSensorKinds{{
     {SensorKind::kFace, FaceScanner::kType, "SCAN_FACE", false},
     {SensorKind::kGround, GroundScanner::kType, "GROUND", false},
     {SensorKind::kLidar, Lidar::kType, "LIDAR", false},
     {SensorKind::kRange, RangeSensor::kType, "RANGE", true},
     {SensorKind::kImu, Imu::kType, "IMU", true},
     {SensorKind::kGnss, Gnss::kType, "GNSS", true},
+    {SensorKind::kAirData, AirData::kType, "AIR_DATA", true},
 }};
 
 using SensorConfig = SensorClasses::Config;

@@ -2,13 +2,14 @@
 // What one run of a sensor is given (Sensor::Run in sensors/sensor.h): the
 // world and the caster, where the sensor and its robot are now, the robot's
 // recent poses, the loop's time and tick, the newest pose's own time stamp,
-// and the level's geodetic frame.
+// the level's geodetic frame and its wind.
 
 #include <Eigen/Geometry>
 #include <cstdint>
 
 #include "scene/collision_world.h"
 #include "scene/geodetic.h"
+#include "scene/wind.h"
 #include "sensors/pose_history.h"
 #include "sensors/ray_caster.h"
 
@@ -25,6 +26,7 @@ struct SensorContext {
   std::int64_t tick{0};
   std::int64_t pose_utime{-1};  // its robot's newest pose's time stamp; -1: none yet
   const scene::LocalTangentPlane* geodetic{nullptr};  // the level's anchor; null: none
+  const scene::WindSpec* wind{nullptr};               // the level's [wind]; null: still air
 };
 
 }  // namespace sandbox::sensors

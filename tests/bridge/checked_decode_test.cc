@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "sandbox_msgs/actor_placements_t.hpp"
+#include "sandbox_msgs/air_data_t.hpp"
 #include "sandbox_msgs/bone_values_t.hpp"
 #include "sandbox_msgs/camera_command_t.hpp"
 #include "sandbox_msgs/gnss_t.hpp"
@@ -101,6 +102,17 @@ struct Samples {
       gnss.height_m.assign(std::size_t(n), 500.0);
       gnss.num_ned = 3 * n, gnss.velocity_ned.assign(std::size_t(3 * n), 1.5);
       Add("gnss_t", gnss);
+      air_data_t air{};
+      air.sensor = "adc";
+      air.num_samples = n;
+      for (auto* field :
+           {&air.static_pressure_pa, &air.temperature_k, &air.density_kg_m3,
+            &air.pressure_altitude_m, &air.impact_pressure_pa, &air.true_airspeed_m_s,
+            &air.indicated_airspeed_m_s, &air.mach, &air.angle_of_attack_rad, &air.sideslip_rad}) {
+        field->assign(std::size_t(n), 1.25);
+      }
+      air.sample_utime.assign(std::size_t(n), 3000);
+      Add("air_data_t", air);
     }
     lidar_scan_t lidar{};
     lidar.channels = 2, lidar.steps = 3, lidar.num_beams = 6;
@@ -179,6 +191,7 @@ Decoded Decode(const std::string& type, const std::uint8_t* data, std::size_t si
       {"ground_map_t", DecodeAs<ground_map_t>},
       {"imu_t", DecodeAs<imu_t>},
       {"gnss_t", DecodeAs<gnss_t>},
+      {"air_data_t", DecodeAs<air_data_t>},
       {"lidar_scan_t", DecodeAs<lidar_scan_t>},
       {"range_t", DecodeAs<range_t>},
       {"robot_state_t", DecodeAs<robot_state_t>},

@@ -13,6 +13,7 @@
 #include "bridge/checked_decode.h"
 #include "bridge/robot_inputs.h"
 #include "sandbox_msgs/actor_placements_t.hpp"
+#include "sandbox_msgs/air_data_t.hpp"
 #include "sandbox_msgs/bone_values_t.hpp"
 #include "sandbox_msgs/camera_command_t.hpp"
 #include "sandbox_msgs/gnss_t.hpp"
@@ -70,6 +71,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   DecodeExactly<ground_map_t>(data, size);
   DecodeExactly<imu_t>(data, size);
   DecodeExactly<gnss_t>(data, size);
+  DecodeExactly<air_data_t>(data, size);
   DecodeExactly<lidar_scan_t>(data, size);
   DecodeExactly<range_t>(data, size);
   DecodeExactly<robot_state_t>(data, size);

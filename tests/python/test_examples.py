@@ -60,3 +60,31 @@ def test_fly_wing(tmp_path):
                            atol=1e-9)
     assert flight["occupied"] > 0
     assert (tmp_path / "face_down.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_autopilot_view(tmp_path):
+    """The instruments of a banked, climbing turn as the turn's own physics says:
+    load factor 1 / cos(bank), turn rate v / r, groundspeed v, climbing 2 m/s;
+    the wing tip's IMU feels the bending the body's does not."""
+    out = tmp_path / "instruments.json"
+    printed = subprocess.run([sys.executable, os.path.join(EXAMPLES, "autopilot_view.py"),
+                              "--seconds", "3", "--json", str(out)], check=True,
+                             capture_output=True, text=True).stdout
+    assert len(printed.splitlines()) == 1 + 6  # the header, a line every half second
+    import json
+    import math
+    data = json.loads(out.read_text())
+    speed, radius, g0 = 30.0, 300.0, 9.80665
+    bank = math.atan(speed * speed / radius / g0)
+    force = np.array(data["specific_force"]).reshape(-1, 3)[10:]
+    rate = np.array(data["angular_rate"]).reshape(-1, 3)[10:]
+    assert len(force) > 1000  # 400 Hz for 3 s
+    assert abs(np.linalg.norm(force, axis=1).mean() / g0 - 1 / math.cos(bank)) < 0.005
+    assert abs(np.linalg.norm(rate.mean(axis=0)) - speed / radius) < 0.002
+    ned = np.array(data["gps_velocity_ned"]).reshape(-1, 3)
+    assert np.all(np.abs(np.hypot(ned[:, 0], ned[:, 1]) - speed) < 0.3)
+    altitude = np.array(data["pressure_altitude"])
+    climb = np.polyfit(np.arange(len(altitude)) / 50.0, altitude, 1)[0]
+    assert abs(climb - 2.0) < 0.5
+    tip = np.array(data["tip_specific_force"]).reshape(-1, 3)[10:]
+    assert tip[:, 2].std() > 3 * force[:, 2].std()

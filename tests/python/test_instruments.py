@@ -85,3 +85,61 @@ def test_one_seed_gives_the_same_bytes(tmp_path):
     second, _ = fly(path, 60)
     assert sum(len(tick) for tick in first) == 2 * 59
     assert first == second
+
+
+def anchored_level(tmp_path):
+    """The wing with air data and a GNSS receiver, the world anchored at 47 N
+    8 E 500 m, a 5 m/s wind towards the east."""
+    wing = ASSETS / "robots/generated/flying_wing.gltf"
+    path = tmp_path / "anchored.toml"
+    path.write_text(f"""
+[[robot]]
+name = "W"
+file = "{wing}"
+bones = ["root"]
+
+[[robot.sensor]]
+name = "adc"
+type = "air_data"
+rate_hz = 1000
+
+[[robot.sensor]]
+name = "gps"
+type = "gnss"
+rate_hz = 10
+latency_s = 0.02
+
+[robot.bridge]
+geodetic_origin = [47.0, 8.0, 500.0]
+
+[wind]
+velocity = [5.0, 0.0, 0.0]
+""")
+    return path
+
+
+def test_air_data_and_gnss_see_the_circle_through_the_wind(tmp_path):
+    with sandbox.Lockstep(anchored_level(tmp_path)) as run:
+        air, fixes = [], []
+        for k in range(300):
+            utime, position, q = circle(k)
+            outputs = run.step(poses={"W": (position, q)}, utime=utime)
+            air += outputs.get("W/AIR_DATA", [])
+            fixes += outputs.get("W/GNSS", [])
+    times = np.concatenate([m.sample_utime for m in air[3:]])
+    tas = np.concatenate([m.true_airspeed_m_s for m in air[3:]])
+    t = (times - 1_000_000) * 1e-6
+    # Velocity (V cos wt, V sin wt, 0) less the wind (5, 0, 0).
+    expected = np.hypot(V * np.cos(OMEGA * t) - 5.0, V * np.sin(OMEGA * t))
+    assert np.abs(tas - expected).max() < 1e-6
+    altitude = np.concatenate([m.pressure_altitude_m for m in air])
+    assert np.all(np.abs(altitude - 1500.0) < 2.0)  # 1,500 m above the ellipsoid, geopotential
+    # Fixes at 10 Hz, each 20 ms after it was taken; 50 m/s horizontal, level.
+    fix_times = np.concatenate([m.fix_utime for m in fixes])
+    assert np.array_equal(fix_times, 1_000_000 + 100_000 * np.arange(1, 3))
+    assert all(m.input_utime - m.fix_utime[0] == 20_000 for m in fixes)
+    ned = np.concatenate([m.velocity_ned.reshape(-1, 3) for m in fixes])
+    assert np.allclose(np.hypot(ned[:, 0], ned[:, 1]), V, atol=1e-3)
+    assert np.allclose(ned[:, 2], 0.0, atol=1e-2)
+    heights = np.concatenate([m.height_m for m in fixes])
+    assert np.all(np.abs(heights - 1500.0) < 1.0)

@@ -111,6 +111,35 @@ TEST_F(ManifestTest, UnknownKeyNamesKeyAndLine) {
             std::string::npos);
 }
 
+// [wind]: the mean wind at a height, its shear layer linear; mistakes named.
+TEST_F(ManifestTest, WindTakesAVelocityAShearLayerAndGusts) {
+  const std::string actor = "[[actor]]\nname = \"a\"\nfile = \"box.obj\"\n";
+  const Level level = Load(actor +
+                           "[wind]\nvelocity = [4, 0, 0]\nshear_velocity = [10, 2, 0]\n"
+                           "shear_bottom_m = 100\nshear_top_m = 300\ngust_sigma_m_s = 1\n");
+  ASSERT_TRUE(level.wind.has_value());
+  EXPECT_EQ(level.wind->At(50.0), Vector3d(4, 0, 0));
+  EXPECT_EQ(level.wind->At(200.0), Vector3d(7, 1, 0));
+  EXPECT_EQ(level.wind->At(1e4), Vector3d(10, 2, 0));
+  EXPECT_EQ(level.wind->gust_length_m, 533.4);
+  EXPECT_FALSE(Load(actor).wind.has_value());
+  EXPECT_NE(Error(actor + "[wind]\nshear_velocity = [1, 0, 0]\n")
+                .find(":4: [wind]: a shear layer takes shear_velocity, shear_bottom_m and "
+                      "shear_top_m"),
+            std::string::npos);
+  EXPECT_NE(Error(actor + "[wind]\nshear_velocity = [1, 0, 0]\nshear_bottom_m = 5\n"
+                          "shear_top_m = 5\n")
+                .find(":7: [wind]: 'shear_top_m' must be above 'shear_bottom_m'"),
+            std::string::npos);
+  EXPECT_NE(Error(actor + "[wind]\ngust_sigma_m_s = -1\n")
+                .find(":5: [wind]: 'gust_sigma_m_s' must be zero or positive"),
+            std::string::npos);
+  EXPECT_NE(Error(actor + "[wind]\nvelocity = [1, 2]\n").find(":5: [wind]: 'velocity'"),
+            std::string::npos);
+  EXPECT_NE(Error(actor + "[wind]\nspeed = 3\n").find(":5: [wind]: unknown key 'speed'"),
+            std::string::npos);
+}
+
 TEST_F(ManifestTest, WrongTypes) {
   EXPECT_NE(Error("[[actor]]\nname = \"a\"\nfile = \"box.obj\"\ncollision = \"yes\"\n")
                 .find(":4: actor 'a': 'collision' must be true or false"),

@@ -217,7 +217,7 @@ TEST(SensorTest, MistakesNameTheSensorAndField) {
   EXPECT_EQ(Error("type = \"face\"\nrefresh = 6\n"),
             "level.toml:9: sensor 's': 'refresh' must be a string");
   EXPECT_EQ(Error("type = \"sonar\"\n"),
-            "level.toml:8: sensor 's': 'type' must be face, ground, lidar, ray, imu or gnss, got "
+            "level.toml:8: sensor 's': 'type' must be face, ground, lidar, ray, imu, gnss or air_data, got "
             "'sonar'");
   EXPECT_EQ(Error("type = \"imu\"\naccel_noise_density = -0.1\n"),
             "level.toml:9: sensor 's': accel_noise_density must be zero or positive, got -0.1");
