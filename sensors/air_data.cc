@@ -5,6 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "sensors/instrument_settings.h"
 #include "sensors/standard_atmosphere.h"
 
 namespace sandbox::sensors {
@@ -19,13 +20,6 @@ double RayleighPitotRatio(double mach) {
   return std::pow((kGamma + 1.0) / 2.0 * m2, kGamma / (kGamma - 1.0)) /
          std::pow(2.0 * kGamma / (kGamma + 1.0) * m2 - (kGamma - 1.0) / (kGamma + 1.0),
                   1.0 / (kGamma - 1.0));
-}
-
-void CheckNonNegative(const char* key, double value) {
-  if (!(std::isfinite(value) && value >= 0.0)) {
-    throw std::invalid_argument(std::string(key) + " must be zero or positive, got " +
-                                (std::ostringstream() << value).str());
-  }
 }
 
 }  // namespace
@@ -76,16 +70,11 @@ AirDataSample IdealAirData(const Eigen::Vector3d& air_S, double height_m) {
 }
 
 void AirDataConfig::ValidateOrThrow() const {
-  if (!(std::isfinite(rate_hz) && rate_hz >= 0.0)) {
-    throw std::invalid_argument("rate_hz must be positive");
-  }
+  CheckInstrumentClock(rate_hz, max_gap_s);
   CheckNonNegative("static_pressure_sigma_pa", static_pressure_sigma_pa);
   CheckNonNegative("impact_pressure_sigma_pa", impact_pressure_sigma_pa);
   CheckNonNegative("temperature_sigma_k", temperature_sigma_k);
   CheckNonNegative("angle_sigma_deg", angle_sigma_deg);
-  if (!(std::isfinite(max_gap_s) && max_gap_s > 0.0)) {
-    throw std::invalid_argument("max_gap_s must be positive");
-  }
 }
 
 AirDataConfig AirDataConfig::Read(scene::SettingsReader& read) {
@@ -96,9 +85,7 @@ AirDataConfig AirDataConfig::Read(scene::SettingsReader& read) {
       read.Number("impact_pressure_sigma_pa", config.impact_pressure_sigma_pa);
   config.temperature_sigma_k = read.Number("temperature_sigma_k", config.temperature_sigma_k);
   config.angle_sigma_deg = read.Number("angle_sigma_deg", config.angle_sigma_deg);
-  const int seed = read.Whole("seed", 0);
-  if (seed < 0) read.Fail("seed", "'seed' must be zero or positive");
-  config.seed = std::uint64_t(seed);
+  config.seed = ReadSeed(read);
   config.max_gap_s = read.Number("max_gap_s", config.max_gap_s);
   return config;
 }

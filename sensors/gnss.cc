@@ -4,15 +4,10 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "sensors/instrument_settings.h"
+
 namespace sandbox::sensors {
 namespace {
-
-void CheckNonNegative(const char* key, double value) {
-  if (!(std::isfinite(value) && value >= 0.0)) {
-    throw std::invalid_argument(std::string(key) + " must be zero or positive, got " +
-                                (std::ostringstream() << value).str());
-  }
-}
 
 // World from the local east-north-up frame at a geodetic point.
 Eigen::Matrix3d WorldFromLocal(const scene::LocalTangentPlane& frame, const GnssFix& at) {
@@ -22,16 +17,11 @@ Eigen::Matrix3d WorldFromLocal(const scene::LocalTangentPlane& frame, const Gnss
 }  // namespace
 
 void GnssConfig::ValidateOrThrow() const {
-  if (!(std::isfinite(rate_hz) && rate_hz >= 0.0)) {
-    throw std::invalid_argument("rate_hz must be positive");
-  }
+  CheckInstrumentClock(rate_hz, max_gap_s);
   CheckNonNegative("latency_s", latency_s);
   CheckNonNegative("horizontal_sigma_m", horizontal_sigma_m);
   CheckNonNegative("vertical_sigma_m", vertical_sigma_m);
   CheckNonNegative("velocity_sigma_m_s", velocity_sigma_m_s);
-  if (!(std::isfinite(max_gap_s) && max_gap_s > 0.0)) {
-    throw std::invalid_argument("max_gap_s must be positive");
-  }
 }
 
 GnssConfig GnssConfig::Read(scene::SettingsReader& read) {
@@ -40,9 +30,7 @@ GnssConfig GnssConfig::Read(scene::SettingsReader& read) {
   config.horizontal_sigma_m = read.Number("horizontal_sigma_m", config.horizontal_sigma_m);
   config.vertical_sigma_m = read.Number("vertical_sigma_m", config.vertical_sigma_m);
   config.velocity_sigma_m_s = read.Number("velocity_sigma_m_s", config.velocity_sigma_m_s);
-  const int seed = read.Whole("seed", 0);
-  if (seed < 0) read.Fail("seed", "'seed' must be zero or positive");
-  config.seed = std::uint64_t(seed);
+  config.seed = ReadSeed(read);
   config.max_gap_s = read.Number("max_gap_s", config.max_gap_s);
   return config;
 }

@@ -5,6 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "sensors/instrument_settings.h"
 #include "sensors/normal_gravity.h"
 #include "sensors/standard_atmosphere.h"
 
@@ -12,15 +13,9 @@ namespace sandbox::sensors {
 namespace {
 
 void CheckErrors(const ImuAxisErrors& errors, const std::string& prefix) {
-  const auto check = [&](const char* key, double value) {
-    if (!(std::isfinite(value) && value >= 0.0)) {
-      throw std::invalid_argument(prefix + key + " must be zero or positive, got " +
-                                  (std::ostringstream() << value).str());
-    }
-  };
-  check("noise_density", errors.noise_density);
-  check("bias_random_walk", errors.bias_random_walk);
-  check("saturation", errors.saturation);
+  CheckNonNegative(prefix + "noise_density", errors.noise_density);
+  CheckNonNegative(prefix + "bias_random_walk", errors.bias_random_walk);
+  CheckNonNegative(prefix + "saturation", errors.saturation);
 }
 
 ImuAxisErrors ReadErrors(scene::SettingsReader& read, const std::string& prefix) {
@@ -38,23 +33,16 @@ bool Noisy(const ImuAxisErrors& errors) {
 }  // namespace
 
 void ImuConfig::ValidateOrThrow() const {
-  if (!(std::isfinite(rate_hz) && rate_hz >= 0.0)) {
-    throw std::invalid_argument("rate_hz must be positive");
-  }
+  CheckInstrumentClock(rate_hz, max_gap_s);
   CheckErrors(accel, "accel_");
   CheckErrors(gyro, "gyro_");
-  if (!(std::isfinite(max_gap_s) && max_gap_s > 0.0)) {
-    throw std::invalid_argument("max_gap_s must be positive");
-  }
 }
 
 ImuConfig ImuConfig::Read(scene::SettingsReader& read) {
   ImuConfig config;
   config.accel = ReadErrors(read, "accel_");
   config.gyro = ReadErrors(read, "gyro_");
-  const int seed = read.Whole("seed", 0);
-  if (seed < 0) read.Fail("seed", "'seed' must be zero or positive");
-  config.seed = std::uint64_t(seed);
+  config.seed = ReadSeed(read);
   config.max_gap_s = read.Number("max_gap_s", config.max_gap_s);
   return config;
 }

@@ -266,6 +266,8 @@ void ManifestSeeds(const fs::path& dir, const fs::path& source) {
         "tests/data/net_fdm_wing.toml", "tests/data/px4_uneven_ground.toml"}) {
     Write(dir / fs::path(file).filename(), Read(source / file));
   }
+  // The instruments and [wind].
+  Write(dir / "instruments.toml", Read(source / "examples/instruments/level.toml"));
   Write(dir / "limits.toml",
         "[level]\nname = \"l\"\nmax_triangles = 100\nmax_file_mb = 1\n"
         "[[actor]]\nname = \"a\"\nheightmap = \"h.png\"\nsize = [1, 2, 3]\n"

@@ -14,15 +14,16 @@ V, R = 50.0, 500.0  # m/s, m
 OMEGA = V / R
 
 
-def level(tmp_path):
+def wing_level(tmp_path, name, tables):
+    """The flying wing with these tables after its [[robot]] table."""
     wing = ASSETS / "robots/generated/flying_wing.gltf"
-    path = tmp_path / "imu.toml"
-    path.write_text(f"""
-[[robot]]
-name = "W"
-file = "{wing}"
-bones = ["root"]
+    path = tmp_path / f"{name}.toml"
+    path.write_text(f'[[robot]]\nname = "W"\nfile = "{wing}"\nbones = ["root"]\n' + tables)
+    return path
 
+
+def level(tmp_path):
+    return wing_level(tmp_path, "imu", """
 [[robot.sensor]]
 name = "clean"
 type = "imu"
@@ -37,7 +38,6 @@ gyro_noise_density = 0.0003
 gyro_bias_random_walk = 0.0001
 seed = 5
 """)
-    return path
 
 
 def circle(k):
@@ -90,14 +90,7 @@ def test_one_seed_gives_the_same_bytes(tmp_path):
 def anchored_level(tmp_path):
     """The wing with air data and a GNSS receiver, the world anchored at 47 N
     8 E 500 m, a 5 m/s wind towards the east."""
-    wing = ASSETS / "robots/generated/flying_wing.gltf"
-    path = tmp_path / "anchored.toml"
-    path.write_text(f"""
-[[robot]]
-name = "W"
-file = "{wing}"
-bones = ["root"]
-
+    return wing_level(tmp_path, "anchored", """
 [[robot.sensor]]
 name = "adc"
 type = "air_data"
@@ -115,7 +108,6 @@ geodetic_origin = [47.0, 8.0, 500.0]
 [wind]
 velocity = [5.0, 0.0, 0.0]
 """)
-    return path
 
 
 def test_air_data_and_gnss_see_the_circle_through_the_wind(tmp_path):
