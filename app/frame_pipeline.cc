@@ -261,7 +261,7 @@ void FramePipeline::Write(const Encoded& item) {
       index = std::make_unique<RowFile>(
           (dir / (item.camera + ".csv")).string(),
           "tick,time_s,file,x,y,z,qw,qx,qy,qz,cam_x,cam_y,cam_z,cam_qw,cam_qx,cam_qy,cam_qz,"
-          "fx,fy,cx,cy,depth_file,segmentation_file,normals_file");
+          "fx,fy,cx,cy,depth_file,segmentation_file,normals_file,lens,k1,k2,k3,k4,p1,p2");
     }
     std::ostringstream row;
     row << std::setprecision(10);
@@ -272,12 +272,18 @@ void FramePipeline::Write(const Encoded& item) {
       row << "," << p.x() << "," << p.y() << "," << p.z() << "," << q.w() << "," << q.x() << ","
           << q.y() << "," << q.z();
     }
-    // Square pixels: one focal length from the vertical field of view; pixel
-    // centres at whole coordinates, as OpenCV's camera matrix has them.
+    // A pinhole: square pixels, one focal length from the vertical field of
+    // view; pixel centres at whole coordinates, as OpenCV's camera matrix has
+    // them. A lens: its own, and its coefficients (OpenCV's).
+    render::Lens lens;
     const double f = 0.5 * item.view.height / std::tan(0.5 * item.view.fov_y_rad);
-    row << "," << f << "," << f << "," << 0.5 * item.view.width - 0.5 << ","
-        << 0.5 * item.view.height - 0.5 << "," << depth_file << "," << segmentation_file << ","
-        << normals_file;
+    lens.fx = lens.fy = f, lens.cx = 0.5 * item.view.width - 0.5;
+    lens.cy = 0.5 * item.view.height - 0.5;
+    if (item.view.lens) lens = *item.view.lens;
+    row << "," << lens.fx << "," << lens.fy << "," << lens.cx << "," << lens.cy << ","
+        << depth_file << "," << segmentation_file << "," << normals_file << ","
+        << (item.view.lens ? lens.ModelName() : "pinhole");
+    for (const double k : {lens.k1, lens.k2, lens.k3, lens.k4, lens.p1, lens.p2}) row << "," << k;
     // The row is the frame's last part: a frame whose row cannot be written is removed.
     index->Add(row.str());
     if (!index->Flush()) throw std::runtime_error(index->error());

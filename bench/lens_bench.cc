@@ -1,8 +1,9 @@
 // A lens remap's cost (sensors/render/lens.h): a 640 x 480 frame with colour,
 // depth, segmentation and normals gathered through a Brown-Conrady and a
-// fisheye lens from their pinhole source frames, against the budget
-// of 1 ms, beside a plain copy of the same images (the reference, in the
-// same process); and the map's one-off build. Medians of runs in turns.
+// fisheye lens from their pinhole source frames (twice the lens's density),
+// against the budget of 1 ms, beside a plain copy of the source
+// images (the reference, in the same process); and the map's one-off build.
+// Medians of runs in turns. The source's own render is not counted.
 //
 //   bench_lens [--seconds S]   (time per figure, default 1)
 

@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace sandbox::render {
@@ -23,6 +24,11 @@ double FisheyeAngle(const Lens& l, double theta) {
 }
 
 }  // namespace
+
+bool Lens::operator==(const Lens& o) const {
+  return model == o.model && fx == o.fx && fy == o.fy && cx == o.cx && cy == o.cy && k1 == o.k1 &&
+         k2 == o.k2 && k3 == o.k3 && k4 == o.k4 && p1 == o.p1 && p2 == o.p2;
+}
 
 std::string Lens::ModelName() const {
   return model == Model::kFisheye ? "fisheye" : "brown_conrady";
@@ -102,14 +108,19 @@ void Lens::ValidateOrThrow(int width, int height, double max_angle_deg) const {
                                            (k1 + std::pow(std::tan(theta), 2) *
                                                      (k2 + std::pow(std::tan(theta), 2) * k3)));
     if (!(radius > last)) {
+      char at[32];
+      std::snprintf(at, sizeof(at), "%.1f", theta * 180.0 / M_PI);
       throw std::invalid_argument(
-          "k1 and the other coefficients fold the projection back inside the image (at " +
-          std::to_string(theta * 180.0 / M_PI) + " degrees off the axis)");
+          std::string("k1 and the other coefficients fold the projection back inside the image "
+                      "(at ") +
+          at + " degrees off the axis)");
     }
     if (radius >= reach) return;
     last = radius;
   }
-  throw std::invalid_argument("the lens sees rays beyond " + std::to_string(max_angle_deg) +
+  char beyond[32];
+  std::snprintf(beyond, sizeof(beyond), "%g", max_angle_deg);
+  throw std::invalid_argument(std::string("the lens sees rays beyond ") + beyond +
                               " degrees off the axis: too wide to draw through a pinhole view");
 }
 
@@ -123,8 +134,11 @@ CameraView SourceView(const CameraView& view, const Lens& lens) {
   };
   for (int u = 0; u < view.width; ++u) reach(u, -0.5), reach(u, view.height - 0.5);
   for (int v = 0; v < view.height; ++v) reach(-0.5, v), reach(view.width - 0.5, v);
-  const double f = std::max(lens.fx, lens.fy);
+  // Twice the lens's density at the centre: a lens pixel takes its data
+  // images from the nearest source pixel, within a quarter of its own.
+  const double f = 2.0 * std::max(lens.fx, lens.fy);
   CameraView source = view;
+  source.lens.reset();
   source.width = int(std::ceil(2.0 * f * tx)) + 2;
   source.height = int(std::ceil(2.0 * f * ty)) + 2;
   source.fov_y_rad = 2.0 * std::atan(source.height / (2.0 * f));

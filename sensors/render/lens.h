@@ -2,10 +2,11 @@
 // Camera lenses: Brown-Conrady (OpenCV's k1, k2, p1, p2, k3) and the
 // equidistant fisheye (OpenCV's cv::fisheye k1..k4), with their intrinsics
 // fx, fy, cx, cy in OpenCV's image convention (pixel indices, u right, v
-// down; rays in OpenCV's camera frame: x right, y down, z forward). A lens
-// camera is to be drawn as a pinhole wide enough for every ray its image
-// sees (SourceView) and remapped through the lens (LensRemap). Not yet read
-// from camera tables: the model and its checks, for issue 43's lenses.
+// down; rays in OpenCV's camera frame: x right, y down, z forward; the
+// struct itself is in view.h, a camera view's value). A lens camera is drawn
+// as a pinhole wide enough for every ray its image sees (SourceView) and
+// remapped through the lens (LensRemap): the renderer does it for any view
+// with a lens.
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -16,28 +17,9 @@
 
 namespace sandbox::render {
 
-struct Lens {
-  enum class Model { kBrownConrady, kFisheye };
-  Model model{Model::kBrownConrady};
-  double fx{0.0}, fy{0.0}, cx{0.0}, cy{0.0};  // pixels
-  double k1{0.0}, k2{0.0}, k3{0.0}, k4{0.0};  // radial (k4: fisheye only)
-  double p1{0.0}, p2{0.0};                    // tangential (Brown-Conrady only)
-
-  // The pixel a ray (OpenCV camera frame, z > 0 for Brown-Conrady) lands on.
-  Eigen::Vector2d Pixel(const Eigen::Vector3d& ray) const;
-  // The unit ray a pixel sees (the inverse, by Newton's method).
-  Eigen::Vector3d Ray(const Eigen::Vector2d& pixel) const;
-  // Throws std::invalid_argument naming the field: non-positive focal
-  // lengths, or coefficients whose projection folds back (is not monotonic)
-  // within a width x height image, or that see rays beyond `max_angle_deg`
-  // off the axis (a pinhole source cannot hold them).
-  void ValidateOrThrow(int width, int height, double max_angle_deg = 80.0) const;
-  std::string ModelName() const;  // "brown_conrady" or "fisheye"
-};
-
 // The pinhole view that holds every ray of a `width` x `height` image
-// through `lens`, at the lens's pixel density at the centre: its size and
-// vertical field of view (square pixels, centred), the rest as `view`.
+// through `lens`, at twice the lens's pixel density at the centre: its size
+// and vertical field of view (square pixels, centred), the rest as `view`.
 CameraView SourceView(const CameraView& view, const Lens& lens);
 
 // Where each pixel of the lens image comes from in the source view's image,

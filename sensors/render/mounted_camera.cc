@@ -63,6 +63,46 @@ void ReadLook(const scene::SensorSpec& spec, scene::SettingsReader* read, Render
   }
 }
 
+// A payload or fixed camera's `lens` and its intrinsics and coefficients
+// (docs/reference/cameras.md); the focal length defaults to the pinhole's of
+// fov_deg, the centre to the image's. Checked against the image's size.
+void ReadLens(const scene::SensorSpec& spec, CameraKind kind, scene::SettingsReader* read,
+              CameraView* view) {
+  if (!read->Has("lens")) return;
+  const std::string model = read->Text("lens", "");
+  if (model != "brown_conrady" && model != "fisheye") {
+    read->Fail("lens", "'lens' must be brown_conrady or fisheye, got '" + model + "'");
+  }
+  if (kind != CameraKind::kPayload && kind != CameraKind::kFixed) {
+    read->Fail("lens", "a lens is for payload and fixed cameras");
+  }
+  Lens lens;
+  lens.model = model == "fisheye" ? Lens::Model::kFisheye : Lens::Model::kBrownConrady;
+  const double f = 0.5 * view->height / std::tan(0.5 * view->fov_y_rad);
+  lens.fx = read->Number("fx", f), lens.fy = read->Number("fy", f);
+  lens.cx = read->Number("cx", 0.5 * view->width - 0.5);
+  lens.cy = read->Number("cy", 0.5 * view->height - 0.5);
+  lens.k1 = read->Number("k1", 0.0), lens.k2 = read->Number("k2", 0.0);
+  lens.k3 = read->Number("k3", 0.0);
+  const double k4 = read->Number("k4", 0.0), p1 = read->Number("p1", 0.0);
+  const double p2 = read->Number("p2", 0.0);
+  if (lens.model == Lens::Model::kFisheye) {
+    if (p1 != 0.0 || p2 != 0.0) read->Fail(p1 != 0.0 ? "p1" : "p2", "a fisheye lens has no p1, p2");
+    lens.k4 = k4;
+  } else {
+    if (k4 != 0.0) read->Fail("k4", "'k4' is for a fisheye lens");
+    lens.p1 = p1, lens.p2 = p2;
+  }
+  try {
+    lens.ValidateOrThrow(view->width, view->height);
+  } catch (const std::invalid_argument& error) {
+    const std::string what = error.what();
+    const std::string key = what.substr(0, what.find(' '));
+    throw scene::LevelError(spec.settings.Where(read->Has(key) ? key : "lens") + what);
+  }
+  view->lens = lens;
+}
+
 }  // namespace
 
 Eigen::Isometry3d MountedCamera::Pose(const scene::RobotState& state, ChaseCamera* chase_state,
@@ -115,6 +155,7 @@ std::vector<MountedCamera> MakeRobotCameras(const scene::Level& level) {
       }
       camera.overlay_colour =
           colour == "surface" ? SampleColour::kSurface : SampleColour::kOccupancy;
+      ReadLens(spec, camera.kind, &read, &camera.view);
       // The pixels the camera may have: a documented default, raised to a bound.
       const double pixel_budget =
           read.Number("pixel_budget", double(CameraView::kDefaultPixelBudget));

@@ -23,6 +23,7 @@
 #include "sensors/render/detail_textures.h"
 #include "sensors/render/frame_targets.h"
 #include "sensors/render/gl_context.h"
+#include "sensors/render/lens.h"
 #include "sensors/render/level_meshes.h"
 #include "sensors/render/material_textures.h"
 #include "sensors/render/mesh_drawer.h"
@@ -128,6 +129,24 @@ class OsMesaRenderer : public Renderer {
   void Render(const CameraView& view, const std::vector<Eigen::Isometry3d>& actor_poses,
               const std::vector<const scene::RobotState*>& robots, const RenderSettings& settings,
               Frame* frame, const Overlay* overlay) override {
+    if (view.lens) {
+      // Drawn as its pinhole source, then through the lens (sensors/render/lens.h).
+      if (!lens_ || !(lens_->lens == *view.lens) || lens_->width != view.width ||
+          lens_->height != view.height) {
+        view.lens->ValidateOrThrow(view.width, view.height);
+        const CameraView source = SourceView(view, *view.lens);
+        lens_ = std::make_unique<LensCache>(LensCache{
+            *view.lens, view.width, view.height, source,
+            LensRemap(*view.lens, view.width, view.height, source)});
+      }
+      CameraView source = view;
+      source.lens.reset();
+      source.width = lens_->source.width, source.height = lens_->source.height;
+      source.fov_y_rad = lens_->source.fov_y_rad;
+      Render(source, actor_poses, robots, settings, &lens_source_, overlay);
+      lens_->remap.Apply(lens_source_, frame);
+      return;
+    }
     context_.MakeCurrent();
     view.ValidateOrThrow();
     if (overlay != nullptr && (overlay->point_rgb.size() != overlay->points_W.size() ||
@@ -573,6 +592,15 @@ class OsMesaRenderer : public Renderer {
   GLfloat max_anisotropy_{1.f};
   GLuint anisotropic_{0};  // a sampler
   std::vector<std::string> warnings_;
+  // The last lens drawn through: its pinhole source view and remap, built once.
+  struct LensCache {
+    Lens lens;
+    int width, height;
+    CameraView source;
+    LensRemap remap;
+  };
+  std::unique_ptr<LensCache> lens_;
+  Frame lens_source_;
 
   // The level.
   const scene::Level* level_{nullptr};

@@ -5,12 +5,37 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace sandbox::render {
 
-// A pinhole camera: pose X_WC with x forward, y left, z up (like a robot body).
+// A camera lens (sensors/render/lens.h): Brown-Conrady (OpenCV's k1, k2, p1,
+// p2, k3) or the equidistant fisheye (cv::fisheye's k1..k4), with OpenCV's
+// intrinsics (pixel indices, u right, v down; rays x right, y down, z forward).
+struct Lens {
+  enum class Model { kBrownConrady, kFisheye };
+  Model model{Model::kBrownConrady};
+  double fx{0.0}, fy{0.0}, cx{0.0}, cy{0.0};  // pixels
+  double k1{0.0}, k2{0.0}, k3{0.0}, k4{0.0};  // radial (k4: fisheye only)
+  double p1{0.0}, p2{0.0};                    // tangential (Brown-Conrady only)
+
+  // The pixel a ray (OpenCV camera frame, z > 0 for Brown-Conrady) lands on.
+  Eigen::Vector2d Pixel(const Eigen::Vector3d& ray) const;
+  // The unit ray a pixel sees (the inverse, by Newton's method).
+  Eigen::Vector3d Ray(const Eigen::Vector2d& pixel) const;
+  // Throws std::invalid_argument naming the field: non-positive focal
+  // lengths, or coefficients whose projection folds back (is not monotonic)
+  // within a width x height image, or that see rays beyond `max_angle_deg`
+  // off the axis (a pinhole source cannot hold them).
+  void ValidateOrThrow(int width, int height, double max_angle_deg = 80.0) const;
+  std::string ModelName() const;  // "brown_conrady" or "fisheye"
+  bool operator==(const Lens& other) const;
+};
+
+// A camera: pose X_WC with x forward, y left, z up (like a robot body); a
+// pinhole unless it has a lens.
 struct CameraView {
   Eigen::Isometry3d X_WC{Eigen::Isometry3d::Identity()};
   int width{640};
@@ -18,6 +43,7 @@ struct CameraView {
   double fov_y_rad{0.9};  // vertical field of view
   double near_m{0.1};
   double far_m{2000.0};
+  std::optional<Lens> lens;  // none: a pinhole of fov_y_rad
   // Below these a frame is blank or all one depth: refused, not drawn.
   static constexpr double kMinNear_m = 1e-4;
   static constexpr double kMinFov_rad = 0.1 * M_PI / 180.0;

@@ -49,7 +49,7 @@ std::vector<IndexRow> ReadIndex(const std::filesystem::path& csv) {
   std::getline(in, line);
   EXPECT_EQ(line,
             "tick,time_s,file,x,y,z,qw,qx,qy,qz,cam_x,cam_y,cam_z,cam_qw,cam_qx,cam_qy,cam_qz,"
-            "fx,fy,cx,cy,depth_file,segmentation_file,normals_file")
+            "fx,fy,cx,cy,depth_file,segmentation_file,normals_file,lens,k1,k2,k3,k4,p1,p2")
       << csv;
   std::vector<IndexRow> rows;
   while (std::getline(in, line)) {

@@ -217,7 +217,8 @@ TEST(SensorTest, MistakesNameTheSensorAndField) {
   EXPECT_EQ(Error("type = \"face\"\nrefresh = 6\n"),
             "level.toml:9: sensor 's': 'refresh' must be a string");
   EXPECT_EQ(Error("type = \"sonar\"\n"),
-            "level.toml:8: sensor 's': 'type' must be face, ground, lidar, ray, imu, gnss or air_data, got "
+            "level.toml:8: sensor 's': 'type' must be face, ground, lidar, ray, imu, gnss or "
+            "air_data, got "
             "'sonar'");
   EXPECT_EQ(Error("type = \"imu\"\naccel_noise_density = -0.1\n"),
             "level.toml:9: sensor 's': accel_noise_density must be zero or positive, got -0.1");
@@ -238,6 +239,24 @@ TEST(SensorTest, MistakesNameTheSensorAndField) {
             "level.toml:9: sensor 's': 'range_m' must be finite, got nan");
   EXPECT_EQ(Error("type = \"ray\"\nrate_hz = -1\n"),
             "level.toml:9: sensor 's': 'rate_hz' must be positive");
+}
+
+TEST(SensorTest, LensMistakesNameTheCameraAndField) {
+  EXPECT_EQ(CameraError("type = \"chase\"\nlens = \"fisheye\"\n"),
+            "level.toml:9: camera 'c': a lens is for payload and fixed cameras");
+  EXPECT_EQ(CameraError("type = \"fixed\"\nlens = \"kannala\"\n"),
+            "level.toml:9: camera 'c': 'lens' must be brown_conrady or fisheye, got 'kannala'");
+  EXPECT_EQ(CameraError("type = \"fixed\"\nlens = \"fisheye\"\nk1 = -0.6\n"),
+            "level.toml:10: camera 'c': k1 and the other coefficients fold the projection back "
+            "inside the image (at 42.7 degrees off the axis)");
+  EXPECT_EQ(CameraError("type = \"payload\"\nlens = \"brown_conrady\"\nk4 = 0.1\n"),
+            "level.toml:10: camera 'c': 'k4' is for a fisheye lens");
+  EXPECT_EQ(CameraError("type = \"payload\"\nlens = \"brown_conrady\"\nfx = -5\n"),
+            "level.toml:10: camera 'c': fx and fy must be positive");
+  EXPECT_EQ(CameraError("type = \"fixed\"\nlens = \"fisheye\"\nfx = 120\nfy = 120\n"),
+            "level.toml:9: camera 'c': the lens sees rays beyond 80 degrees off the axis: "
+            "too wide to draw through a pinhole view");
+  EXPECT_EQ(CameraError("type = \"fixed\"\nlens = \"fisheye\"\nk1 = 0.02\n"), "no error");
 }
 
 TEST(SensorTest, CameraMistakesNameTheCameraAndField) {

@@ -78,7 +78,7 @@ TEST(LensTest, CoefficientsThatFoldTheImageAreRefused) {
   EXPECT_NO_THROW(Brown().ValidateOrThrow(640, 480));
   EXPECT_NO_THROW(Fisheye().ValidateOrThrow(640, 480));
   Lens fold = Fisheye();
-  fold.k1 = -0.6;  // theta (1 - 0.6 theta^2) peaks at 42 degrees, inside the image
+  fold.k1 = -0.6;  // theta (1 - 0.6 theta^2) peaks at 42.7 degrees, inside the image
   try {
     fold.ValidateOrThrow(640, 480);
     ADD_FAILURE() << "a folding fisheye was accepted";

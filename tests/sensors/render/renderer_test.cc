@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <set>
@@ -1064,6 +1065,98 @@ TEST(CameraTest, BadViewsAreRefused) {
   view.width = 640;
   view.fov_y_rad = 4.0;
   EXPECT_THROW(view.ValidateOrThrow(), std::invalid_argument);
+}
+
+// Lenses: square markers on a grid in front of a camera drawn through a
+// Brown-Conrady and a fisheye lens. Points on the markers and in the gaps
+// between them are projected by OpenCV (cv::projectPoints,
+// cv::fisheye::projectPoints) with the same coefficients; every point whose
+// projection lies more than 0.5 px (plus the half diagonal to its nearest
+// pixel centre) from a marker's projected edge is seen there as what it is:
+// each marker's edges are where OpenCV puts them, within 0.5 px.
+TEST(RendererLensTest, MarkersLandWhereOpenCvProjectsThem) {
+  testing::TempDir dir;
+  constexpr double kHalf = 0.35, kPitch = 1.1, kDistance = 10.0;
+  dir.Write("marker.obj",
+            "o m\nv 0 -0.35 -0.35\nv 0 0.35 -0.35\nv 0 0.35 0.35\nv 0 -0.35 0.35\nf 1 2 3 4\n");
+  std::ostringstream toml;
+  std::vector<Vector3d> centres;
+  for (int row = -4; row <= 4; ++row) {
+    for (int column = -6; column <= 6; ++column) {
+      const Vector3d c(kDistance, kPitch * column, kPitch * row);
+      toml << "[[actor]]\nname = \"m" << centres.size() << "\"\nfile = \"marker.obj\"\n"
+           << "position = [" << c.x() << ", " << c.y() << ", " << c.z() << "]\n";
+      centres.push_back(c);
+    }
+  }
+  const scene::Level level = scene::LoadLevel(dir.Write("level.toml", toml.str()));
+  std::unique_ptr<Renderer> renderer = MakeRenderer();
+  renderer->SetLevel(level, app::OpenCvTextureDecoder());
+  Lens brown;
+  brown.fx = 520.0, brown.fy = 515.0, brown.cx = 321.5, brown.cy = 238.25;
+  brown.k1 = -0.28, brown.k2 = 0.09, brown.k3 = -0.01, brown.p1 = 0.0012, brown.p2 = -0.0008;
+  Lens fisheye;
+  fisheye.model = Lens::Model::kFisheye;
+  fisheye.fx = fisheye.fy = 330.0, fisheye.cx = 319.5, fisheye.cy = 239.5;
+  fisheye.k1 = 0.02, fisheye.k2 = -0.004, fisheye.k3 = 0.001, fisheye.k4 = -0.0002;
+  for (const Lens& lens : {brown, fisheye}) {
+    CameraView view;  // at the origin, looking along +x
+    view.lens = lens;
+    RenderSettings settings;
+    settings.images = kSegmentationImage | kColorImage | kDepthImage;
+    Frame frame;
+    renderer->Render(view, {}, {}, settings, &frame);
+    ASSERT_EQ(frame.width, 640);
+    ASSERT_EQ(frame.segment.size(), 640u * 480u);
+    // Points on the marker plane, and for each its nearest marker edge point.
+    std::vector<cv::Point3d> points;  // OpenCV's camera frame: x right, y down, z forward
+    std::vector<std::uint32_t> truth;
+    for (double y = -7.0; y <= 7.0; y += 0.013) {
+      for (double z = -4.9; z <= 4.9; z += 0.013) {
+        const double col = std::round(y / kPitch), row = std::round(z / kPitch);
+        const double dy = y - kPitch * col, dz = z - kPitch * row;
+        const bool on = std::abs(dy) < kHalf && std::abs(dz) < kHalf && std::abs(col) <= 6 &&
+                        std::abs(row) <= 4;
+        // The nearest edge point of the marker this point is on or beside.
+        double ey = y, ez = z;
+        if (std::abs(std::abs(dy) - kHalf) < std::abs(std::abs(dz) - kHalf)) {
+          ey = kPitch * col + std::copysign(kHalf, dy);
+        } else {
+          ez = kPitch * row + std::copysign(kHalf, dz);
+        }
+        points.emplace_back(-y, -z, kDistance);
+        points.emplace_back(-ey, -ez, kDistance);
+        truth.push_back(on ? std::uint32_t((row + 4) * 13 + (col + 6) + 1) : 0u);
+      }
+    }
+    const cv::Matx33d K(lens.fx, 0, lens.cx, 0, lens.fy, lens.cy, 0, 0, 1);
+    std::vector<cv::Point2d> pixels;
+    if (lens.model == Lens::Model::kFisheye) {
+      cv::fisheye::projectPoints(points, pixels, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K,
+                                 cv::Vec4d(lens.k1, lens.k2, lens.k3, lens.k4));
+    } else {
+      cv::projectPoints(points, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K,
+                        std::vector<double>{lens.k1, lens.k2, lens.p1, lens.p2, lens.k3}, pixels);
+    }
+    int checked = 0, wrong = 0, on_markers = 0;
+    for (std::size_t i = 0; i < truth.size(); ++i) {
+      const cv::Point2d p = pixels[2 * i], edge = pixels[2 * i + 1];
+      const int u = int(std::lround(p.x)), v = int(std::lround(p.y));
+      if (u < 0 || u >= 640 || v < 0 || v >= 480) continue;
+      if (cv::norm(p - edge) < 0.5 + 0.71) continue;  // too near an edge to tell
+      ++checked;
+      on_markers += truth[i] != 0;
+      if (frame.segment[std::size_t(v) * 640 + std::size_t(u)] != truth[i]) ++wrong;
+    }
+    EXPECT_GT(checked, 200000) << lens.ModelName();
+    EXPECT_GT(on_markers, 50000) << lens.ModelName();
+    EXPECT_EQ(wrong, 0) << lens.ModelName();
+    // Depth through the lens: the middle marker lies 10 m along the optical axis.
+    EXPECT_NEAR(
+        frame.depth_m[std::size_t(std::lround(lens.cy)) * 640 + std::size_t(std::lround(lens.cx))],
+        kDistance, 0.01)
+        << lens.ModelName();
+  }
 }
 
 }  // namespace
