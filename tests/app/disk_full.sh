@@ -63,7 +63,7 @@ faces=$("$sandbox" topics --log "$record" | awk '$1 == "ELAHA/SCAN_FACE" { print
   { echo "$faces faces published in $ticks ticks"; status=1; }
 # What is on the disk is whole: every index row has all of its columns, and
 # every frame left is listed in its index.
-awk -F, 'NR > 1 && NF != 24 { bad = 1 } END { exit bad }' "$dir/chase.csv" ||
+awk -F, 'NR > 1 && NF != 31 { bad = 1 } END { exit bad }' "$dir/chase.csv" ||
   { echo "chase.csv has a cut row"; status=1; }
 for png in $(find "$dir" -name 'chase_*.png'); do
   grep -q ",chase/$(basename "$png")," "$dir/chase.csv" || { echo "$png is not indexed"; status=1; }

@@ -61,8 +61,13 @@ std::vector<IndexRow> ReadIndex(const std::filesystem::path& csv) {
     std::vector<double> v;
     std::vector<std::string> image_files;  // depth, segmentation, normals ("" when none)
     while (v.size() < 18u && std::getline(cells, cell, ',')) v.push_back(std::stod(cell));
-    while (std::getline(cells, cell, ',')) image_files.push_back(cell);
-    if (!line.empty() && line.back() == ',') image_files.push_back("");
+    for (int k = 0; k < 3 && std::getline(cells, cell, ','); ++k) image_files.push_back(cell);
+    std::string lens;  // then the lens: a pinhole's, all coefficients 0
+    std::getline(cells, lens, ',');
+    EXPECT_EQ(lens, "pinhole") << line;
+    int zeros = 0;
+    while (std::getline(cells, cell, ',')) zeros += std::stod(cell) == 0.0;
+    EXPECT_EQ(zeros, 6) << line;
     EXPECT_EQ(v.size(), 18u) << line;
     EXPECT_EQ(image_files.size(), 3u) << line;
     if (v.size() != 18u) break;
