@@ -74,14 +74,20 @@ def bones_message(values, utime, seq):
     return message.encode()
 
 
+def names_of(names, argument):
+    """`names` as a list of strings an LCM string carries (no NUL: it ends one), else ValueError."""
+    names = list(names)
+    if not all(isinstance(name, str) and "\0" not in name for name in names):
+        raise ValueError(f"{argument}: names must be strings without NUL")
+    return names
+
+
 def joints_message(values, utime, seq):
     """`values`: {joint name: value}, or every joint's value in the robot's order."""
     message = sandbox_msgs.joint_values_t()
     message.utime, message.seq = int(utime), int(seq)
     if isinstance(values, dict):
-        names = list(values)
-        if not all(isinstance(name, str) for name in names):
-            raise ValueError("joints: names must be strings")
+        names = names_of(values, "joints")
         message.names = names
         message.values = finite([values[name] for name in names], len(names), "joints")
     else:
@@ -98,9 +104,8 @@ def actors_message(placements, utime, seq):
     message = sandbox_msgs.actor_placements_t()
     message.utime, message.seq = int(utime), int(seq)
     message.names, positions, orientations = [], [], []
+    names_of(placements, "actors")
     for name, placement in placements.items():
-        if not isinstance(name, str):
-            raise ValueError("actors: names must be strings")
         try:
             position, orientation = placement
         except (TypeError, ValueError):

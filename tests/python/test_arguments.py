@@ -175,6 +175,7 @@ CLIENT = sandbox.Client("memq://")
        utime=st.one_of(st.none(), st.integers(-10**30, 10**30), anything))
 @example(robot="\x00", position=None, orientation=None, values=0, utime=None)  # LCM cuts at NUL
 @example(robot="r" * 60, position=(0, 0, 1), orientation=(1, 0, 0, 0), values=[], utime=1)
+@example(robot="", position=None, orientation=None, values={"\x00": 0}, utime=None)  # NUL name
 def test_client_takes_any_argument(robot, position, orientation, values, utime):
     """What is published decodes as what was given; anything else is a ValueError."""
     published = []
