@@ -1,24 +1,62 @@
 #include "sensors/render/frame_targets.h"
 
+#include <algorithm>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 
 namespace sandbox::render {
 
 void FrameTargets::Resize(int width, int height, int samples) {
-  if (width == width_ && height == height_ && samples == samples_) return;
-  if (fbo_ == 0) {
-    glGenFramebuffers(1, &fbo_);
-    glGenRenderbuffers(4, buffers_);
-    glGenFramebuffers(1, &msaa_fbo_);
-    glGenRenderbuffers(2, msaa_buffers_);
-    glGenFramebuffers(1, &gbuffer_fbo_);
-    glGenFramebuffers(1, &translucent_fbo_);
-    glGenFramebuffers(1, &gbuffer_lean_fbo_);
-    glGenFramebuffers(1, &translucent_lean_fbo_);
-    glGenFramebuffers(1, &overlay_fbo_);
-    glGenRenderbuffers(5, layer_buffers_);
+  for (std::size_t i = 0; i < sizes_.size(); ++i) {
+    const Targets& t = sizes_[i];
+    if (t.width == width && t.height == height && t.samples == samples) {
+      std::rotate(sizes_.begin() + std::ptrdiff_t(i), sizes_.begin() + std::ptrdiff_t(i) + 1,
+                  sizes_.end());  // now the current, the last
+      return;
+    }
   }
+  Targets targets;
+  targets.width = width, targets.height = height, targets.samples = samples;
+  try {
+    Allocate(&targets);
+  } catch (...) {
+    Free(targets);
+    throw;
+  }
+  if (sizes_.size() == kSizesKept) {
+    Free(sizes_.front());
+    sizes_.erase(sizes_.begin());
+  }
+  sizes_.push_back(targets);
+}
+
+void FrameTargets::Free(const Targets& t) {
+  const GLuint fbos[] = {t.fbo,
+                         t.msaa_fbo,
+                         t.gbuffer_fbo,
+                         t.translucent_fbo,
+                         t.gbuffer_lean_fbo,
+                         t.translucent_lean_fbo,
+                         t.overlay_fbo};
+  glDeleteFramebuffers(GLsizei(std::size(fbos)), fbos);
+  glDeleteRenderbuffers(4, t.buffers);
+  glDeleteRenderbuffers(2, t.msaa_buffers);
+  glDeleteRenderbuffers(5, t.layer_buffers);
+}
+
+void FrameTargets::Allocate(Targets* t) {
+  const int width = t->width, height = t->height, samples = t->samples;
+  glGenFramebuffers(1, &t->fbo);
+  glGenRenderbuffers(4, t->buffers);
+  glGenFramebuffers(1, &t->msaa_fbo);
+  glGenRenderbuffers(2, t->msaa_buffers);
+  glGenFramebuffers(1, &t->gbuffer_fbo);
+  glGenFramebuffers(1, &t->translucent_fbo);
+  glGenFramebuffers(1, &t->gbuffer_lean_fbo);
+  glGenFramebuffers(1, &t->translucent_lean_fbo);
+  glGenFramebuffers(1, &t->overlay_fbo);
+  glGenRenderbuffers(5, t->layer_buffers);
   auto attach = [&](GLuint fbo, GLuint buffer, GLenum format, GLenum attachment, int n) {
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     glBindRenderbuffer(GL_RENDERBUFFER, buffer);
@@ -32,10 +70,10 @@ void FrameTargets::Resize(int width, int height, int samples) {
                                " is incomplete");
     }
   };
-  attach(fbo_, buffers_[0], GL_RGBA8, GL_COLOR_ATTACHMENT0, 0);
-  attach(fbo_, buffers_[1], GL_R32UI, GL_COLOR_ATTACHMENT1, 0);
-  attach(fbo_, buffers_[2], GL_RGBA32F, GL_COLOR_ATTACHMENT2, 0);
-  attach(fbo_, buffers_[3], GL_DEPTH_COMPONENT32F, GL_DEPTH_ATTACHMENT, 0);
+  attach(t->fbo, t->buffers[0], GL_RGBA8, GL_COLOR_ATTACHMENT0, 0);
+  attach(t->fbo, t->buffers[1], GL_R32UI, GL_COLOR_ATTACHMENT1, 0);
+  attach(t->fbo, t->buffers[2], GL_RGBA32F, GL_COLOR_ATTACHMENT2, 0);
+  attach(t->fbo, t->buffers[3], GL_DEPTH_COMPONENT32F, GL_DEPTH_ATTACHMENT, 0);
   check("the");
   // Deferred shading's layers (SurfaceLayer): the opaque surfaces' and the
   // translucent ones', each in a framebuffer with the segment, normal and
@@ -44,28 +82,29 @@ void FrameTargets::Resize(int width, int height, int samples) {
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, attachment, GL_RENDERBUFFER, buffer);
   };
   for (int layer = 0; layer < 2; ++layer) {
-    const GLuint albedo = layer_buffers_[2 * layer], normal = layer_buffers_[2 * layer + 1];
-    attach(layer == 0 ? gbuffer_fbo_ : translucent_fbo_, albedo, GL_RGBA8, GL_COLOR_ATTACHMENT0, 0);
-    attach(layer == 0 ? gbuffer_fbo_ : translucent_fbo_, normal, GL_RGBA8, GL_COLOR_ATTACHMENT3, 0);
-    share(GL_COLOR_ATTACHMENT1, buffers_[1]);
-    share(GL_COLOR_ATTACHMENT2, buffers_[2]);
-    share(GL_DEPTH_ATTACHMENT, buffers_[3]);
+    const GLuint albedo = t->layer_buffers[2 * layer], normal = t->layer_buffers[2 * layer + 1];
+    attach(layer == 0 ? t->gbuffer_fbo : t->translucent_fbo, albedo, GL_RGBA8, GL_COLOR_ATTACHMENT0,
+           0);
+    attach(layer == 0 ? t->gbuffer_fbo : t->translucent_fbo, normal, GL_RGBA8, GL_COLOR_ATTACHMENT3,
+           0);
+    share(GL_COLOR_ATTACHMENT1, t->buffers[1]);
+    share(GL_COLOR_ATTACHMENT2, t->buffers[2]);
+    share(GL_DEPTH_ATTACHMENT, t->buffers[3]);
     check("a deferred shading layer's");
-    glBindFramebuffer(GL_FRAMEBUFFER, layer == 0 ? gbuffer_lean_fbo_ : translucent_lean_fbo_);
+    glBindFramebuffer(GL_FRAMEBUFFER, layer == 0 ? t->gbuffer_lean_fbo : t->translucent_lean_fbo);
     share(GL_COLOR_ATTACHMENT0, albedo);
     share(GL_COLOR_ATTACHMENT3, normal);
-    share(GL_DEPTH_ATTACHMENT, buffers_[3]);
+    share(GL_DEPTH_ATTACHMENT, t->buffers[3]);
     check("a lean deferred shading layer's");
   }
-  attach(overlay_fbo_, layer_buffers_[4], GL_RGBA8, GL_COLOR_ATTACHMENT0, 0);
-  share(GL_DEPTH_ATTACHMENT, buffers_[3]);
+  attach(t->overlay_fbo, t->layer_buffers[4], GL_RGBA8, GL_COLOR_ATTACHMENT0, 0);
+  share(GL_DEPTH_ATTACHMENT, t->buffers[3]);
   check("the overlay's");
   if (samples > 0) {
-    attach(msaa_fbo_, msaa_buffers_[0], GL_RGBA8, GL_COLOR_ATTACHMENT0, samples);
-    attach(msaa_fbo_, msaa_buffers_[1], GL_DEPTH_COMPONENT32F, GL_DEPTH_ATTACHMENT, samples);
+    attach(t->msaa_fbo, t->msaa_buffers[0], GL_RGBA8, GL_COLOR_ATTACHMENT0, samples);
+    attach(t->msaa_fbo, t->msaa_buffers[1], GL_DEPTH_COMPONENT32F, GL_DEPTH_ATTACHMENT, samples);
     check("the multisampled");
   }
-  width_ = width, height_ = height, samples_ = samples;
 }
 
 void FrameTargets::ReadLayer(bool opaque, int width, int height, SurfaceLayer* layer) const {
@@ -75,7 +114,8 @@ void FrameTargets::ReadLayer(bool opaque, int width, int height, SurfaceLayer* l
   layer->albedo.resize(count);
   layer->normal.resize(count);
   layer->depth.resize(count);
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, opaque ? gbuffer_lean_fbo_ : translucent_lean_fbo_);
+  const Targets& t = current();
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, opaque ? t.gbuffer_lean_fbo : t.translucent_lean_fbo);
   glReadBuffer(GL_COLOR_ATTACHMENT0);
   glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, layer->albedo.data());
   glReadBuffer(GL_COLOR_ATTACHMENT3);

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -27,6 +28,7 @@
 #include "sensors/ray_caster.h"
 #include "sensors/render/cameras.h"
 #include "sensors/render/debug_overlay.h"
+#include "sensors/render/frame_targets.h"
 #include "tests/test_util.h"
 
 namespace sandbox::render {
@@ -126,6 +128,39 @@ TEST_F(RendererTest, SkyAboveTerrainBelow) {
   EXPECT_GT(bottom[1], bottom[0]);  // the terrain's green
   EXPECT_GT(bottom[1], bottom[2]);
   EXPECT_TRUE(std::isinf(frame.depth_m[2 * 640 + 320]));
+}
+
+// Views of different sizes in turn (a renderer's cameras, a lens's source)
+// each draw into their own kept framebuffers: a frame drawn between frames
+// of other sizes, past the number of sizes kept, is the frame drawn alone.
+TEST_F(RendererTest, ViewsOfSeveralSizesInTurnDrawWhatEachDrawsAlone) {
+  RenderSettings settings;
+  settings.images = kColorImage | kDepthImage | kSegmentationImage | kNormalsImage;
+  const auto view_of = [](int width, int height) {
+    CameraView view;
+    view.X_WC = LookAt(Vector3d(-60, -120, 50), Vector3d(-30, 45, 10));
+    view.width = width, view.height = height;
+    return view;
+  };
+  const std::pair<int, int> sizes[] = {{640, 480}, {320, 240}, {200, 100}, {160, 120},
+                                       {96, 64},   {640, 480}, {320, 240}, {640, 480}};
+  std::map<std::pair<int, int>, Frame> first;
+  int compared = 0;
+  for (const auto& [width, height] : sizes) {
+    Frame frame;
+    renderer_->Render(view_of(width, height), {}, {}, settings, &frame);
+    ASSERT_EQ(frame.width, width);
+    const auto [kept, added] = first.emplace(std::make_pair(width, height), frame);
+    if (added) continue;
+    EXPECT_TRUE(frame.rgb == kept->second.rgb) << width << " x " << height;
+    EXPECT_TRUE(frame.depth_m == kept->second.depth_m) << width << " x " << height;
+    EXPECT_TRUE(frame.segment == kept->second.segment) << width << " x " << height;
+    EXPECT_TRUE(frame.normal_C == kept->second.normal_C) << width << " x " << height;
+    ++compared;
+  }
+  EXPECT_EQ(compared, 3);
+  EXPECT_GT(FrameTargets::kSizesKept, 1u);
+  EXPECT_LT(FrameTargets::kSizesKept, 5u);  // so that 640 x 480 was dropped and made anew
 }
 
 TEST_F(RendererTest, DepthAgreesWithTheRayCaster) {
