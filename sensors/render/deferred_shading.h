@@ -124,6 +124,9 @@ class DeferredShader {
   void FilterEdges(const std::vector<std::uint8_t>& in, int width, int height,
                    std::vector<std::uint8_t>* out);
 
+  // Its threads, for the renderer's other per-pixel work between frames' shading.
+  sensors::WorkerPool& pool() { return pool_; }
+
   // The kernel in use, and those this CPU runs (widest first).
   const std::string& kernel() const { return kernel_; }
   static std::vector<std::string> Kernels();

@@ -38,7 +38,7 @@ void FlippedImage(const std::vector<float>& values, int width, int height, int c
   });
 }
 
-void RgbImage(const std::vector<std::uint8_t>& rgba, int width, int height,
+void RgbImage(const std::uint8_t* rgba, int width, int height,
               const std::vector<std::uint32_t>* marks, std::vector<std::uint8_t>* rgb) {
   const std::size_t w = std::size_t(width);
   rgb->resize(3 * w * std::size_t(height));
@@ -55,6 +55,15 @@ void RgbImage(const std::vector<std::uint8_t>& rgba, int width, int height,
               dst[3 * x + 2] = std::uint8_t(mark >> 16);
     }
   });
+}
+
+void MarkImage(const std::vector<std::uint32_t>& marks, std::vector<std::uint8_t>* rgba) {
+  for (std::size_t i = 0; i < marks.size(); ++i) {
+    const std::uint32_t mark = marks[i];
+    if ((mark >> 24) == 0) continue;
+    std::uint8_t* p = &(*rgba)[4 * i];
+    p[0] = std::uint8_t(mark), p[1] = std::uint8_t(mark >> 8), p[2] = std::uint8_t(mark >> 16);
+  }
 }
 
 void FlipImage(RgbaImage* image) {

@@ -27,8 +27,11 @@ void FlippedImage(const std::vector<float>& values, int width, int height, int c
                   std::vector<float>* out);
 // RGBA8 to RGB8 (alpha dropped). With `marks` (RGBA8 of the same size, rows
 // bottom first too), each pixel whose mark has alpha takes the mark's colour.
-void RgbImage(const std::vector<std::uint8_t>& rgba, int width, int height,
+void RgbImage(const std::uint8_t* rgba, int width, int height,
               const std::vector<std::uint32_t>* marks, std::vector<std::uint8_t>* rgb);
+// Each pixel of `rgba` (rows bottom first) whose mark has alpha takes the
+// mark's colour: RgbImage's marks, kept in RGBA.
+void MarkImage(const std::vector<std::uint32_t>& marks, std::vector<std::uint8_t>* rgba);
 // A decoded image (row 0 at the top) upside down: GL's first texture row is t = 0.
 void FlipImage(RgbaImage* image);
 

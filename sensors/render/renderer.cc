@@ -129,24 +129,22 @@ class OsMesaRenderer : public Renderer {
   void Render(const CameraView& view, const std::vector<Eigen::Isometry3d>& actor_poses,
               const std::vector<const scene::RobotState*>& robots, const RenderSettings& settings,
               Frame* frame, const Overlay* overlay) override {
-    if (view.lens) {
-      // Drawn as its pinhole source, then through the lens (sensors/render/lens.h).
-      if (!lens_ || !(lens_->lens == *view.lens) || lens_->width != view.width ||
-          lens_->height != view.height) {
-        view.lens->ValidateOrThrow(view.width, view.height);
-        const CameraView source = SourceView(view, *view.lens);
-        lens_ = std::make_unique<LensCache>(LensCache{
-            *view.lens, view.width, view.height, source,
-            LensRemap(*view.lens, view.width, view.height, source)});
-      }
-      CameraView source = view;
-      source.lens.reset();
-      source.width = lens_->source.width, source.height = lens_->source.height;
-      source.fov_y_rad = lens_->source.fov_y_rad;
-      Render(source, actor_poses, robots, settings, &lens_source_, overlay);
-      lens_->remap.Apply(lens_source_, frame);
-      return;
-    }
+    if (view.lens) return RenderThroughLens(view, actor_poses, robots, settings, frame, overlay);
+    const FramePlan plan = Draw(view, actor_poses, robots, settings, overlay);
+    ReadBack(view, settings, plan, overlay, frame);
+  }
+
+  void SetTerrain(std::shared_ptr<const scene::TileList> tiles) override {
+    terrain_ = std::move(tiles);
+  }
+  const std::vector<std::string>& warnings() const override { return warnings_; }
+  std::string description() const override { return context_.description(); }
+
+ private:
+  // Every pass of a frame before read-back; the plan it followed.
+  FramePlan Draw(const CameraView& view, const std::vector<Eigen::Isometry3d>& actor_poses,
+                 const std::vector<const scene::RobotState*>& robots,
+                 const RenderSettings& settings, const Overlay* overlay) {
     context_.MakeCurrent();
     view.ValidateOrThrow();
     if (overlay != nullptr && (overlay->point_rgb.size() != overlay->points_W.size() ||
@@ -176,16 +174,52 @@ class OsMesaRenderer : public Renderer {
       DrawForwardColor(view, settings, plan);
     }
     if (plan.data_pass()) DrawDataPass(view, settings);
-    ReadBack(view, settings, plan, overlay, frame);
+    return plan;
   }
 
-  void SetTerrain(std::shared_ptr<const scene::TileList> tiles) override {
-    terrain_ = std::move(tiles);
-  }
-  const std::vector<std::string>& warnings() const override { return warnings_; }
-  std::string description() const override { return context_.description(); }
+  struct LensCache;  // below
 
- private:
+  // A view with a lens: drawn as its pinhole source (lens.h), then gathered
+  // through the lens straight from the source's read-back, on the shading
+  // threads (the source's own images are never converted).
+  void RenderThroughLens(const CameraView& view, const std::vector<Eigen::Isometry3d>& actor_poses,
+                         const std::vector<const scene::RobotState*>& robots,
+                         const RenderSettings& settings, Frame* frame, const Overlay* overlay) {
+    const LensCache& lens = LensOf(view);
+    CameraView source = view;
+    source.lens.reset();
+    source.width = lens.source.width, source.height = lens.source.height;
+    source.fov_y_rad = lens.source.fov_y_rad;
+    const FramePlan plan = Draw(source, actor_poses, robots, settings, overlay);
+    const std::vector<std::uint32_t>* marks = nullptr;
+    RawImages raw = ReadRaw(source, settings, plan, overlay, &marks);
+    if (marks != nullptr) {  // deferred colour's overlay, over a copy
+      marked_.assign(raw.rgba, raw.rgba + 4 * std::size_t(source.width) * source.height);
+      MarkImage(*marks, &marked_);
+      raw.rgba = marked_.data();
+    }
+    lens.remap.Apply(raw, frame, &deferred_.pool());
+    frame->kinds = plan.kinds;
+  }
+
+  // The source view and map of `view`'s lens, built at its first frame (a
+  // tenth of a second) and kept: a level's lens cameras take turns.
+  const LensCache& LensOf(const CameraView& view) {
+    for (const std::unique_ptr<LensCache>& cached : lenses_) {
+      if (cached->lens == *view.lens && cached->width == view.width &&
+          cached->height == view.height) {
+        return *cached;
+      }
+    }
+    view.lens->ValidateOrThrow(view.width, view.height);
+    const CameraView source = SourceView(view, *view.lens);
+    if (lenses_.size() == kLensesKept) lenses_.erase(lenses_.begin());
+    lenses_.push_back(std::make_unique<LensCache>(
+        LensCache{*view.lens, view.width, view.height, source,
+                  LensRemap(*view.lens, view.width, view.height, source)}));
+    return *lenses_.back();
+  }
+
   // The camera-centred world: rotation only in the view; positions relative
   // to the camera. Levels of detail in colour-only frames; depth,
   // segmentation and normals are measurements.
@@ -327,36 +361,34 @@ class OsMesaRenderer : public Renderer {
     DrawScene(Pass::kData, uniforms_.view_proj);
   }
 
-  // The images, rows flipped to top first; depth before the overlay, which
-  // is drawn over colour (on the CPU's image after deferred shading).
-  void ReadBack(const CameraView& view, const RenderSettings& settings, const FramePlan& plan,
-                const Overlay* overlay, Frame* frame) {
+  // The images as GL holds them (rows bottom first), read back without
+  // conversion; depth before the overlay, which is drawn over colour (on
+  // the CPU's image after deferred shading: its marks then in overlay_rgba_,
+  // returned as `marks`).
+  RawImages ReadRaw(const CameraView& view, const RenderSettings& settings, const FramePlan& plan,
+                    const Overlay* overlay, const std::vector<std::uint32_t>** marks) {
     const int w = view.width, h = view.height;
     const std::size_t count = std::size_t(w) * std::size_t(h);
-    frame->width = w;
-    frame->height = h;
-    frame->kinds = plan.kinds;
+    RawImages raw;
+    raw.width = w, raw.height = h, raw.near_m = view.near_m, raw.far_m = view.far_m;
+    *marks = nullptr;
     glBindFramebuffer(GL_READ_FRAMEBUFFER, targets_.data());
-    frame->depth_m.clear();
-    frame->segment.clear();
-    frame->normal_C.clear();
-    frame->rgb.clear();
     if (plan.want_depth) {
       depth_.resize(count);
       glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, depth_.data());
-      DepthImage(depth_, w, h, view.near_m, view.far_m, &frame->depth_m);
+      raw.depth = depth_.data();
     }
     if (plan.kinds & kSegmentationImage) {
       segment_.resize(count);
       glReadBuffer(GL_COLOR_ATTACHMENT1);
       glReadPixels(0, 0, w, h, GL_RED_INTEGER, GL_UNSIGNED_INT, segment_.data());
-      FlippedImage(segment_, w, h, &frame->segment);
+      raw.segment = segment_.data();
     }
     if (plan.kinds & kNormalsImage) {
       normal_.resize(3 * count);
       glReadBuffer(GL_COLOR_ATTACHMENT2);
       glReadPixels(0, 0, w, h, GL_RGB, GL_FLOAT, normal_.data());
-      FlippedImage(normal_, w, h, 3, &frame->normal_C);
+      raw.normal = normal_.data();
     }
     if (plan.deferred) {
       const std::vector<std::uint8_t>* image = &lit_;
@@ -374,20 +406,40 @@ class OsMesaRenderer : public Renderer {
         glBindFramebuffer(GL_READ_FRAMEBUFFER, targets_.overlay());
         glReadBuffer(GL_COLOR_ATTACHMENT0);
         glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, overlay_rgba_.data());
+        *marks = &overlay_rgba_;
       }
-      RgbImage(*image, w, h, plan.marks ? &overlay_rgba_ : nullptr, &frame->rgb);
+      raw.rgba = image->data();
     } else if (plan.kinds & kColorImage) {
       glBindFramebuffer(GL_FRAMEBUFFER, targets_.data());
       if (plan.marks) {
         glDrawBuffers(1, kColorOnly);
         DrawOverlay(*overlay);
       }
-      glFinish();
       pixels_.resize(4 * count);
       glReadBuffer(GL_COLOR_ATTACHMENT0);
       glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, pixels_.data());
-      RgbImage(pixels_, w, h, nullptr, &frame->rgb);
+      raw.rgba = pixels_.data();
     }
+    return raw;
+  }
+
+  // The images, rows flipped to top first, depth in metres.
+  void ReadBack(const CameraView& view, const RenderSettings& settings, const FramePlan& plan,
+                const Overlay* overlay, Frame* frame) {
+    const std::vector<std::uint32_t>* marks = nullptr;
+    const RawImages raw = ReadRaw(view, settings, plan, overlay, &marks);
+    const int w = view.width, h = view.height;
+    frame->width = w;
+    frame->height = h;
+    frame->kinds = plan.kinds;
+    frame->depth_m.clear();
+    frame->segment.clear();
+    frame->normal_C.clear();
+    frame->rgb.clear();
+    if (raw.depth) DepthImage(depth_, w, h, view.near_m, view.far_m, &frame->depth_m);
+    if (raw.segment) FlippedImage(segment_, w, h, &frame->segment);
+    if (raw.normal) FlippedImage(normal_, w, h, 3, &frame->normal_C);
+    if (raw.rgba) RgbImage(raw.rgba, w, h, marks, &frame->rgb);
   }
 
   void DrawOverlay(const Overlay& overlay) {
@@ -592,15 +644,15 @@ class OsMesaRenderer : public Renderer {
   GLfloat max_anisotropy_{1.f};
   GLuint anisotropic_{0};  // a sampler
   std::vector<std::string> warnings_;
-  // The last lens drawn through: its pinhole source view and remap, built once.
+  // A lens drawn through: its pinhole source view and remap.
   struct LensCache {
     Lens lens;
     int width, height;
     CameraView source;
     LensRemap remap;
   };
-  std::unique_ptr<LensCache> lens_;
-  Frame lens_source_;
+  static constexpr std::size_t kLensesKept = 8;  // the oldest goes first
+  std::vector<std::unique_ptr<LensCache>> lenses_;
 
   // The level.
   const scene::Level* level_{nullptr};
@@ -626,7 +678,7 @@ class OsMesaRenderer : public Renderer {
   float lod_px_{0.f}, pixel_angle_{0.f};
   // What was read back.
   SurfaceLayer opaque_, translucent_;
-  std::vector<std::uint8_t> lit_, filtered_, pixels_;
+  std::vector<std::uint8_t> lit_, filtered_, pixels_, marked_;
   std::vector<std::uint32_t> overlay_rgba_, segment_;
   std::vector<float> depth_, normal_;
 };

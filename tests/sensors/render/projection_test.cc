@@ -109,9 +109,9 @@ TEST(ReadBackTest, ColourDropsAlphaAndTakesTheMarks) {
                                           7, 8, 9, 255, 10, 11, 12, 255};
   const std::vector<std::uint32_t> marks = {0, 0xff332211u, 0, 0};
   std::vector<std::uint8_t> rgb;
-  RgbImage(rgba, 2, 2, nullptr, &rgb);
+  RgbImage(rgba.data(), 2, 2, nullptr, &rgb);
   EXPECT_EQ(rgb, (std::vector<std::uint8_t>{7, 8, 9, 10, 11, 12, 1, 2, 3, 4, 5, 6}));
-  RgbImage(rgba, 2, 2, &marks, &rgb);
+  RgbImage(rgba.data(), 2, 2, &marks, &rgb);
   EXPECT_EQ(rgb, (std::vector<std::uint8_t>{7, 8, 9, 10, 11, 12, 1, 2, 3, 0x11, 0x22, 0x33}));
 }
 

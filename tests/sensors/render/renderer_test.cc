@@ -1191,6 +1191,41 @@ TEST(RendererLensTest, MarkersLandWhereOpenCvProjectsThem) {
         frame.depth_m[std::size_t(std::lround(lens.cy)) * 640 + std::size_t(std::lround(lens.cx))],
         kDistance, 0.01)
         << lens.ModelName();
+
+    // The overlay through the lens, deferred and forward colour: a red mark
+    // (6 source pixels wide) before each marker's centre lands where OpenCV
+    // projects that centre.
+    Overlay overlay;
+    overlay.point_size_px = 6.f;
+    std::vector<cv::Point3d> marks;
+    for (const Vector3d& c : centres) {
+      overlay.AddPoint(c - Vector3d(0.5, 0, 0), Eigen::Vector3f(1.f, 0.f, 0.f));
+      marks.emplace_back(-c.y(), -c.z(), c.x() - 0.5);
+    }
+    std::vector<cv::Point2d> at;
+    if (lens.model == Lens::Model::kFisheye) {
+      cv::fisheye::projectPoints(marks, at, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K,
+                                 cv::Vec4d(lens.k1, lens.k2, lens.k3, lens.k4));
+    } else {
+      cv::projectPoints(marks, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K,
+                        std::vector<double>{lens.k1, lens.k2, lens.p1, lens.p2, lens.k3}, at);
+    }
+    for (const bool deferred : {true, false}) {
+      settings.deferred = deferred;
+      settings.images = kColorImage;
+      renderer->Render(view, {}, {}, settings, &frame, &overlay);
+      ASSERT_EQ(frame.rgb.size(), 3u * 640u * 480u);
+      int red = 0, inside = 0;
+      for (const cv::Point2d& p : at) {
+        const int u = int(std::lround(p.x)), v = int(std::lround(p.y));
+        if (u < 0 || u >= 640 || v < 0 || v >= 480) continue;
+        ++inside;
+        const std::uint8_t* rgb = &frame.rgb[3 * (std::size_t(v) * 640 + std::size_t(u))];
+        red += rgb[0] == 255 && rgb[1] == 0 && rgb[2] == 0;
+      }
+      EXPECT_GT(inside, 80) << lens.ModelName();
+      EXPECT_EQ(red, inside) << lens.ModelName() << (deferred ? ", deferred" : ", forward");
+    }
   }
 }
 
