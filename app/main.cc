@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "app/bench_frames_command.h"
+#include "app/convert_command.h"
 #include "app/demo_command.h"
 #include "app/info_command.h"
 #include "app/isolated_load.h"
@@ -31,6 +32,7 @@ const char* kUsage =
     "  render [LEVEL] --camera C --at X,Y,Z --out F  one camera frame (OSMesa)\n"
     "  topics                  the LCM channels heard: type, count, rate, size\n"
     "  view LOG                a recorded flight in the browser: replayed, then played back\n"
+    "  convert IN OUT          a recording from an LCM log to MCAP (Foxglove's format) or back\n"
     "LEVEL: a level manifest (.toml), a scene file, or a robot description (.urdf, .sdf)\n"
     "run 'sandbox COMMAND --help' for a command's options\n";
 
@@ -53,6 +55,7 @@ int main(int argc, char** argv) {
     if (args[0] == "render") return sandbox::app::RunRender(rest, std::cout, std::cerr);
     if (args[0] == "topics") return sandbox::app::RunTopics(rest, std::cout, std::cerr);
     if (args[0] == "view") return sandbox::app::RunView(rest, std::cout, std::cerr);
+    if (args[0] == "convert") return sandbox::app::RunConvert(rest, std::cout, std::cerr);
     // The child of an isolated load (--isolate); not for users.
     if (args[0] == "__load-level") return sandbox::app::RunLoadLevelChild(rest, std::cout);
   } catch (const std::exception& error) {

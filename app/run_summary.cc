@@ -16,7 +16,7 @@ std::string PaceName(const RunOptions& options) {
   return out.str();
 }
 
-void PrintReplayProgress(const bridge::LogReader& replay, std::int64_t ticks, double wall_s,
+void PrintReplayProgress(const bridge::EventReader& replay, std::int64_t ticks, double wall_s,
                          std::ostream& err) {
   const double done = replay.fraction_read();
   err << "\rreplay: " << std::setw(3) << int(100 * done) << "% | " << ticks << " ticks | "

@@ -30,7 +30,7 @@ struct RunRecord {
   std::int64_t ticks{0};
   double elapsed_s{0.0};
   TickStats* stats{nullptr};  // flushed here
-  const bridge::LogReader* replay{nullptr};
+  const bridge::EventReader* replay{nullptr};
   std::int64_t origin_moves{0};
   double longest_origin_move_ms{0.0};
   Eigen::Vector3d origin{Eigen::Vector3d::Zero()};
@@ -50,7 +50,7 @@ struct RunRecord {
 // The browser view's line of the summary: clients, states, bytes, refusals.
 void PrintWebCounts(const web::ServerCounts& counts, std::ostream& out);
 
-void PrintReplayProgress(const bridge::LogReader& replay, std::int64_t ticks, double wall_s,
+void PrintReplayProgress(const bridge::EventReader& replay, std::int64_t ticks, double wall_s,
                          std::ostream& err);
 
 // The name of the pace: "100 Hz", "free running" or "lock-step".

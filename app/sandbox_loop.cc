@@ -38,7 +38,7 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
       hooks_(std::move(hooks)),
       out_(out),
       err_(err),
-      log_(options.replay() ? std::make_unique<bridge::LogReader>(options.replay_file) : nullptr),
+      log_(options.replay() ? bridge::OpenEventReader(options.replay_file) : nullptr),
       // A replay feeds its inputs through an in-process link: nothing on the network.
       link_(options.replay() ? "memq://" : options.lcm_url),
       loaded_(LoadCheckedLevel(options.level, {},

@@ -159,14 +159,14 @@ class SandboxLoop {
   std::ostream& err_;
   StopRequest stop_;
   // The replayed log and the link before the level: a bad file or URL fails at once.
-  std::unique_ptr<bridge::LogReader> log_;
+  std::unique_ptr<bridge::EventReader> log_;
   std::unique_ptr<bridge::StatesAsInputs> log_states_;  // a --record log's STATEs as inputs
   std::vector<bridge::LogEvent> log_feed_;
   bridge::LcmLink link_;
   const LoadedLevel loaded_;
   const scene::Level& level_{loaded_.level};
   scene::CollisionWorld world_;
-  std::unique_ptr<scene::TerrainStreamer> terrain_;  // when the level has [[terrain]]
+  std::unique_ptr<scene::TerrainStreamer> terrain_;   // when the level has [[terrain]]
   std::optional<scene::LocalTangentPlane> geodetic_;  // its anchor, for the instruments
   std::vector<Eigen::Vector3d> robot_positions_;
   sensors::RayCaster caster_;

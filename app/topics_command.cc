@@ -25,7 +25,7 @@ const char* kUsage =
     "  --every    print the table every S seconds, rates over that window (default: 1 on a\n"
     "             terminal, redrawn in place; else only once, at the end)\n"
     "  --json     each table as one JSON object on a line (JSON Lines), for scripts\n"
-    "  --log FILE the same for the events of an LCM log (rates by the events' times)\n";
+    "  --log FILE the same for the events of an LCM log or MCAP file (rates by the events' times)\n";
 
 // Escapes a string for a JSON value (channel names are anyone's bytes).
 std::string Json(const std::string& text) {

@@ -138,7 +138,7 @@ bool LcmLink::Inject(const std::string& channel, const void* data, unsigned size
 
 bool LcmLink::Wait(int timeout_ms) { return impl_->lcm.handleTimeout(timeout_ms) > 0; }
 
-void LcmLink::RecordTo(const std::string& path) { record_ = std::make_unique<LogWriter>(path); }
+void LcmLink::RecordTo(const std::string& path) { record_ = OpenEventWriter(path); }
 
 bool LcmLink::FinishRecording() { return !record_ || record_->Close(); }
 

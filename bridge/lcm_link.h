@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "bridge/event_log.h"
 #include "bridge/reject_log.h"
 
 namespace sandbox::bridge {
@@ -33,24 +34,22 @@ std::string WithReceiveBuffer(const std::string& url);
 // Writes an LCM log file event by event, in lcm-logger's format (see
 // LogReader). Write errors (a full disk, /dev/full) are kept, not thrown: the
 // first one stops the writing and error() says what happened.
-class LogWriter {
+class LogWriter final : public EventWriter {
  public:
   // Throws std::runtime_error naming the file when it cannot be opened for
   // writing, or is a FIFO, a socket or a folder (a FIFO would block).
   explicit LogWriter(const std::string& path);
-  ~LogWriter();
+  ~LogWriter() override;
   LogWriter(const LogWriter&) = delete;
   LogWriter& operator=(const LogWriter&) = delete;
 
-  // Appends one event; false once writing has failed.
-  bool Write(const std::string& channel, const void* data, unsigned size, std::int64_t utime);
-  // Flushes and closes; false when that or any earlier write failed.
-  bool Close();
-  bool failed() const { return !error_.empty(); }
+  bool Write(const std::string& channel, const void* data, unsigned size,
+             std::int64_t utime) override;
+  bool Close() override;  // flushes and closes
   // Empty while everything was written, else "cannot write 'x.lcmlog' after
   // 12 events: No space left on device".
-  const std::string& error() const { return error_; }
-  std::int64_t events() const { return events_; }
+  std::string error() const override { return error_; }
+  std::int64_t events() const override { return events_; }
 
  private:
   void Fail(int error_number);
@@ -79,17 +78,19 @@ class LcmLink {
   // Publishes raw bytes (an encoded LCM message). Returns false on failure.
   bool Publish(const std::string& channel, const void* data, unsigned size);
   // Also hands every message Publish() sends to `tap` (on the publishing thread).
-  using PublishTap = std::function<void(const std::string& channel, const void* data, unsigned size)>;
+  using PublishTap =
+      std::function<void(const std::string& channel, const void* data, unsigned size)>;
   void set_publish_tap(PublishTap tap) { tap_ = std::move(tap); }
   // Publishes without recording (a replay feeding its inputs through memq://).
   bool Inject(const std::string& channel, const void* data, unsigned size);
   // Waits up to `timeout_ms` for one message and handles it; false on timeout.
   bool Wait(int timeout_ms);
 
-  // Also writes every message this link publishes to an LCM log file, stamped
-  // with the time set by set_record_utime() (deterministic in lock-step runs).
-  // Throws std::runtime_error naming the file when it cannot be opened; a
-  // later write error is kept in record_error() and stops the recording.
+  // Also writes every message this link publishes to a recording (an MCAP
+  // file for a name ending in ".mcap", else an LCM log file), stamped with the
+  // time set by set_record_utime() (deterministic in lock-step runs). Throws
+  // std::runtime_error naming the file when it cannot be opened; a later
+  // write error is kept in record_error() and stops the recording.
   void RecordTo(const std::string& path);
   void set_record_utime(std::int64_t utime) { record_utime_ = utime; }
   // Closes the recording (flushing it); false when any of it could not be written.
@@ -104,7 +105,7 @@ class LcmLink {
  private:
   std::string url_;
   std::unique_ptr<Impl> impl_;
-  std::unique_ptr<LogWriter> record_;
+  std::unique_ptr<EventWriter> record_;
   std::int64_t record_utime_{0};
   PublishTap tap_;
 };
@@ -113,7 +114,7 @@ class LcmLink {
 // format (lcm-logger's): per event a big-endian sync word 0xEDA1DA01, event
 // number (int64), utime (int64), channel length and data length (int32),
 // then the channel name and the data.
-class LogReader {
+class LogReader final : public EventReader {
  public:
   // Events larger than this are skipped without being read (counted in skipped()).
   static constexpr std::uint32_t kDefaultMaxEventBytes = 64u << 20;
@@ -122,21 +123,20 @@ class LogReader {
   // a regular file (a FIFO would block) or does not start like an LCM log.
   explicit LogReader(const std::string& path,
                      std::uint32_t max_event_bytes = kDefaultMaxEventBytes);
-  ~LogReader();
+  ~LogReader() override;
   LogReader(const LogReader&) = delete;
   LogReader& operator=(const LogReader&) = delete;
 
-  // The next event, or false at the end of the file or of its valid part.
-  bool Next(std::string* channel, std::vector<std::uint8_t>* data, std::int64_t* utime);
+  bool Next(std::string* channel, std::vector<std::uint8_t>* data, std::int64_t* utime) override;
   // How far the replay is, 0 .. 1: by the events' times (the time of the
   // last event read between the first event's and the last's), else, when
   // the last event cannot be found (a log cut short), by bytes.
-  double fraction_read() const;
-  std::int64_t events() const { return events_; }  // read so far
-  std::int64_t skipped() const { return skipped_; }
+  double fraction_read() const override;
+  std::int64_t events() const override { return events_; }
+  std::int64_t skipped() const override { return skipped_; }
   // Empty after a clean end; otherwise where and why reading stopped, e.g.
   // "truncated: event 1201 at byte 120345 of 120400 needs 88 bytes".
-  const std::string& stopped_early() const { return stopped_early_; }
+  const std::string& stopped_early() const override { return stopped_early_; }
 
  private:
   // The time of the event that ends the file, when one does within its last megabyte.

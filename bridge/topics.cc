@@ -7,21 +7,7 @@
 #include <stdexcept>
 
 #include "bridge/lcm_link_impl.h"
-#include "sandbox_msgs/actor_placements_t.hpp"
-#include "sandbox_msgs/air_data_t.hpp"
-#include "sandbox_msgs/bone_values_t.hpp"
-#include "sandbox_msgs/camera_command_t.hpp"
-#include "sandbox_msgs/gnss_t.hpp"
-#include "sandbox_msgs/ground_map_t.hpp"
-#include "sandbox_msgs/imu_t.hpp"
-#include "sandbox_msgs/lidar_scan_t.hpp"
-#include "sandbox_msgs/range_t.hpp"
-#include "sandbox_msgs/robot_pose_t.hpp"
-#include "sandbox_msgs/robot_state_t.hpp"
-#include "sandbox_msgs/scan_face_compact_t.hpp"
-#include "sandbox_msgs/scan_face_t.hpp"
-#include "sandbox_msgs/status_t.hpp"
-#include "sandbox_msgs/wrench_t.hpp"
+#include "bridge/lcm_types.h"
 
 namespace sandbox::bridge {
 namespace {
@@ -31,26 +17,7 @@ std::string TypeOf(const std::uint8_t* data, std::uint32_t size) {
   if (size < 8) return "?";
   std::int64_t hash = 0;
   for (int i = 0; i < 8; ++i) hash = (hash << 8) | data[i];
-  using namespace sandbox_msgs;
-  const std::pair<std::int64_t, const char*> known[] = {
-      {robot_pose_t::getHash(), "robot_pose_t"},
-      {bone_values_t::getHash(), "bone_values_t"},
-      {actor_placements_t::getHash(), "actor_placements_t"},
-      {camera_command_t::getHash(), "camera_command_t"},
-      {scan_face_t::getHash(), "scan_face_t"},
-      {scan_face_compact_t::getHash(), "scan_face_compact_t"},
-      {ground_map_t::getHash(), "ground_map_t"},
-      {imu_t::getHash(), "imu_t"},
-      {gnss_t::getHash(), "gnss_t"},
-      {air_data_t::getHash(), "air_data_t"},
-      {lidar_scan_t::getHash(), "lidar_scan_t"},
-      {range_t::getHash(), "range_t"},
-      {robot_state_t::getHash(), "robot_state_t"},
-      {wrench_t::getHash(), "wrench_t"},
-      {status_t::getHash(), "status_t"}};
-  for (const auto& [known_hash, name] : known) {
-    if (known_hash == hash) return name;
-  }
+  if (const LcmType* type = LcmTypeOf(data, size)) return type->name;
   char text[24];
   std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(hash));
   return text;
@@ -122,14 +89,14 @@ void TopicMonitor::StartWindow() {
 std::map<std::string, ChannelStats> ReadLogTopics(const std::string& path,
                                                   std::string* stopped_early) {
   std::map<std::string, ChannelStats> stats;
-  LogReader log(path);
+  const std::unique_ptr<EventReader> log = OpenEventReader(path);
   std::string channel;
   std::vector<std::uint8_t> data;
   std::int64_t utime = 0;
-  while (log.Next(&channel, &data, &utime)) {
+  while (log->Next(&channel, &data, &utime)) {
     Count(channel, data.data(), std::uint32_t(data.size()), utime, &stats);
   }
-  *stopped_early = log.stopped_early();
+  *stopped_early = log->stopped_early();
   return stats;
 }
 

@@ -5,12 +5,11 @@
 #include <chrono>
 #include <cstdint>
 #include <deque>
+#include <lcm/lcm-cpp.hpp>
 #include <memory>
 #include <string>
 #include <tuple>
 #include <vector>
-
-#include <lcm/lcm-cpp.hpp>
 
 #include "bridge/lcm_link.h"
 #include "bridge/lcm_link_impl.h"
@@ -110,13 +109,13 @@ void BindLcm(py::module_& module) {
            "[(channel, receive utime, bytes)], oldest first; waits up to timeout s for the "
            "first");
 
-  py::class_<bridge::LogReader>(module, "_LogReader",
-                                "An LCM log file read event by event (bridge::LogReader). "
-                                "sandbox.read_log is the interface.")
-      .def(py::init<const std::string&>(), py::arg("path"))
+  py::class_<bridge::EventReader>(module, "_LogReader",
+                                  "An LCM log or MCAP file read event by event "
+                                  "(bridge::EventReader). sandbox.read_log is the interface.")
+      .def(py::init(&bridge::OpenEventReader), py::arg("path"))
       .def(
           "next",
-          [](bridge::LogReader& reader) -> py::object {
+          [](bridge::EventReader& reader) -> py::object {
             std::string channel;
             std::vector<std::uint8_t> data;
             std::int64_t utime = 0;
@@ -129,9 +128,9 @@ void BindLcm(py::module_& module) {
             return py::make_tuple(channel, utime, Bytes(data));
           },
           "(channel, utime, bytes), or None at the end")
-      .def_property_readonly("events", &bridge::LogReader::events)
-      .def_property_readonly("skipped", &bridge::LogReader::skipped)
-      .def_property_readonly("stopped_early", &bridge::LogReader::stopped_early);
+      .def_property_readonly("events", &bridge::EventReader::events)
+      .def_property_readonly("skipped", &bridge::EventReader::skipped)
+      .def_property_readonly("stopped_early", &bridge::EventReader::stopped_early);
 }
 
 }  // namespace sandbox::python

@@ -65,9 +65,10 @@ class Log:
 
 
 def read_log(path, channels=None):
-    """Reads an LCM log file (`sandbox run --record`, lcm-logger) into a `Log`,
-    the messages of `channels` only when given (a list of names). A file that
-    is not an LCM log raises RuntimeError naming it."""
+    """Reads an LCM log file (`sandbox run --record`, lcm-logger) or an MCAP
+    recording (`--record FILE.mcap`) into a `Log`, the messages of `channels`
+    only when given (a list of names). A file that is neither raises
+    RuntimeError naming it."""
     wanted = None if channels is None else set(channels)
     reader = _sandbox._LogReader(str(path))
     log = Log(path)

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "bridge/lcm_link.h"
+#include "bridge/mcap_writer.h"
 #include "bridge/net_fdm.h"
 #include "sandbox_msgs/actor_placements_t.hpp"
 #include "sandbox_msgs/bone_values_t.hpp"
@@ -162,6 +163,26 @@ void LogSeeds(const fs::path& dir) {
     recorded.Write("R/STATE", bytes.data(), unsigned(bytes.size()), 1000 * i);
   }
   recorded.Close();
+}
+
+// Small recordings in each chunk compression, one with a message of a type
+// the sandbox does not know (a channel without a schema).
+void McapSeeds(const fs::path& dir) {
+  fs::create_directories(dir);
+  sandbox_msgs::robot_pose_t pose{};
+  pose.orientation[0] = 1;
+  const Bytes other = "not an LCM message";
+  for (const std::string compression : {"zstd", "lz4", ""}) {
+    sandbox::bridge::McapWriter writer((dir / ("flight_" + compression)).string(),
+                                       {compression, 200});
+    for (int i = 0; i < 4; ++i) {
+      pose.seq = i;
+      const Bytes bytes = Encode(pose);
+      writer.Write("ELAHA/POSE", bytes.data(), unsigned(bytes.size()), 1000 * i);
+      writer.Write("OTHER", other.data(), unsigned(other.size()), 1000 * i);
+    }
+    writer.Close();
+  }
 }
 
 // PNG's CRC-32, for the zip below.
@@ -383,6 +404,7 @@ int main(int argc, char** argv) {
   LcmSeeds(dir / "lcm_inputs");
   UdpSeeds(dir / "udp");
   LogSeeds(dir / "lcm_log");
+  McapSeeds(dir / "mcap");
   LevelFileSeeds(dir / "level_file");
   RasterSeeds(dir / "raster");
   TileCacheSeeds(dir / "tile_cache");

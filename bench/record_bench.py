@@ -1,0 +1,89 @@
+#!/usr/bin/python3
+"""What recording costs the loop: `sandbox run --replay` of the same inputs
+(the sample level, 3000 ticks of poses and bends, its sensors on) without a
+recording, with an LCM log and with MCAP (zstd, lz4), in turns; each run's
+mean tick against the unrecorded run's (target for MCAP: at most 1.05x), the
+files' sizes against the LCM log's (target: at most 0.7x), and the writer
+thread's own work a tick (`sandbox convert` of the LCM log, timed).
+
+usage: PYTHONPATH=build/python bench/record_bench.py [ROUNDS]   (default 5)
+"""
+import math
+import os
+import pathlib
+import re
+import statistics
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+
+from sandbox import sandbox_msgs
+
+SANDBOX = os.environ.get("SANDBOX", str(pathlib.Path(__file__).resolve().parents[1] / "build/sandbox"))
+TICKS = 3000
+
+
+def write_inputs(path):
+    """An LCM log (lcm-logger's format) of TICKS poses and bends at 100 Hz."""
+    with open(path, "wb") as f:
+        number = 0
+        for k in range(TICKS):
+            utime = 1_000_000 + 10_000 * k
+            pose = sandbox_msgs.robot_pose_t()
+            heading = 0.002 * k
+            pose.utime, pose.seq = utime, k
+            pose.position = (30 * math.cos(heading), 30 * math.sin(heading) - 12, 25.0)
+            pose.orientation = (math.cos(heading / 2), 0.0, 0.0, math.sin(heading / 2))
+            for channel, data in (("ELAHA/POSE", pose.encode()),):
+                f.write(struct.pack(">IqqII", 0xEDA1DA01, number, utime, len(channel), len(data)))
+                f.write(channel.encode() + data)
+                number += 1
+
+
+def mean_tick_ms(inputs, record):
+    args = [SANDBOX, "run", "--replay", str(inputs)] + (["--record", str(record)] if record else [])
+    done = subprocess.run(args, capture_output=True, text=True, check=True)
+    return float(re.search(r"mean tick ([0-9.]+) ms", done.stdout).group(1))
+
+
+def main():
+    rounds = int(sys.argv[1]) if len(sys.argv) > 1 else 5
+    with tempfile.TemporaryDirectory(prefix="sandbox-record-bench-") as folder:
+        folder = pathlib.Path(folder)
+        inputs = folder / "inputs.lcmlog"
+        write_inputs(inputs)
+        kinds = {"none": None, "LCM log": folder / "run.lcmlog", "MCAP zstd": folder / "run.mcap",
+                 "MCAP lz4": folder / "lz4.mcap"}
+        ticks = {kind: [] for kind in kinds}
+        for _ in range(rounds):
+            for kind, record in kinds.items():
+                ticks[kind].append(mean_tick_ms(inputs, record))
+        subprocess.run([SANDBOX, "convert", str(kinds["LCM log"]), str(kinds["MCAP lz4"]),
+                        "--compression", "lz4"], check=True, capture_output=True)
+        print(f"record_bench: the sample level replayed, {TICKS} ticks, sensors on, "
+              f"{rounds} rounds in turns (median)")
+        print("%-12s %14s %10s %14s %10s" % ("recording", "mean tick ms", "ratio", "bytes", "size"))
+        log_bytes = kinds["LCM log"].stat().st_size
+        reference = statistics.median(ticks["none"])
+        for kind, record in kinds.items():
+            tick = statistics.median(ticks[kind])
+            size = record.stat().st_size if record else 0
+            print("%-12s %14.3f %10.3f %14d %10s" % (
+                kind, tick, tick / reference, size,
+                "%.3f" % (size / log_bytes) if record else "-"))
+        print("the writer's thread, a tick (sandbox convert of the LCM log, best of %d):" % rounds)
+        for compression in ("zstd", "lz4"):
+            best = float("inf")
+            for _ in range(rounds):
+                start = time.perf_counter()
+                subprocess.run([SANDBOX, "convert", str(kinds["LCM log"]), str(folder / "c.mcap"),
+                                "--compression", compression], check=True, capture_output=True)
+                best = min(best, time.perf_counter() - start)
+            print("  %-5s %8.3f ms a tick, %.3f of the unrecorded tick (start-up included)" % (
+                compression, 1e3 * best / TICKS, 1e3 * best / TICKS / reference))
+
+
+if __name__ == "__main__":
+    main()

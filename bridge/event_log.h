@@ -1,0 +1,52 @@
+#pragma once
+// Recordings of a run's messages, whatever their file format: an LCM log
+// (lcm-logger's) or an MCAP file, chosen by the file's name when writing and
+// by its first bytes when reading. Threads: the caller's (a writer may keep a
+// thread of its own behind Write()).
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace sandbox::bridge {
+
+// Events in, one at a time. Write errors are kept, not thrown: the first one
+// stops the writing and error() says what happened.
+class EventWriter {
+ public:
+  virtual ~EventWriter() = default;
+  // Appends one event (the bytes are copied before it returns); false once
+  // writing has failed.
+  virtual bool Write(const std::string& channel, const void* data, unsigned size,
+                     std::int64_t utime) = 0;
+  // Finishes the file; false when that or any earlier write failed.
+  virtual bool Close() = 0;
+  // Empty while everything was written, else what failed and where.
+  virtual std::string error() const = 0;
+  bool failed() const { return !error().empty(); }
+  virtual std::int64_t events() const = 0;
+};
+
+// Events out, in the file's order, for replays and conversions.
+class EventReader {
+ public:
+  virtual ~EventReader() = default;
+  // The next event, or false at the end of the file or of its valid part.
+  virtual bool Next(std::string* channel, std::vector<std::uint8_t>* data, std::int64_t* utime) = 0;
+  // How far reading is, 0 .. 1.
+  virtual double fraction_read() const = 0;
+  virtual std::int64_t events() const = 0;   // read so far
+  virtual std::int64_t skipped() const = 0;  // not LCM messages, or over the size limit
+  // Empty after a clean end; otherwise where and why reading stopped.
+  virtual const std::string& stopped_early() const = 0;
+};
+
+// An MCAP file for a name ending in ".mcap", else an LCM log. Throws
+// std::runtime_error naming the file when it cannot be written.
+std::unique_ptr<EventWriter> OpenEventWriter(const std::string& path);
+// An MCAP reader when the file starts with MCAP's magic, else an LCM log
+// reader. Throws std::runtime_error naming the file when it is neither.
+std::unique_ptr<EventReader> OpenEventReader(const std::string& path);
+
+}  // namespace sandbox::bridge

@@ -1,0 +1,264 @@
+#include "bridge/mcap_writer.h"
+
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+
+#include "bridge/lcm_types.h"
+#include "bridge/mcap_records.h"
+
+namespace sandbox::bridge {
+
+using mcap::Builder;
+
+namespace {
+
+// The summary's group of one opcode, for its summary offset record.
+struct Group {
+  mcap::Opcode opcode;
+  std::size_t start, length;  // in the summary
+};
+
+}  // namespace
+
+McapWriter::McapWriter(const std::string& path, Options options)
+    : path_(path), options_(std::move(options)) {
+  if (options_.compression != "zstd" && options_.compression != "lz4" &&
+      !options_.compression.empty()) {
+    throw std::invalid_argument("MCAP: no compression '" + options_.compression +
+                                "' (zstd, lz4 or none)");
+  }
+  // Regular files and character devices (/dev/null) only: a FIFO blocks.
+  struct stat info {};
+  if (::stat(path.c_str(), &info) == 0 && !S_ISREG(info.st_mode) && !S_ISCHR(info.st_mode)) {
+    throw std::runtime_error("cannot write the MCAP file '" + path + "': not a regular file");
+  }
+  file_ = std::fopen(path.c_str(), "wb");
+  if (file_ == nullptr) {
+    throw std::runtime_error("cannot write the MCAP file '" + path + "': " + std::strerror(errno));
+  }
+  std::string start(mcap::kMagic, sizeof(mcap::kMagic));
+  Builder b(&start);
+  const std::size_t header = b.BeginRecord(mcap::kHeader);
+  b.String("").String("sandbox");  // no well-known profile; the library
+  b.EndRecord(header);
+  Put(start);
+  thread_ = std::thread(&McapWriter::Run, this);
+}
+
+McapWriter::~McapWriter() { Close(); }
+
+bool McapWriter::Write(const std::string& channel, const void* data, unsigned size,
+                       std::int64_t utime) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  changed_.wait(lock, [&] { return queued_bytes_ < kMaxQueuedBytes || closing_; });
+  if (closing_ || !error_.empty()) return false;
+  queue_.push_back({channel, std::string(static_cast<const char*>(data), size), utime});
+  queued_bytes_ += size + channel.size();
+  ++events_;
+  changed_.notify_all();
+  return true;
+}
+
+bool McapWriter::Close() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    closing_ = true;
+    changed_.notify_all();
+  }
+  if (thread_.joinable()) thread_.join();
+  if (file_ != nullptr) {
+    errno = 0;
+    if (std::fclose(file_) != 0) Fail(std::strerror(errno != 0 ? errno : EIO));
+    file_ = nullptr;
+  }
+  return error().empty();
+}
+
+std::string McapWriter::error() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return error_;
+}
+
+std::int64_t McapWriter::events() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return events_;
+}
+
+void McapWriter::Run() {
+  for (;;) {
+    Event event;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      changed_.wait(lock, [&] { return !queue_.empty() || closing_; });
+      if (queue_.empty()) break;  // closing, and everything written
+      event = std::move(queue_.front());
+      queue_.pop_front();
+      queued_bytes_ -= event.data.size() + event.channel.size();
+      changed_.notify_all();
+    }
+    Add(event);
+  }
+  Finish();
+}
+
+std::uint16_t McapWriter::SchemaOf(const Event& event) {
+  const LcmType* type =
+      LcmTypeOf(reinterpret_cast<const std::uint8_t*>(event.data.data()), event.data.size());
+  if (type == nullptr) return 0;  // no schema
+  const auto [it, added] =
+      schema_ids_.emplace(type->full_name(), std::uint16_t(schema_ids_.size() + 1));
+  if (added) {
+    for (std::string* out : {&chunk_, &schemas_}) {
+      Builder b(out);
+      const std::size_t record = b.BeginRecord(mcap::kSchema);
+      b.U16(it->second).String(type->full_name()).String("lcm").String(type->schema);
+      b.EndRecord(record);
+    }
+  }
+  return it->second;
+}
+
+std::uint16_t McapWriter::ChannelOf(const Event& event) {
+  const std::uint16_t schema = SchemaOf(event);
+  const auto [it, added] = channel_ids_.emplace(ChannelKey{event.channel, schema},
+                                                std::uint16_t(channel_ids_.size() + 1));
+  if (added) {
+    for (std::string* out : {&chunk_, &channels_}) {
+      Builder b(out);
+      const std::size_t record = b.BeginRecord(mcap::kChannel);
+      b.U16(it->second).U16(schema).String(event.channel).String("lcm").U32(0);  // no metadata
+      b.EndRecord(record);
+    }
+  }
+  return it->second;
+}
+
+void McapWriter::Add(const Event& event) {
+  if (!error().empty()) return;
+  if (channel_ids_.size() == 0xffff) return Fail("over 65535 channels");
+  const std::uint16_t channel = ChannelOf(event);
+  const std::uint64_t time = std::uint64_t(event.utime) * 1000;  // nanoseconds
+  chunk_index_[channel].emplace_back(time, chunk_.size());
+  Builder b(&chunk_);
+  const std::size_t record = b.BeginRecord(mcap::kMessage);
+  b.U16(channel).U32(sequence_[channel]++).U64(time).U64(time).Bytes(event.data);
+  b.EndRecord(record);
+  if (messages_ == 0 || time < first_time_) first_time_ = time;
+  if (messages_ == 0 || time > last_time_) last_time_ = time;
+  if (chunk_index_.size() == 1 && chunk_index_.begin()->second.size() == 1) {
+    chunk_start_ = chunk_end_ = time;  // the chunk's first message
+  }
+  chunk_start_ = std::min(chunk_start_, time);
+  chunk_end_ = std::max(chunk_end_, time);
+  ++messages_;
+  ++channel_counts_[channel];
+  if (chunk_.size() >= options_.chunk_bytes) FinishChunk();
+}
+
+void McapWriter::FinishChunk() {
+  if (chunk_.empty()) return;
+  std::string compressed;
+  try {
+    compressed = mcap::Compress(options_.compression, chunk_);
+  } catch (const std::exception& e) {
+    return Fail(e.what());
+  }
+  std::string out;
+  Builder b(&out);
+  const std::size_t record = b.BeginRecord(mcap::kChunk);
+  b.U64(chunk_start_).U64(chunk_end_).U64(chunk_.size()).U32(mcap::Crc32(chunk_));
+  b.String(options_.compression).U64(compressed.size()).Bytes(compressed);
+  b.EndRecord(record);
+  const std::uint64_t chunk_offset = offset_, chunk_length = out.size();
+  std::map<std::uint16_t, std::uint64_t> index_offsets;
+  for (const auto& [channel, entries] : chunk_index_) {
+    index_offsets[channel] = chunk_offset + out.size();
+    const std::size_t index = b.BeginRecord(mcap::kMessageIndex);
+    b.U16(channel).U32(std::uint32_t(entries.size() * 16));
+    for (const auto& [time, at] : entries) b.U64(time).U64(at);
+    b.EndRecord(index);
+  }
+  Put(out);
+
+  Builder s(&chunk_indexes_);
+  const std::size_t chunk_index = s.BeginRecord(mcap::kChunkIndex);
+  s.U64(chunk_start_).U64(chunk_end_).U64(chunk_offset).U64(chunk_length);
+  s.U32(std::uint32_t(index_offsets.size() * 10));
+  for (const auto& [channel, at] : index_offsets) s.U16(channel).U64(at);
+  s.U64(out.size() - chunk_length).String(options_.compression);
+  s.U64(compressed.size()).U64(chunk_.size());
+  s.EndRecord(chunk_index);
+
+  ++chunks_;
+  chunk_.clear();
+  chunk_index_.clear();
+}
+
+void McapWriter::Finish() {
+  FinishChunk();
+  std::string end;
+  Builder e(&end);
+  const std::size_t data_end = e.BeginRecord(mcap::kDataEnd);
+  e.U32(data_crc_);
+  e.EndRecord(data_end);
+  Put(end);
+
+  const std::uint64_t summary_start = offset_;
+  std::string summary;
+  std::vector<Group> groups;
+  const auto group = [&](mcap::Opcode opcode, const std::string& records) {
+    if (records.empty()) return;
+    groups.push_back({opcode, summary.size(), records.size()});
+    summary += records;
+  };
+  group(mcap::kSchema, schemas_);
+  group(mcap::kChannel, channels_);
+  std::string statistics;
+  Builder st(&statistics);
+  const std::size_t record = st.BeginRecord(mcap::kStatistics);
+  st.U64(messages_).U16(std::uint16_t(schema_ids_.size())).U32(std::uint32_t(channel_ids_.size()));
+  st.U32(0).U32(0).U32(chunks_);  // no attachments, no metadata
+  st.U64(first_time_).U64(last_time_).U32(std::uint32_t(channel_counts_.size() * 10));
+  for (const auto& [channel, count] : channel_counts_) st.U16(channel).U64(count);
+  st.EndRecord(record);
+  group(mcap::kStatistics, statistics);
+  group(mcap::kChunkIndex, chunk_indexes_);
+
+  const std::uint64_t offsets_start = summary_start + summary.size();
+  Builder b(&summary);
+  for (const Group& g : groups) {
+    const std::size_t offset = b.BeginRecord(mcap::kSummaryOffset);
+    b.U8(g.opcode).U64(summary_start + g.start).U64(g.length);
+    b.EndRecord(offset);
+  }
+  b.U8(mcap::kFooter).U64(20).U64(summary_start).U64(offsets_start);
+  b.U32(mcap::Crc32(summary));  // from the summary's start through the footer's offsets
+  b.Bytes(std::string_view(mcap::kMagic, sizeof(mcap::kMagic)));
+  Put(summary);
+  errno = 0;
+  if (file_ != nullptr && std::fflush(file_) != 0) Fail(std::strerror(errno != 0 ? errno : EIO));
+}
+
+void McapWriter::Put(const std::string& bytes) {
+  if (file_ == nullptr || !error().empty()) return;
+  errno = 0;
+  if (std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size()) {
+    return Fail(std::strerror(errno != 0 ? errno : EIO));
+  }
+  data_crc_ = mcap::Crc32(bytes, data_crc_);
+  offset_ += bytes.size();
+}
+
+void McapWriter::Fail(const std::string& why) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (error_.empty()) {
+    error_ =
+        "cannot write '" + path_ + "' after " + std::to_string(messages_) + " messages: " + why;
+  }
+  changed_.notify_all();
+}
+
+}  // namespace sandbox::bridge

@@ -1,0 +1,214 @@
+// MCAP recordings: the writer's files read back by the reader in every
+// compression, and damaged files (offsets from the specification's record
+// layout, not from the code): a bad magic, a chunk whose CRC or compressed
+// bytes are wrong, a file cut inside a chunk, a length that lies, a changed
+// byte outside the chunks (the data section's CRC). The npm reader
+// (@mcap/core) checks the writer independently: tests/python/test_mcap.py.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "bridge/event_log.h"
+#include "bridge/lcm_link.h"
+#include "bridge/mcap_reader.h"
+#include "bridge/mcap_writer.h"
+#include "sandbox_msgs/robot_pose_t.hpp"
+#include "tests/test_util.h"
+
+namespace sandbox::bridge {
+namespace {
+
+// The first chunk's record: after the magic (8) and the header (opcode,
+// length, an empty profile and the library "sandbox": 1 + 8 + 4 + 4 + 7).
+constexpr std::size_t kFirstChunk = 8 + 24;
+// Its fields before the records: opcode, length, start, end, size, CRC,
+// compression (empty), the records' length.
+constexpr std::size_t kRecordsLength = kFirstChunk + 1 + 8 + 8 + 8 + 8 + 4 + 4;
+
+struct Event {
+  std::string channel;
+  std::vector<std::uint8_t> data;
+  std::int64_t utime;
+  bool operator==(const Event& o) const {
+    return channel == o.channel && data == o.data && utime == o.utime;
+  }
+};
+
+std::vector<Event> SomeEvents(int n) {
+  std::mt19937 random(7);
+  std::vector<Event> events;
+  for (int k = 0; k < n; ++k) {
+    if (k % 3 == 0) {  // a sandbox type, with a schema
+      sandbox_msgs::robot_pose_t pose{};
+      pose.utime = k;
+      pose.position[0] = 0.5 * k;
+      pose.orientation[0] = 1.0;
+      std::vector<std::uint8_t> bytes(std::size_t(pose.getEncodedSize()));
+      pose.encode(bytes.data(), 0, int(bytes.size()));
+      events.push_back({"R/POSE", bytes, 1'000'000 + 10'000 * k});
+    } else {  // anything else, without one (sizes 0 to 3000)
+      std::vector<std::uint8_t> bytes(random() % 3001);
+      for (auto& b : bytes) b = std::uint8_t(random());
+      events.push_back({k % 2 ? "OTHER" : "R/SCAN", bytes, 1'000'000 + 10'000 * k});
+    }
+  }
+  return events;
+}
+
+void Write(const std::string& path, const std::vector<Event>& events, McapWriter::Options options) {
+  McapWriter writer(path, options);
+  for (const Event& e : events) {
+    ASSERT_TRUE(writer.Write(e.channel, e.data.data(), unsigned(e.data.size()), e.utime));
+  }
+  ASSERT_TRUE(writer.Close()) << writer.error();
+  EXPECT_EQ(writer.events(), std::int64_t(events.size()));
+}
+
+std::vector<Event> ReadAll(EventReader& reader) {
+  std::vector<Event> events;
+  Event e;
+  while (reader.Next(&e.channel, &e.data, &e.utime)) events.push_back(e);
+  return events;
+}
+
+std::string Bytes(const std::string& path) {
+  std::string bytes(std::filesystem::file_size(path), '\0');
+  std::ifstream(path, std::ios::binary).read(bytes.data(), std::streamsize(bytes.size()));
+  return bytes;
+}
+
+void Put(const std::string& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+TEST(McapTest, EveryEventComesBackInOrderInEveryCompression) {
+  testing::TempDir dir;
+  const std::vector<Event> events = SomeEvents(300);
+  for (const std::string compression : {"", "zstd", "lz4"}) {
+    const std::string path = (dir.path() / ("run" + compression + ".mcap")).string();
+    Write(path, events, {compression, 20'000});  // about 25 chunks
+    const std::unique_ptr<EventReader> reader = OpenEventReader(path);
+    EXPECT_EQ(ReadAll(*reader), events) << "compression '" << compression << "'";
+    EXPECT_EQ(reader->stopped_early(), "");
+    EXPECT_EQ(reader->events(), 300);
+    EXPECT_DOUBLE_EQ(reader->fraction_read(), 1.0);
+  }
+}
+
+TEST(McapTest, TheFileNameChoosesTheWriterAndTheFirstBytesTheReader) {
+  testing::TempDir dir;
+  const std::vector<Event> events = SomeEvents(10);
+  for (const std::string name : {"a.mcap", "a.lcmlog", "a"}) {
+    const std::string path = (dir.path() / name).string();
+    {
+      const std::unique_ptr<EventWriter> writer = OpenEventWriter(path);
+      for (const Event& e : events)
+        writer->Write(e.channel, e.data.data(), unsigned(e.data.size()), e.utime);
+      ASSERT_TRUE(writer->Close());
+    }
+    const bool mcap = Bytes(path).compare(0, 5, "\x89MCAP") == 0;
+    EXPECT_EQ(mcap, name == std::string("a.mcap"));
+    EXPECT_EQ(ReadAll(*OpenEventReader(path)), events) << name;
+  }
+}
+
+TEST(McapTest, AFileWithoutTheMagicIsRefusedNamingIt) {
+  testing::TempDir dir;
+  const std::string path = (dir.path() / "not.mcap").string();
+  Put(path, "\x89MCAQ0\r\n and more");
+  try {
+    McapReader reader(path);
+    FAIL() << "read a file without the magic";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), "'" + path + "' is not an MCAP file: no MCAP magic at byte 0");
+  }
+}
+
+class DamagedMcap : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    path_ = (dir_.path() / "run.mcap").string();
+    Write(path_, SomeEvents(30), {"", 1 << 20});  // one uncompressed chunk
+    bytes_ = Bytes(path_);
+    ASSERT_EQ(bytes_[kFirstChunk], '\x06');  // a chunk record
+  }
+  // Reads the damaged file to its end.
+  std::unique_ptr<EventReader> Read(const std::string& bytes) {
+    Put(path_, bytes);
+    auto reader = OpenEventReader(path_);
+    ReadAll(*reader);
+    return reader;
+  }
+  testing::TempDir dir_;
+  std::string path_, bytes_;
+};
+
+TEST_F(DamagedMcap, AChangedByteInAChunkIsItsCrc) {
+  std::string bytes = bytes_;
+  bytes[kRecordsLength + 8 + 40] ^= 0x10;  // inside the chunk's records
+  const auto reader = Read(bytes);
+  EXPECT_EQ(reader->events(), 0);
+  EXPECT_EQ(reader->stopped_early().rfind("damaged at byte 32: the chunk's CRC is ", 0), 0u)
+      << reader->stopped_early();
+}
+
+TEST_F(DamagedMcap, AChunkCutShortStopsAtIt) {
+  const auto reader = Read(bytes_.substr(0, kFirstChunk + 500));
+  EXPECT_EQ(reader->events(), 0);
+  EXPECT_EQ(reader->stopped_early().rfind("damaged at byte 32: a record of ", 0), 0u)
+      << reader->stopped_early();
+}
+
+TEST_F(DamagedMcap, ALengthThatLiesIsCaughtWithinItsRecord) {
+  std::string bytes = bytes_;
+  bytes[kRecordsLength + 5] = '\x7f';  // the records' length, now about 5e14
+  const auto reader = Read(bytes);
+  EXPECT_EQ(reader->events(), 0);
+  EXPECT_NE(reader->stopped_early().find("damaged at byte 32: chunk: records says "),
+            std::string::npos)
+      << reader->stopped_early();
+}
+
+TEST_F(DamagedMcap, AChangedByteOutsideTheChunksIsTheDataSectionsCrc) {
+  std::string bytes = bytes_;
+  bytes[kFirstChunk - 1] = 'X';  // the header's library name: "sandboX"
+  const auto reader = Read(bytes);
+  EXPECT_EQ(reader->events(), 30);  // every message, then the data end disagrees
+  EXPECT_NE(reader->stopped_early().find("the data section's CRC is "), std::string::npos)
+      << reader->stopped_early();
+}
+
+TEST_F(DamagedMcap, BadCompressedBytesAreAClearError) {
+  testing::TempDir dir;
+  const std::string path = (dir.path() / "z.mcap").string();
+  Write(path, SomeEvents(30), {"zstd", 1 << 20});
+  std::string bytes = Bytes(path);
+  // The compressed records start 4 bytes later than uncompressed ("zstd").
+  for (std::size_t i = kRecordsLength + 4 + 8 + 4; i < kRecordsLength + 4 + 8 + 40; ++i) {
+    bytes[i] = '\xff';
+  }
+  Put(path, bytes);
+  const auto reader = OpenEventReader(path);
+  ReadAll(*reader);
+  EXPECT_EQ(reader->events(), 0);
+  EXPECT_EQ(reader->stopped_early().rfind("damaged at byte 32: chunk: zstd: ", 0), 0u)
+      << reader->stopped_early();
+}
+
+TEST(McapTest, AWriteErrorIsKeptNamingTheFile) {
+  if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  McapWriter writer("/dev/full", {"zstd", 1000});
+  const std::vector<Event> events = SomeEvents(100);
+  for (const Event& e : events)
+    writer.Write(e.channel, e.data.data(), unsigned(e.data.size()), e.utime);
+  EXPECT_FALSE(writer.Close());
+  EXPECT_EQ(writer.error().rfind("cannot write '/dev/full' after ", 0), 0u) << writer.error();
+}
+
+}  // namespace
+}  // namespace sandbox::bridge
