@@ -1,9 +1,10 @@
 #!/usr/bin/python3
 """What recording costs the loop: `sandbox run --replay` of the same inputs
-(the sample level, 3000 ticks of poses and bends, its sensors on) without a
-recording, with an LCM log and with MCAP (zstd, lz4), in turns; each run's
+(the sample level, 3000 ticks of poses along a circle, its sensors on) without a
+recording, with an LCM log and with MCAP (zstd), in turns; each run's
 mean tick against the unrecorded run's (target for MCAP: at most 1.05x), the
-files' sizes against the LCM log's (target: at most 0.7x), and the writer
+files' sizes against the LCM log's (target: at most 0.7x); the demo at its
+rate (100 Hz, cameras on) without and with a recording; and the writer
 thread's own work a tick (`sandbox convert` of the LCM log, timed).
 
 usage: PYTHONPATH=build/python bench/record_bench.py [ROUNDS]   (default 5)
@@ -48,20 +49,25 @@ def mean_tick_ms(inputs, record):
     return float(re.search(r"mean tick ([0-9.]+) ms", done.stdout).group(1))
 
 
+def demo_tick_ms(folder, record):
+    """The demo in-process (100 Hz, cameras writing frames and videos, scans): its mean tick."""
+    args = [SANDBOX, "demo", "--in-process", "--duration", "15", "--out", str(folder / "demo")]
+    done = subprocess.run(args + (["--record", str(record)] if record else []),
+                          capture_output=True, text=True, check=True)
+    return float(re.search(r"mean tick ([0-9.]+) ms", done.stdout).group(1))
+
+
 def main():
     rounds = int(sys.argv[1]) if len(sys.argv) > 1 else 5
     with tempfile.TemporaryDirectory(prefix="sandbox-record-bench-") as folder:
         folder = pathlib.Path(folder)
         inputs = folder / "inputs.lcmlog"
         write_inputs(inputs)
-        kinds = {"none": None, "LCM log": folder / "run.lcmlog", "MCAP zstd": folder / "run.mcap",
-                 "MCAP lz4": folder / "lz4.mcap"}
+        kinds = {"none": None, "LCM log": folder / "run.lcmlog", "MCAP zstd": folder / "run.mcap"}
         ticks = {kind: [] for kind in kinds}
         for _ in range(rounds):
             for kind, record in kinds.items():
                 ticks[kind].append(mean_tick_ms(inputs, record))
-        subprocess.run([SANDBOX, "convert", str(kinds["LCM log"]), str(kinds["MCAP lz4"]),
-                        "--compression", "lz4"], check=True, capture_output=True)
         print(f"record_bench: the sample level replayed, {TICKS} ticks, sensors on, "
               f"{rounds} rounds in turns (median)")
         print("%-12s %14s %10s %14s %10s" % ("recording", "mean tick ms", "ratio", "bytes", "size"))
@@ -73,6 +79,23 @@ def main():
             print("%-12s %14.3f %10.3f %14d %10s" % (
                 kind, tick, tick / reference, size,
                 "%.3f" % (size / log_bytes) if record else "-"))
+        lz4 = folder / "lz4.mcap"
+        subprocess.run([SANDBOX, "convert", str(kinds["LCM log"]), str(lz4), "--compression", "lz4"],
+                       check=True, capture_output=True)
+        print("%-12s %14s %10s %14d %10.3f   (sandbox convert --compression lz4)" % (
+            "MCAP lz4", "-", "-", lz4.stat().st_size, lz4.stat().st_size / log_bytes))
+        demo = {"none": None, "MCAP zstd": folder / "demo.mcap", "LCM log": folder / "demo.lcmlog"}
+        demo_ticks = {kind: [] for kind in demo}
+        for _ in range(max(2, rounds // 2)):
+            for kind, record in demo.items():
+                demo_ticks[kind].append(demo_tick_ms(folder, record))
+        print("the demo at its rate (in-process, 15 s, 100 Hz, cameras and scans on), "
+              "%d rounds in turns (median):" % max(2, rounds // 2))
+        demo_reference = statistics.median(demo_ticks["none"])
+        for kind, record in demo.items():
+            tick = statistics.median(demo_ticks[kind])
+            print("%-12s %14.3f %10.3f %14d" % (kind, tick, tick / demo_reference,
+                                                record.stat().st_size if record else 0))
         print("the writer's thread, a tick (sandbox convert of the LCM log, best of %d):" % rounds)
         for compression in ("zstd", "lz4"):
             best = float("inf")

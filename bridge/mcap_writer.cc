@@ -6,6 +6,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "bridge/foxglove_views.h"
 #include "bridge/lcm_types.h"
 #include "bridge/mcap_records.h"
 
@@ -58,7 +59,9 @@ bool McapWriter::Write(const std::string& channel, const void* data, unsigned si
   queue_.push_back({channel, std::string(static_cast<const char*>(data), size), utime});
   queued_bytes_ += size + channel.size();
   ++events_;
-  changed_.notify_all();
+  // The writer's thread looks every kWritePeriod: no wake-up (a system call)
+  // a message unless much is waiting.
+  if (queued_bytes_ >= kWakeBytes) changed_.notify_all();
   return true;
 }
 
@@ -88,48 +91,46 @@ std::int64_t McapWriter::events() const {
 }
 
 void McapWriter::Run() {
-  for (;;) {
-    Event event;
+  std::deque<Event> events;
+  for (bool closing = false; !closing;) {
     {
       std::unique_lock<std::mutex> lock(mutex_);
-      changed_.wait(lock, [&] { return !queue_.empty() || closing_; });
-      if (queue_.empty()) break;  // closing, and everything written
-      event = std::move(queue_.front());
-      queue_.pop_front();
-      queued_bytes_ -= event.data.size() + event.channel.size();
-      changed_.notify_all();
+      changed_.wait_for(lock, kWritePeriod,
+                        [&] { return queued_bytes_ >= kWakeBytes || closing_; });
+      closing = closing_;
+      events.swap(queue_);  // everything waiting, at once
+      queued_bytes_ = 0;
+      changed_.notify_all();  // a Write() waiting for room
     }
-    Add(event);
+    for (const Event& event : events) Add(event);
+    events.clear();
   }
   Finish();
 }
 
-std::uint16_t McapWriter::SchemaOf(const Event& event) {
-  const LcmType* type =
-      LcmTypeOf(reinterpret_cast<const std::uint8_t*>(event.data.data()), event.data.size());
-  if (type == nullptr) return 0;  // no schema
-  const auto [it, added] =
-      schema_ids_.emplace(type->full_name(), std::uint16_t(schema_ids_.size() + 1));
+std::uint16_t McapWriter::SchemaId(const std::string& name, const std::string& encoding,
+                                   const std::string& text) {
+  const auto [it, added] = schema_ids_.emplace(name, std::uint16_t(schema_ids_.size() + 1));
   if (added) {
     for (std::string* out : {&chunk_, &schemas_}) {
       Builder b(out);
       const std::size_t record = b.BeginRecord(mcap::kSchema);
-      b.U16(it->second).String(type->full_name()).String("lcm").String(type->schema);
+      b.U16(it->second).String(name).String(encoding).String(text);
       b.EndRecord(record);
     }
   }
   return it->second;
 }
 
-std::uint16_t McapWriter::ChannelOf(const Event& event) {
-  const std::uint16_t schema = SchemaOf(event);
-  const auto [it, added] = channel_ids_.emplace(ChannelKey{event.channel, schema},
-                                                std::uint16_t(channel_ids_.size() + 1));
+std::uint16_t McapWriter::ChannelId(const std::string& topic, std::uint16_t schema,
+                                    const std::string& message_encoding) {
+  const auto [it, added] =
+      channel_ids_.emplace(ChannelKey{topic, schema}, std::uint16_t(channel_ids_.size() + 1));
   if (added) {
     for (std::string* out : {&chunk_, &channels_}) {
       Builder b(out);
       const std::size_t record = b.BeginRecord(mcap::kChannel);
-      b.U16(it->second).U16(schema).String(event.channel).String("lcm").U32(0);  // no metadata
+      b.U16(it->second).U16(schema).String(topic).String(message_encoding).U32(0);  // no metadata
       b.EndRecord(record);
     }
   }
@@ -138,24 +139,37 @@ std::uint16_t McapWriter::ChannelOf(const Event& event) {
 
 void McapWriter::Add(const Event& event) {
   if (!error().empty()) return;
-  if (channel_ids_.size() == 0xffff) return Fail("over 65535 channels");
-  const std::uint16_t channel = ChannelOf(event);
+  // Room for the message's channel and its views' (two more at most).
+  if (channel_ids_.size() > 0xffff - 3 || schema_ids_.size() > 0xffff - 3) {
+    return Fail("over 65532 channels or schemas");
+  }
+  const auto* bytes = reinterpret_cast<const std::uint8_t*>(event.data.data());
+  const LcmType* type = LcmTypeOf(bytes, event.data.size());
+  const std::uint16_t schema = type ? SchemaId(type->full_name(), "lcm", type->schema) : 0;
   const std::uint64_t time = std::uint64_t(event.utime) * 1000;  // nanoseconds
+  AddMessage(ChannelId(event.channel, schema, "lcm"), time, event.data);
+  if (options_.foxglove_views) {
+    for (const FoxgloveView& view : FoxgloveViewsOf(event.channel, bytes, event.data.size())) {
+      const std::uint16_t view_schema = SchemaId(view.schema_name, "jsonschema", *view.schema);
+      AddMessage(ChannelId(view.topic, view_schema, "json"), time, view.json);
+    }
+  }
+  if (chunk_.size() >= options_.chunk_bytes) FinishChunk();
+}
+
+void McapWriter::AddMessage(std::uint16_t channel, std::uint64_t time, std::string_view data) {
+  if (chunk_index_.empty()) chunk_start_ = chunk_end_ = time;  // the chunk's first message
   chunk_index_[channel].emplace_back(time, chunk_.size());
   Builder b(&chunk_);
   const std::size_t record = b.BeginRecord(mcap::kMessage);
-  b.U16(channel).U32(sequence_[channel]++).U64(time).U64(time).Bytes(event.data);
+  b.U16(channel).U32(sequence_[channel]++).U64(time).U64(time).Bytes(data);
   b.EndRecord(record);
   if (messages_ == 0 || time < first_time_) first_time_ = time;
   if (messages_ == 0 || time > last_time_) last_time_ = time;
-  if (chunk_index_.size() == 1 && chunk_index_.begin()->second.size() == 1) {
-    chunk_start_ = chunk_end_ = time;  // the chunk's first message
-  }
   chunk_start_ = std::min(chunk_start_, time);
   chunk_end_ = std::max(chunk_end_, time);
   ++messages_;
   ++channel_counts_[channel];
-  if (chunk_.size() >= options_.chunk_bytes) FinishChunk();
 }
 
 void McapWriter::FinishChunk() {

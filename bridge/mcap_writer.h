@@ -5,13 +5,16 @@
 // summary (schemas, channels, statistics, chunk indexes, summary offsets)
 // with its own CRC. A channel's schema is the sandbox type's .lcm text
 // (schema and message encoding "lcm"); a message of another type goes on a
-// channel without a schema.
+// channel without a schema. Poses, face scans and lidar sweeps are also
+// written as Foxglove's well-known schemas in JSON (foxglove_views.h).
 //
-// Threads: Write() copies the message and returns; a thread of the writer's
-// builds, compresses and writes the chunks. Write() waits only when over
+// Threads: Write() copies the message into a queue and returns; a thread of
+// the writer's takes the queue every kWritePeriod (sooner past kWakeBytes)
+// and builds, compresses and writes the chunks. Write() waits only when over
 // kMaxQueuedBytes are queued (the disk is slower than the run: nothing is
 // dropped).
 
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <cstdio>
@@ -19,6 +22,7 @@
 #include <map>
 #include <mutex>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <tuple>
 #include <utility>
@@ -33,8 +37,13 @@ class McapWriter final : public EventWriter {
   struct Options {
     std::string compression = "zstd";    // "zstd", "lz4" or "" (none)
     std::size_t chunk_bytes = 4u << 20;  // records a chunk holds before it is written
+    // Also each pose, face scan and lidar sweep as Foxglove's FrameTransform
+    // or PointCloud, on a channel of its own (bridge/foxglove_views.h).
+    bool foxglove_views = true;
   };
   static constexpr std::size_t kMaxQueuedBytes = 256u << 20;
+  static constexpr std::size_t kWakeBytes = 8u << 20;  // wakes the writer's thread early
+  static constexpr std::chrono::milliseconds kWritePeriod{20};
 
   // Throws std::runtime_error naming the file when it cannot be opened for
   // writing (or is a FIFO, a socket or a folder), std::invalid_argument for
@@ -67,8 +76,11 @@ class McapWriter final : public EventWriter {
 
   void Run();  // the writer's thread
   void Add(const Event& event);
-  std::uint16_t SchemaOf(const Event& event);
-  std::uint16_t ChannelOf(const Event& event);
+  void AddMessage(std::uint16_t channel, std::uint64_t time, std::string_view data);
+  std::uint16_t SchemaId(const std::string& name, const std::string& encoding,
+                         const std::string& text);
+  std::uint16_t ChannelId(const std::string& topic, std::uint16_t schema,
+                          const std::string& message_encoding);
   void FinishChunk();
   void Finish();  // data end, summary, footer, magic
   void Put(const std::string& bytes);

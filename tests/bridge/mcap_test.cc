@@ -5,18 +5,23 @@
 // byte outside the chunks (the data section's CRC). The npm reader
 // (@mcap/core) checks the writer independently: tests/python/test_mcap.py.
 
+#include <glib.h>
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "bridge/event_log.h"
+#include "bridge/foxglove_views.h"
 #include "bridge/lcm_link.h"
 #include "bridge/mcap_reader.h"
 #include "bridge/mcap_writer.h"
+#include "sandbox_msgs/lidar_scan_t.hpp"
 #include "sandbox_msgs/robot_pose_t.hpp"
 #include "tests/test_util.h"
 
@@ -208,6 +213,75 @@ TEST(McapTest, AWriteErrorIsKeptNamingTheFile) {
     writer.Write(e.channel, e.data.data(), unsigned(e.data.size()), e.utime);
   EXPECT_FALSE(writer.Close());
   EXPECT_EQ(writer.error().rfind("cannot write '/dev/full' after ", 0), 0u) << writer.error();
+}
+
+// A lidar sweep as Foxglove's PointCloud: each beam's point, range, hit, id
+// and intensity at the offsets the fields say, in little-endian bytes.
+TEST(FoxgloveViewsTest, ALidarSweepIsAPointCloudWithItsIdsAndIntensities) {
+  sandbox_msgs::lidar_scan_t scan{};
+  scan.utime = 1'234'567'890;
+  scan.channels = 1;
+  scan.steps = 2;
+  scan.origin[0] = 1000.5;
+  scan.start_orientation[0] = scan.end_orientation[0] = 1;
+  scan.num_beams = 2;
+  scan.range_m = {5.5f, 0.0f};
+  scan.hit = {1, 0};
+  scan.num_xyz = 6;
+  scan.xyz = {1.f, 2.f, 3.f, -4.f, -5.f, -6.f};
+  scan.time_s = {0.f, 0.05f};
+  scan.num_surface = 2;
+  scan.surface = {17, 0};
+  scan.num_intensity = 2;
+  scan.intensity = {0.25f, 0.f};
+  std::vector<std::uint8_t> bytes(std::size_t(scan.getEncodedSize()));
+  scan.encode(bytes.data(), 0, int(bytes.size()));
+  const std::vector<FoxgloveView> views = FoxgloveViewsOf("R/LIDAR", bytes.data(), bytes.size());
+  ASSERT_EQ(views.size(), 1u);
+  EXPECT_EQ(views[0].topic, "R/LIDAR/points");
+  EXPECT_EQ(views[0].schema_name, "foxglove.PointCloud");
+  const auto cloud = nlohmann::json::parse(views[0].json);
+  EXPECT_EQ(cloud["timestamp"]["sec"], 1234);
+  EXPECT_EQ(cloud["timestamp"]["nsec"], 567'890'000);
+  EXPECT_EQ(cloud["frame_id"], "world");
+  EXPECT_EQ(cloud["pose"]["position"]["x"], 1000.5);
+  const int stride = cloud["point_stride"];
+  std::map<std::string, int> offset;
+  for (const auto& field : cloud["fields"]) offset[field["name"]] = field["offset"];
+  gsize size = 0;
+  guchar* raw = g_base64_decode(cloud["data"].get<std::string>().c_str(), &size);
+  const std::string data(reinterpret_cast<char*>(raw), size);
+  g_free(raw);
+  ASSERT_EQ(size, std::size_t(2 * stride));
+  const auto f32 = [&](int point, const std::string& name) {
+    float v;
+    std::memcpy(&v, data.data() + point * stride + offset.at(name), 4);
+    return v;
+  };
+  const auto i32 = [&](int point, const std::string& name) {
+    std::int32_t v;
+    std::memcpy(&v, data.data() + point * stride + offset.at(name), 4);
+    return v;
+  };
+  EXPECT_EQ(f32(0, "x"), 1.f);
+  EXPECT_EQ(f32(1, "z"), -6.f);
+  EXPECT_EQ(f32(0, "range"), 5.5f);
+  EXPECT_EQ(data[std::size_t(offset.at("hit"))], 1);
+  EXPECT_EQ(data[std::size_t(stride + offset.at("hit"))], 0);
+  EXPECT_EQ(i32(0, "surface"), 17);
+  EXPECT_EQ(f32(0, "intensity"), 0.25f);
+  // Without ids and intensities, no such fields.
+  scan.num_surface = scan.num_intensity = 0;
+  scan.surface.clear();
+  scan.intensity.clear();
+  bytes.resize(std::size_t(scan.getEncodedSize()));
+  scan.encode(bytes.data(), 0, int(bytes.size()));
+  const auto bare =
+      nlohmann::json::parse(FoxgloveViewsOf("R/LIDAR", bytes.data(), bytes.size())[0].json);
+  EXPECT_EQ(bare["fields"].size(), 5u);  // x, y, z, range, hit
+  EXPECT_EQ(bare["point_stride"], 17);
+  // A message that is not a sandbox type, or does not decode: no view.
+  EXPECT_TRUE(FoxgloveViewsOf("R/LIDAR", bytes.data(), bytes.size() - 1).empty());
 }
 
 }  // namespace

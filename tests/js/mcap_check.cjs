@@ -3,7 +3,8 @@
 // summary CRC, summary offsets, statistics, chunk indexes, message indexes,
 // chunk CRCs) and the streaming reader (every record in file order), plus the
 // data section's CRC computed here with @foxglove/crc. Prints, as JSON, every
-// message in file order (topic, log time, SHA-256 of its bytes) and the
+// LCM message in file order (topic, log time, SHA-256 of its bytes), every
+// JSON message (topic, log time, schema name, the message parsed) and the
 // channels' schemas; exits 1 naming what disagrees.
 //
 //   NODE_PATH=build/node/node_modules node mcap_check.cjs FILE.mcap
@@ -41,7 +42,7 @@ async function main() {
   // Every record in file order, chunks opened, their CRCs checked.
   const stream = new McapStreamReader({ includeChunks: true, decompressHandlers, validateCrcs: true });
   stream.append(bytes);
-  const messages = [];
+  const messages = [], views = [], all = [];
   const counts = {};
   const channels = new Map();
   const schemas = new Map();
@@ -53,8 +54,15 @@ async function main() {
     if (record.type === "MessageIndex") messageIndexes++;
     if (record.type === "DataEnd") dataEnd = record;
     if (record.type === "Message") {
-      const topic = channels.get(record.channelId).topic;
-      messages.push([topic, record.logTime.toString(), sha(record.data)]);
+      const channel = channels.get(record.channelId);
+      if (channel.messageEncoding === "json") {  // Foxglove's schemas, decoded as Foxglove does
+        const schema = schemas.get(channel.schemaId);
+        views.push([channel.topic, record.logTime.toString(), schema.name,
+                    JSON.parse(new TextDecoder().decode(record.data))]);
+      } else {
+        messages.push([channel.topic, record.logTime.toString(), sha(record.data)]);
+      }
+      all.push([channel.topic, record.logTime.toString(), sha(record.data)]);
       counts[record.channelId] = (counts[record.channelId] || 0) + 1;
     }
   }
@@ -70,8 +78,8 @@ async function main() {
   // The summary against what the stream holds.
   const stats = indexed.statistics;
   if (stats === undefined) fail("no statistics record");
-  if (stats.messageCount !== BigInt(messages.length)) {
-    fail(`statistics say ${stats.messageCount} messages, the file has ${messages.length}`);
+  if (stats.messageCount !== BigInt(all.length)) {
+    fail(`statistics say ${stats.messageCount} messages, the file has ${all.length}`);
   }
   if (stats.chunkCount !== chunks || indexed.chunkIndexes.length !== chunks) {
     fail(`statistics say ${stats.chunkCount} chunks, ${indexed.chunkIndexes.length} chunk ` +
@@ -104,8 +112,8 @@ async function main() {
   }
   const key = (m) => m.join(" ");
   const sorted = (list) => list.map(key).sort();
-  if (JSON.stringify(sorted(viaIndex)) !== JSON.stringify(sorted(messages))) {
-    fail(`the indexed reader found ${viaIndex.length} messages, not the stream's ${messages.length}`);
+  if (JSON.stringify(sorted(viaIndex)) !== JSON.stringify(sorted(all))) {
+    fail(`the indexed reader found ${viaIndex.length} messages, not the stream's ${all.length}`);
   }
 
   const channelSchemas = {};
@@ -119,7 +127,7 @@ async function main() {
     };
   }
   process.stdout.write(JSON.stringify({
-    messages, channels: channelSchemas, chunks,
+    messages, views, channels: channelSchemas, chunks,
     compression: [...new Set(indexed.chunkIndexes.map((c) => c.compression))],
   }));
 }

@@ -3,6 +3,7 @@ read by Foxglove's own reader (npm @mcap/core with Debian's nodejs,
 tests/js/mcap_check.cjs: every CRC, index and the summary checked there), and
 compared message by message with the LCM log of the same run, read here from
 lcm-logger's format (not the project's reader)."""
+import base64
 import hashlib
 import json
 import os
@@ -22,18 +23,23 @@ CHECK = ROOT / "tests/js/mcap_check.cjs"
 NODE_PATH = os.environ.get("NODE_PATH", str(ROOT / "build/node/node_modules"))
 
 
-def lcm_log(path):
-    """(channel, time in ns, SHA-256 of the data) an event of an LCM log."""
-    data, at, events = path.read_bytes(), 0, []
+def lcm_events(path):
+    """(channel, utime, data) an event of an LCM log, read from lcm-logger's format."""
+    data, at = path.read_bytes(), 0
     while at < len(data):
         sync, _, utime, channel_bytes, data_bytes = struct.unpack_from(">IqqII", data, at)
         assert sync == 0xEDA1DA01
         at += 28
         channel = data[at:at + channel_bytes].decode()
         at += channel_bytes
-        events.append([channel, str(utime * 1000), hashlib.sha256(data[at:at + data_bytes]).hexdigest()])
+        yield channel, utime, data[at:at + data_bytes]
         at += data_bytes
-    return events
+
+
+def lcm_log(path):
+    """(channel, time in ns, SHA-256 of the data) an event of an LCM log."""
+    return [[channel, str(utime * 1000), hashlib.sha256(data).hexdigest()]
+            for channel, utime, data in lcm_events(path)]
 
 
 def read_mcap(path):
@@ -66,6 +72,8 @@ def test_a_recording_holds_every_message_of_the_lcm_log_with_its_type(runs):
     assert mcap["compression"] == ["zstd"]
     lcm_types = {p.stem: p.read_text() for p in (ROOT / "bridge/lcmtypes").glob("*.lcm")}
     for topic, channel in mcap["channels"].items():
+        if channel["message_encoding"] == "json":
+            continue  # Foxglove's schemas: below
         assert channel["message_encoding"] == "lcm", topic
         assert channel["schema_encoding"] == "lcm", topic
         assert channel["schema_text"] == lcm_types[channel["schema"].removeprefix("sandbox_msgs.")]
@@ -118,3 +126,41 @@ def test_read_log_reads_a_recording_in_either_format_alike(runs):
     assert len(state_log) == len(state_mcap) == 40
     assert np.array_equal(state_log.utime, state_mcap.utime)
     assert np.array_equal(state_log.array("position"), state_mcap.array("position"))
+
+
+def test_poses_and_face_scans_are_also_foxglove_frame_transforms_and_point_clouds(runs):
+    """Each STATE's pose as the FrameTransform world -> ELAHA, each face scan as a
+    PointCloud in world whose points, occupancy and hit ids are the scan's, at the same time."""
+    mcap = read_mcap(runs / "run.mcap")
+    assert mcap["channels"]["ELAHA/STATE/tf"]["schema"] == "foxglove.FrameTransform"
+    assert mcap["channels"]["ELAHA/STATE/tf"]["schema_encoding"] == "jsonschema"
+    assert mcap["channels"]["ELAHA/SCAN_FACE/points"]["schema"] == "foxglove.PointCloud"
+    views = {(topic, time): message for topic, time, _, message in mcap["views"]}
+    transforms = clouds = 0
+    for channel, utime, data in lcm_events(runs / "run.lcmlog"):
+        if channel == "ELAHA/STATE":
+            state = sandbox.decode(data)
+            tf = views[("ELAHA/STATE/tf", str(utime * 1000))]
+            assert tf["parent_frame_id"] == "world" and tf["child_frame_id"] == "ELAHA"
+            assert tf["timestamp"]["sec"] * 10**6 + tf["timestamp"]["nsec"] // 1000 == state.utime
+            assert [tf["translation"][a] for a in "xyz"] == list(state.position)
+            assert [tf["rotation"][a] for a in "wxyz"] == list(state.orientation)
+            transforms += 1
+        elif channel == "ELAHA/SCAN_FACE":
+            face = sandbox.decode(data)
+            cloud = views[("ELAHA/SCAN_FACE/points", str(utime * 1000))]
+            assert cloud["frame_id"] == "world"
+            assert [cloud["pose"]["position"][a] for a in "xyz"] == list(face.origin)
+            fields = {f["name"]: (f["offset"], f["type"]) for f in cloud["fields"]}
+            kinds = {2: "i1", 6: "<i4", 7: "<f4"}
+            dtype = np.dtype({"names": list(fields), "formats": [kinds[t] for _, t in fields.values()],
+                              "offsets": [o for o, _ in fields.values()],
+                              "itemsize": cloud["point_stride"]})
+            points = np.frombuffer(base64.b64decode(cloud["data"]), dtype=dtype)
+            assert len(points) == face.num_points > 0
+            xyz = np.stack([points["x"], points["y"], points["z"]], axis=1)
+            assert np.array_equal(xyz, np.asarray(face.xyz, np.float32).reshape(-1, 3), equal_nan=True)
+            assert np.array_equal(points["occupancy"], face.occupancy)
+            assert np.array_equal(points["surface"], face.surface)
+            clouds += 1
+    assert transforms == 40 and clouds == 40
