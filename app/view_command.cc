@@ -22,9 +22,9 @@ namespace {
 const char* kUsage =
     "usage: sandbox view LOG [--level LEVEL] [--web [ADDR:]PORT] [--isolate]\n"
     "  LOG       an LCM log of a run's inputs (lcm-logger, fly_wing --write-log) or a run's\n"
-    "            --record log (its STATE messages replayed as inputs), replayed in lock-step\n"
-    "            first (with a progress line), then shown in the browser view with a player:\n"
-    "            play, pause, speed, a time slider, a jump to a tick\n"
+    "            --record log or MCAP file (its STATE messages replayed as inputs), replayed\n"
+    "            in lock-step first (with a progress line), then shown in the browser view\n"
+    "            with a player: play, pause, speed, a time slider, a jump to a tick\n"
     "  --level   the level it was flown in (default: the bundled sample level)\n"
     "  --web     where to serve it (default 127.0.0.1 and any free port; the address is\n"
     "            printed); docs/reference/web.md\n"
@@ -35,7 +35,7 @@ const char* kUsage =
 // The replayed run: each tick's state, and the ones with their samples (the
 // loop sends samples once every RunHooks::web_samples_every_s).
 struct Recording {
-  std::vector<web::StreamState> states;  // samples dropped, see below
+  std::vector<web::StreamState> states;   // samples dropped, see below
   std::vector<std::size_t> sample_ticks;  // ticks whose samples are kept, in order
   std::vector<web::StreamState> samples;  // the states of those ticks, with their samples
 
