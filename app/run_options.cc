@@ -36,10 +36,10 @@ void ParseFrames(const std::string& text, FramePipelineConfig* config) {
 }  // namespace
 
 const std::set<std::string> kRunValueOptions = {
-    "--rate",   "--duration", "--lcm-url",     "--replay",   "--record", "--out",
-    "--frames", "--depth",    "--scans-every", "--realtime", "--ticks",  "--web"};
-const std::set<std::string> kRunFlags = {"--lockstep",    "--view",        "--isolate",
-                                         "--no-sensors",  "--frames-only", "--web-control"};
+    "--rate",  "--duration",    "--lcm-url",  "--replay", "--record", "--out",     "--frames",
+    "--depth", "--scans-every", "--realtime", "--ticks",  "--web",    "--foxglove"};
+const std::set<std::string> kRunFlags = {"--lockstep",   "--view",        "--isolate",
+                                         "--no-sensors", "--frames-only", "--web-control"};
 
 RunOptions ParseRunOptions(const ParsedArgs& args) {
   RunOptions options;
@@ -117,10 +117,19 @@ RunOptions ParseRunOptions(const ParsedArgs& args) {
   options.web_control = args.flags.count("--web-control") > 0;
   if (options.web_control && options.web_port < 0)
     throw UsageError("--web-control steers the cameras from the browser view: it needs --web");
+  if (args.values.count("--foxglove")) {
+    ParseServerAddress(args.Value("--foxglove"), "--foxglove", &options.foxglove_address,
+                       &options.foxglove_port);
+  }
   return options;
 }
 
 void ParseWebAddress(const std::string& text, RunOptions* options) {
+  ParseServerAddress(text, "--web", &options->web_address, &options->web_port);
+}
+
+void ParseServerAddress(const std::string& text, const std::string& option,
+                        std::string* address_out, int* port_out) {
   const auto colon = text.rfind(':');
   const std::string port = colon == std::string::npos ? text : text.substr(colon + 1);
   std::string address = colon == std::string::npos ? "127.0.0.1" : text.substr(0, colon);
@@ -130,12 +139,12 @@ void ParseWebAddress(const std::string& text, RunOptions* options) {
   const bool digits = !port.empty() && port.size() <= 5 &&
                       port.find_first_not_of("0123456789") == std::string::npos;
   if (!digits || std::stoi(port) > 65535 || address.empty()) {
-    throw UsageError(
-        "--web must be PORT or ADDRESS:PORT (port 0 to 65535, 0: any free one), got '" + text +
-        "'");
+    throw UsageError(option +
+                     " must be PORT or ADDRESS:PORT (port 0 to 65535, 0: any free one), got '" +
+                     text + "'");
   }
-  options->web_address = address;
-  options->web_port = std::stoi(port);
+  *address_out = address;
+  *port_out = std::stoi(port);
 }
 
 }  // namespace sandbox::app

@@ -104,6 +104,7 @@ bool ReportRun(const RunRecord& run, std::ostream& out, std::ostream& err) {
     }
   }
   if (run.web != nullptr) PrintWebCounts(run.web->counts(), out);
+  if (run.foxglove != nullptr) PrintFoxgloveCounts(run.foxglove->counts(), out);
   if (run.live_view != nullptr) {
     out << "  live view: " << run.live_view->shown() << " frames shown, last camera "
         << run.cameras->live_camera()
@@ -144,6 +145,16 @@ bool ReportRun(const RunRecord& run, std::ostream& out, std::ostream& err) {
     }
   }
   return !output_lost;
+}
+
+void PrintFoxgloveCounts(const web::FoxgloveCounts& c, std::ostream& out) {
+  out << "  foxglove: " << c.connections << " clients (" << c.clients << " at the end), "
+      << c.channels << " channels, " << c.subscriptions << " subscriptions, " << c.messages_sent
+      << " messages sent, " << c.messages_skipped << " skipped for slow clients, "
+      << c.bytes_sent / 1024 << " KiB; refused: " << c.refused_origin << " other origin, "
+      << c.refused_protocol << " not the Foxglove protocol, " << c.refused_full
+      << " over the limit, " << c.requests_refused << " requests; closed: " << c.closed_oversized
+      << " oversized messages, " << c.dropped_slow << " too slow\n";
 }
 
 void PrintWebCounts(const web::ServerCounts& c, std::ostream& out) {

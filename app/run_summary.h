@@ -19,6 +19,7 @@
 #include "bridge/lcm_link.h"
 #include "bridge/robot_feed.h"
 #include "bridge/unknown_robots.h"
+#include "web/foxglove_server.h"
 #include "web/stream_server.h"
 
 namespace sandbox::app {
@@ -36,7 +37,8 @@ struct RunRecord {
   Eigen::Vector3d origin{Eigen::Vector3d::Zero()};
   const ScanFileWriter* scan_files{nullptr};
   const LiveView* live_view{nullptr};
-  const web::StreamServer* web{nullptr};  // the browser view, when served
+  const web::StreamServer* web{nullptr};         // the browser view, when served
+  const web::FoxgloveServer* foxglove{nullptr};  // the Foxglove server, when served
   const CameraDirector* cameras{nullptr};
   const bridge::LcmLink* link{nullptr};
   const FramePipeline* frames{nullptr};  // null unless frames were written
@@ -49,6 +51,7 @@ struct RunRecord {
 // A replay's progress bar, on one line of `err`: read, ticks, ticks/s, time left.
 // The browser view's line of the summary: clients, states, bytes, refusals.
 void PrintWebCounts(const web::ServerCounts& counts, std::ostream& out);
+void PrintFoxgloveCounts(const web::FoxgloveCounts& counts, std::ostream& out);
 
 void PrintReplayProgress(const bridge::EventReader& replay, std::int64_t ticks, double wall_s,
                          std::ostream& err);

@@ -48,7 +48,13 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
       cameras_(level_, loaded_.cameras),
       stats_(PrepareOutDir(options)) {
   if (!options_.record_file.empty()) link_.RecordTo(options_.record_file);
-  if (hooks_.published) link_.set_publish_tap(hooks_.published);
+  StartFoxglove();
+  if (hooks_.published || foxglove_) {
+    link_.set_publish_tap([this](const std::string& channel, const void* data, unsigned size) {
+      if (hooks_.published) hooks_.published(channel, data, size);
+      if (foxglove_feed_) foxglove_feed_->Published(channel, data, size, tick_utime_);
+    });
+  }
   if (level_.terrain) terrain_ = std::make_unique<scene::TerrainStreamer>(level_);
   // The world's geodetic anchor, for the instruments.
   if (const auto anchor = bridge::WorldAnchor(level_, loaded_.bridges)) geodetic_.emplace(*anchor);
@@ -203,6 +209,7 @@ void SandboxLoop::Start(double period_s, const std::string& priority) {
                              : PaceName(options_) + ", LCM " + link_.url())
        << priority << "\n";
   if (web_) out_ << "sandbox run: browser view at " << web_->url() << "\n";
+  if (foxglove_) out_ << "sandbox run: Foxglove WebSocket server at " << foxglove_->url() << "\n";
   out_ << std::flush;
   start_ = Clock::now();
   pacer_ = TickPacer(period_s, 0.0);
@@ -517,6 +524,7 @@ bool SandboxLoop::Report(double elapsed_s) {
   run.scan_files = &scan_files_;
   run.live_view = live_view_.get();
   run.web = web_.get();
+  run.foxglove = foxglove_.get();
   run.cameras = &cameras_;
   run.link = &link_;
   run.frames = write_frames_ ? frames_.get() : nullptr;

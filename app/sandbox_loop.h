@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "app/camera_director.h"
+#include "app/foxglove_feed.h"
 #include "app/frame_pipeline.h"
 #include "app/input_clock.h"
 #include "app/live_view.h"
@@ -56,6 +57,7 @@
 #include "sensors/pose_history.h"
 #include "sensors/ray_caster.h"
 #include "sensors/sensor.h"
+#include "web/foxglove_server.h"
 #include "web/stream_server.h"
 
 namespace sandbox::app {
@@ -100,6 +102,7 @@ class SandboxLoop {
   const LoadedLevel& loaded_level() const { return loaded_; }
   // The browser view's address (--web), or "".
   std::string web_url() const { return web_ ? web_->url() : std::string(); }
+  std::string foxglove_url() const { return foxglove_ ? foxglove_->url() : std::string(); }
 
  private:
   // A robot: its state, what drives it and what it publishes.
@@ -183,7 +186,12 @@ class SandboxLoop {
   std::unique_ptr<LiveView> live_view_;  // before frames_: frames_ calls into it
   bool write_frames_{false};
   std::unique_ptr<FramePipeline> frames_;
-  std::unique_ptr<web::StreamServer> web_;                       // the browser view (--web)
+  std::unique_ptr<web::StreamServer> web_;  // the browser view (--web)
+  // The live Foxglove server (--foxglove) and what feeds it (sandbox_loop_web.cc).
+  // The server goes first (its thread may still run the feed's work).
+  void StartFoxglove();
+  std::unique_ptr<FoxgloveFeed> foxglove_feed_;
+  std::unique_ptr<web::FoxgloveServer> foxglove_;
   static constexpr double kWebSamplesHz = 5.0;                   // scan samples sent so often
   static constexpr std::size_t kWebSamplesPerSensor = 20000;     // at most so many a sensor
   double web_samples_due_s_{0.0}, web_samples_wall_due_s_{0.0};  // --web's next samples

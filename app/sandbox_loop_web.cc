@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "app/command_line.h"
 #include "app/images.h"
 #include "app/sandbox_loop.h"
 #include "app/web_samples.h"
@@ -14,6 +15,19 @@
 namespace sandbox::app {
 
 using Clock = std::chrono::steady_clock;
+
+void SandboxLoop::StartFoxglove() {
+  if (options_.foxglove_port < 0) return;
+  web::ServerOptions server;
+  server.address = options_.foxglove_address;
+  server.port = options_.foxglove_port;
+  try {
+    foxglove_ = std::make_unique<web::FoxgloveServer>(server);
+  } catch (const std::exception& e) {
+    throw CommandError(e.what());
+  }
+  foxglove_feed_ = std::make_unique<FoxgloveFeed>(*foxglove_);
+}
 
 void SandboxLoop::ShowCameraFrame(const std::string& camera, std::int64_t tick,
                                   const render::CameraView& view, const render::Frame& frame,

@@ -7,6 +7,7 @@
 #include "bridge/mcap_reader.h"
 #include "bridge/mcap_records.h"
 #include "bridge/mcap_writer.h"
+#include "scene/files.h"
 
 namespace sandbox::bridge {
 
@@ -17,6 +18,8 @@ bool EndsWith(const std::string& text, const std::string& end) {
 }
 
 bool StartsWithMcapMagic(const std::string& path) {
+  // Regular files only: opening a FIFO would block (the readers say what it is).
+  if (!scene::RegularFileProblem(path).empty()) return false;
   std::FILE* file = std::fopen(path.c_str(), "rb");
   if (file == nullptr) return false;
   char magic[sizeof(mcap::kMagic)];

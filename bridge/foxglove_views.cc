@@ -101,6 +101,12 @@ std::string RobotOf(const std::string& channel) {
 
 }  // namespace
 
+bool HasFoxgloveView(const std::uint8_t* data, std::size_t size) {
+  const LcmType* type = LcmTypeOf(data, size);
+  return type != nullptr && (type->name == "robot_state_t" || type->name == "robot_pose_t" ||
+                             type->name == "scan_face_t" || type->name == "lidar_scan_t");
+}
+
 std::vector<FoxgloveView> FoxgloveViewsOf(const std::string& channel, const std::uint8_t* data,
                                           std::size_t size) {
   const LcmType* type = LcmTypeOf(data, size);

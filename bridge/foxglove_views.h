@@ -20,6 +20,9 @@ struct FoxgloveView {
   std::string json;                    // the message
 };
 
+// Whether the message is of a type with a view (a look at its fingerprint).
+bool HasFoxgloveView(const std::uint8_t* data, std::size_t size);
+
 // The views of one LCM message on `channel` (none for other types or a
 // message that does not decode).
 std::vector<FoxgloveView> FoxgloveViewsOf(const std::string& channel, const std::uint8_t* data,

@@ -44,7 +44,9 @@ class Outputs {
   using Spans = std::vector<std::pair<std::size_t, std::size_t>>;
   Outputs(std::int64_t tick, py::array_t<std::uint8_t> buffer,
           std::vector<std::pair<std::string, Spans>> channels)
-      : tick_(tick), buffer_(std::move(buffer)), channels_(std::move(channels)),
+      : tick_(tick),
+        buffer_(std::move(buffer)),
+        channels_(std::move(channels)),
         decoded_(channels_.size()) {}
 
   std::int64_t tick() const { return tick_; }
@@ -216,10 +218,10 @@ class Lockstep {
   }
   std::string LevelName() const { return loop_->level().name; }
   std::string WebUrl() const { return loop_->web_url(); }
+  std::string FoxgloveUrl() const { return loop_->foxglove_url(); }
 
   // One tick: the inputs in, the tick's outputs back (channel, bytes).
-  Outputs Step(
-      const std::vector<std::tuple<std::string, py::bytes>>& inputs) {
+  Outputs Step(const std::vector<std::tuple<std::string, py::bytes>>& inputs) {
     std::vector<bridge::LogEvent> events;
     events.reserve(inputs.size());
     AddEncoded(inputs, &events);
@@ -233,11 +235,10 @@ class Lockstep {
   // plus `period_us`). A robot without a pose here keeps its last one,
   // re-sent at this time. Everything is checked before the tick runs.
   Outputs StepRobots(const py::object& poses, const py::object& bones,
-                       const std::vector<std::tuple<std::string, py::bytes>>& encoded,
-                       const py::object& utime_value, std::int64_t period_us) {
-    const std::int64_t utime = utime_value.is_none()
-                                   ? (last_utime_ ? *last_utime_ + period_us : 0)
-                                   : Utime(utime_value);
+                     const std::vector<std::tuple<std::string, py::bytes>>& encoded,
+                     const py::object& utime_value, std::int64_t period_us) {
+    const std::int64_t utime =
+        utime_value.is_none() ? (last_utime_ ? *last_utime_ + period_us : 0) : Utime(utime_value);
     std::vector<bridge::LogEvent> events;
     std::vector<Robot*> bones_sent;
     if (!bones.is_none()) {
@@ -260,8 +261,8 @@ class Lockstep {
       }
     }
     for (std::size_t r = 0; r < robots_.size(); ++r) {  // the others' last poses
-      const bool given = std::any_of(sent.begin(), sent.end(),
-                                     [r](const auto& p) { return p.first == r; });
+      const bool given =
+          std::any_of(sent.begin(), sent.end(), [r](const auto& p) { return p.first == r; });
       if (!given && robots_[r].last) sent.emplace_back(r, *robots_[r].last);
     }
     if (sent.empty()) {
@@ -322,7 +323,8 @@ class Lockstep {
     auto* arena = arena_.release();
     arena_ = std::make_unique<std::vector<std::uint8_t>>();
     arena_->reserve(arena->size());
-    const py::capsule owner(arena, [](void* p) { delete static_cast<std::vector<std::uint8_t>*>(p); });
+    const py::capsule owner(arena,
+                            [](void* p) { delete static_cast<std::vector<std::uint8_t>*>(p); });
     py::array_t<std::uint8_t> buffer({py::ssize_t(arena->size())}, {py::ssize_t(1)}, arena->data(),
                                      owner);
     py::detail::array_proxy(buffer.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
@@ -461,7 +463,10 @@ void BindLockstep(py::module_& module) {
       .def_property_readonly("robots", &Lockstep::Robots, "[(name, channel prefix)]")
       .def_property_readonly("actors", &Lockstep::Actors, "the movable actors' names")
       .def_property_readonly("name", &Lockstep::LevelName)
-      .def_property_readonly("web_url", &Lockstep::WebUrl, "the browser view's address (--web), or ''")
+      .def_property_readonly("web_url", &Lockstep::WebUrl,
+                             "the browser view's address (--web), or ''")
+      .def_property_readonly("foxglove_url", &Lockstep::FoxgloveUrl,
+                             "the Foxglove WebSocket server's address (--foxglove), or ''")
       .def("step", &Lockstep::Step, py::arg("inputs"),
            "Outputs: the inputs given to the loop, one tick run")
       .def("step_robots", &Lockstep::StepRobots, py::arg("poses"), py::arg("bones"),
@@ -469,7 +474,8 @@ void BindLockstep(py::module_& module) {
            "Outputs: Lockstep.step()'s tick: bone values "
            "{robot: values}, encoded messages [(channel, bytes)], poses {robot: pose}, utime or "
            "None (the last plus period_us)")
-      .def_property_readonly("last_utime", &Lockstep::last_utime, "the last step's utime (None before)")
+      .def_property_readonly("last_utime", &Lockstep::last_utime,
+                             "the last step's utime (None before)")
       .def("close", &Lockstep::Close, "ends the run; its summary")
       .def_property_readonly("exit_code", &Lockstep::exit_code)
       .def_property_readonly("messages", &Lockstep::messages,

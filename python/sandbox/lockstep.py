@@ -30,6 +30,7 @@ class Lockstep:
         self.actors = self._run.actors
         self.name = self._run.name
         self.web_url = self._run.web_url or None  # `--web PORT`: the browser view's address
+        self.foxglove_url = self._run.foxglove_url or None  # `--foxglove PORT`: ws://...
         self._period_us = round(1e6 / rate_hz)
         self._seq, self._channel_names = {}, {}
         self.summary = None

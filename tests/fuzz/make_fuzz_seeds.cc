@@ -185,6 +185,18 @@ void McapSeeds(const fs::path& dir) {
   }
 }
 
+// What Foxglove and Lichtblick send the live server, and what they might.
+void FoxgloveRequestSeeds(const fs::path& dir) {
+  fs::create_directories(dir);
+  Write(dir / "subscribe",
+        R"({"op":"subscribe","subscriptions":[{"id":0,"channelId":3},{"id":1,"channelId":0}]})");
+  Write(dir / "unsubscribe", R"({"op":"unsubscribe","subscriptionIds":[0,1]})");
+  Write(
+      dir / "advertise",
+      R"({"op":"advertise","channels":[{"id":1,"topic":"/x","encoding":"json","schemaName":"s"}]})");
+  Write(dir / "get_parameters", R"({"op":"getParameters","parameterNames":[],"id":"a"})");
+}
+
 // PNG's CRC-32, for the zip below.
 std::uint32_t Crc32(const Bytes& bytes) {
   std::uint32_t crc = 0xffffffffu;
@@ -405,6 +417,7 @@ int main(int argc, char** argv) {
   UdpSeeds(dir / "udp");
   LogSeeds(dir / "lcm_log");
   McapSeeds(dir / "mcap");
+  FoxgloveRequestSeeds(dir / "foxglove_request");
   LevelFileSeeds(dir / "level_file");
   RasterSeeds(dir / "raster");
   TileCacheSeeds(dir / "tile_cache");

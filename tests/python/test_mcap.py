@@ -128,6 +128,31 @@ def test_read_log_reads_a_recording_in_either_format_alike(runs):
     assert np.array_equal(state_log.array("position"), state_mcap.array("position"))
 
 
+def check_transform(tf, state):
+    """A foxglove.FrameTransform (JSON, parsed) against the robot_state_t it shows."""
+    assert tf["parent_frame_id"] == "world" and tf["child_frame_id"] == "ELAHA"
+    assert tf["timestamp"]["sec"] * 10**6 + tf["timestamp"]["nsec"] // 1000 == state.utime
+    assert [tf["translation"][a] for a in "xyz"] == list(state.position)
+    assert [tf["rotation"][a] for a in "wxyz"] == list(state.orientation)
+
+
+def check_cloud(cloud, face):
+    """A foxglove.PointCloud (JSON, parsed) against the scan_face_t it shows."""
+    assert cloud["frame_id"] == "world"
+    assert cloud["timestamp"]["sec"] * 10**6 + cloud["timestamp"]["nsec"] // 1000 == face.utime
+    assert [cloud["pose"]["position"][a] for a in "xyz"] == list(face.origin)
+    fields = {f["name"]: (f["offset"], f["type"]) for f in cloud["fields"]}
+    kinds = {2: "i1", 6: "<i4", 7: "<f4"}
+    dtype = np.dtype({"names": list(fields), "formats": [kinds[t] for _, t in fields.values()],
+                      "offsets": [o for o, _ in fields.values()], "itemsize": cloud["point_stride"]})
+    points = np.frombuffer(base64.b64decode(cloud["data"]), dtype=dtype)
+    assert len(points) == face.num_points > 0
+    xyz = np.stack([points["x"], points["y"], points["z"]], axis=1)
+    assert np.array_equal(xyz, np.asarray(face.xyz, np.float32).reshape(-1, 3), equal_nan=True)
+    assert np.array_equal(points["occupancy"], face.occupancy)
+    assert np.array_equal(points["surface"], face.surface)
+
+
 def test_poses_and_face_scans_are_also_foxglove_frame_transforms_and_point_clouds(runs):
     """Each STATE's pose as the FrameTransform world -> ELAHA, each face scan as a
     PointCloud in world whose points, occupancy and hit ids are the scan's, at the same time."""
@@ -139,28 +164,9 @@ def test_poses_and_face_scans_are_also_foxglove_frame_transforms_and_point_cloud
     transforms = clouds = 0
     for channel, utime, data in lcm_events(runs / "run.lcmlog"):
         if channel == "ELAHA/STATE":
-            state = sandbox.decode(data)
-            tf = views[("ELAHA/STATE/tf", str(utime * 1000))]
-            assert tf["parent_frame_id"] == "world" and tf["child_frame_id"] == "ELAHA"
-            assert tf["timestamp"]["sec"] * 10**6 + tf["timestamp"]["nsec"] // 1000 == state.utime
-            assert [tf["translation"][a] for a in "xyz"] == list(state.position)
-            assert [tf["rotation"][a] for a in "wxyz"] == list(state.orientation)
+            check_transform(views[("ELAHA/STATE/tf", str(utime * 1000))], sandbox.decode(data))
             transforms += 1
         elif channel == "ELAHA/SCAN_FACE":
-            face = sandbox.decode(data)
-            cloud = views[("ELAHA/SCAN_FACE/points", str(utime * 1000))]
-            assert cloud["frame_id"] == "world"
-            assert [cloud["pose"]["position"][a] for a in "xyz"] == list(face.origin)
-            fields = {f["name"]: (f["offset"], f["type"]) for f in cloud["fields"]}
-            kinds = {2: "i1", 6: "<i4", 7: "<f4"}
-            dtype = np.dtype({"names": list(fields), "formats": [kinds[t] for _, t in fields.values()],
-                              "offsets": [o for o, _ in fields.values()],
-                              "itemsize": cloud["point_stride"]})
-            points = np.frombuffer(base64.b64decode(cloud["data"]), dtype=dtype)
-            assert len(points) == face.num_points > 0
-            xyz = np.stack([points["x"], points["y"], points["z"]], axis=1)
-            assert np.array_equal(xyz, np.asarray(face.xyz, np.float32).reshape(-1, 3), equal_nan=True)
-            assert np.array_equal(points["occupancy"], face.occupancy)
-            assert np.array_equal(points["surface"], face.surface)
+            check_cloud(views[("ELAHA/SCAN_FACE/points", str(utime * 1000))], sandbox.decode(data))
             clouds += 1
     assert transforms == 40 and clouds == 40

@@ -1,0 +1,42 @@
+#include "app/foxglove_feed.h"
+
+#include <algorithm>
+
+#include "bridge/foxglove_views.h"
+
+namespace sandbox::app {
+
+void FoxgloveFeed::Published(const std::string& channel, const void* data, unsigned size,
+                             std::int64_t utime) {
+  const auto* bytes = static_cast<const std::uint8_t*>(data);
+  if (!server_.HasClients() || !bridge::HasFoxgloveView(bytes, size)) return;
+  server_.Defer([this, channel, copy = std::string(static_cast<const char*>(data), size), utime] {
+    Convert(channel, copy, utime);
+  });
+}
+
+void FoxgloveFeed::Convert(const std::string& channel, const std::string& bytes,
+                           std::int64_t utime) {
+  const auto known = views_.find(channel);
+  if (known != views_.end() &&
+      std::none_of(known->second.begin(), known->second.end(),
+                   [this](std::uint32_t id) { return server_.Subscribed(id); })) {
+    return;  // advertised, and nobody wants it
+  }
+  const auto* data = reinterpret_cast<const std::uint8_t*>(bytes.data());
+  std::vector<std::uint32_t>& ids = views_[channel];
+  for (const bridge::FoxgloveView& view : bridge::FoxgloveViewsOf(channel, data, bytes.size())) {
+    auto it = ids_.find(view.topic);
+    if (it == ids_.end()) {
+      it = ids_.emplace(view.topic, server_.Advertise({view.topic, "json", view.schema_name,
+                                                       "jsonschema", *view.schema}))
+               .first;
+      ids.push_back(it->second);
+    }
+    if (server_.Subscribed(it->second)) {
+      server_.Send(it->second, std::uint64_t(std::max<std::int64_t>(utime, 0)) * 1000, view.json);
+    }
+  }
+}
+
+}  // namespace sandbox::app
