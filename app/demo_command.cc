@@ -34,7 +34,7 @@ namespace {
 
 const char* kUsage =
     "usage: sandbox demo [--duration S] [--out DIR] [--in-process] [--web [ADDR:]PORT]\n"
-    "                    [--web-control] [--record FILE]\n"
+    "                    [--web-control] [--record FILE] [--foxglove [ADDR:]PORT]\n"
     "  The sample level and the flying wing, flown by the example model (examples/fly_wing)\n"
     "  as a separate process over LCM inside a private network namespace (nothing reaches\n"
     "  the LAN). Face scanner on; chase, trailing and belly cameras write JPEG and an mp4\n"
@@ -48,7 +48,8 @@ const char* kUsage =
     "                ports are out of the browser's reach (docs/reference/web.md)\n"
     "  --web-control the page may steer the cameras (pan, tilt, zoom, overlay)\n"
     "  --record      every message the run publishes to FILE: MCAP for a name ending in\n"
-    "                .mcap, else an LCM log\n";
+    "                .mcap, else an LCM log\n"
+    "  --foxglove    a live Foxglove WebSocket server on this port, as sandbox run --foxglove\n";
 
 bool InNamespace() {
   const char* flag = std::getenv("SANDBOX_IN_NETNS");
@@ -151,8 +152,9 @@ void WriteOverview(const std::filesystem::path& dir, const std::string& file) {
 }  // namespace
 
 int RunDemo(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  const auto parsed = ParseArgs(args, "demo", {"--duration", "--out", "--web", "--record"},
-                                {"--in-process", "--web-control"}, kUsage, err);
+  const auto parsed =
+      ParseArgs(args, "demo", {"--duration", "--out", "--web", "--record", "--foxglove"},
+                {"--in-process", "--web-control"}, kUsage, err);
   if (!parsed) return 2;
   if (parsed->help) {
     out << kUsage;
@@ -189,8 +191,9 @@ int RunDemo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
                                          "--frames",   "jpg,mp4",     "--scans-every", "1"};
     if (web) run_args.insert(run_args.end(), {"--web", parsed->Value("--web")});
     if (parsed->flags.count("--web-control")) run_args.push_back("--web-control");
-    if (parsed->values.count("--record")) {
-      run_args.insert(run_args.end(), {"--record", parsed->Value("--record")});
+    for (const char* option : {"--record", "--foxglove"}) {
+      if (parsed->values.count(option))
+        run_args.insert(run_args.end(), {option, parsed->Value(option)});
     }
     StatusListener status;
     RunHooks hooks;

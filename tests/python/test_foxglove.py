@@ -88,3 +88,29 @@ def test_a_foxglove_client_decodes_the_runs_poses_and_face_scans(tmp_path):
             clouds += 1
     # Every tick after both were subscribed, at least.
     assert transforms >= len(steps) - first and clouds >= len(steps) - first, (transforms, clouds)
+
+
+def handshake(port, protocol="foxglove.websocket.v1", origin=None, host="127.0.0.1", path="/"):
+    """The HTTP status line the server answers a WebSocket handshake with."""
+    import socket
+    lines = [f"GET {path} HTTP/1.1", f"Host: {host}:{port}", "Upgrade: websocket",
+             "Connection: Upgrade", "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==",
+             "Sec-WebSocket-Version: 13"]
+    if protocol:
+        lines.append(f"Sec-WebSocket-Protocol: {protocol}")
+    if origin:
+        lines.append(f"Origin: {origin}")
+    with socket.create_connection(("127.0.0.1", port), timeout=30) as s:
+        s.sendall(("\r\n".join(lines) + "\r\n\r\n").encode())
+        return s.recv(4096).decode(errors="replace").split("\r\n")[0]
+
+
+def test_the_server_keeps_the_browser_views_rules(tmp_path):
+    with sandbox.Lockstep(args=["--foxglove", "0"]) as run:
+        port = int(run.foxglove_url.rsplit(":", 1)[1].strip("/"))
+        assert " 101 " in handshake(port)
+        assert " 101 " in handshake(port, origin=f"http://127.0.0.1:{port}")  # its own address
+        assert " 400 " in handshake(port, protocol=None)          # not the Foxglove protocol
+        assert " 400 " in handshake(port, path="/stream")
+        assert " 403 " in handshake(port, origin="https://evil.example")
+        assert " 403 " in handshake(port, host="rebound.example")  # DNS rebinding
