@@ -9,20 +9,12 @@
 
 #include "web/foxglove_protocol.h"
 #include "web/request_rules.h"
-
-// websocketpp over standalone Asio, as web/stream_server.cc.
-#define ASIO_STANDALONE
-#define _WEBSOCKETPP_CPP11_STL_
-#include <websocketpp/config/asio_no_tls.hpp>
-#include <websocketpp/server.hpp>
+#include "web/websocket_server.h"
 
 namespace sandbox::web {
 namespace {
 
-using Server = websocketpp::server<websocketpp::config::asio>;
-using Handle = websocketpp::connection_hdl;
 using Clock = std::chrono::steady_clock;
-namespace http_status = websocketpp::http::status_code;
 
 nlohmann::json ChannelJson(std::uint32_t id, const FoxgloveChannel& c) {
   return {{"id", id},
@@ -39,12 +31,6 @@ class FoxgloveServer::Impl {
  public:
   explicit Impl(const ServerOptions& options)
       : options_(options), session_(std::to_string(Clock::now().time_since_epoch().count())) {
-    server_.clear_access_channels(websocketpp::log::alevel::all);
-    server_.clear_error_channels(websocketpp::log::elevel::all);
-    server_.init_asio();
-    server_.set_reuse_addr(true);
-    server_.set_max_message_size(options.max_message_bytes);
-    server_.set_max_http_body_size(options.max_message_bytes);
     server_.set_validate_handler([this](Handle h) { return Validate(h); });
     server_.set_http_handler([this](Handle h) {
       server_.get_con_from_hdl(h)->set_status(http_status::upgrade_required);
@@ -53,20 +39,7 @@ class FoxgloveServer::Impl {
     server_.set_open_handler([this](Handle h) { Opened(h); });
     server_.set_close_handler([this](Handle h) { Closed(h); });
     server_.set_message_handler([this](Handle h, Server::message_ptr m) { Request(h, m); });
-    asio::error_code ec;
-    const asio::ip::address address = asio::ip::make_address(options.address, ec);
-    if (ec) throw ServerError("--foxglove: '" + options.address + "' is no IP address");
-    if (options.port < 0 || options.port > 65535) {
-      throw ServerError("--foxglove: port " + std::to_string(options.port) + " is out of 0-65535");
-    }
-    server_.listen(asio::ip::tcp::endpoint(address, std::uint16_t(options.port)), ec);
-    if (ec) {
-      throw ServerError("--foxglove: cannot listen on " + options.address + ":" +
-                        std::to_string(options.port) + ": " + ec.message());
-    }
-    server_.start_accept(ec);
-    if (ec) throw ServerError("--foxglove: cannot accept: " + ec.message());
-    port_ = server_.get_local_endpoint(ec).port();
+    port_ = Listen(server_, options, "--foxglove");
     thread_ = std::thread([this] { server_.run(); });
   }
 
@@ -313,11 +286,7 @@ FoxgloveServer::FoxgloveServer(const ServerOptions& options)
     : impl_(std::make_unique<Impl>(options)), port_(impl_->port()), address_(options.address) {}
 FoxgloveServer::~FoxgloveServer() = default;
 
-std::string FoxgloveServer::url() const {
-  std::string host = address_ == "0.0.0.0" ? "127.0.0.1" : address_ == "::" ? "::1" : address_;
-  if (host.find(':') != std::string::npos) host = "[" + host + "]";
-  return "ws://" + host + ":" + std::to_string(port_) + "/";
-}
+std::string FoxgloveServer::url() const { return ServerUrl("ws", address_, port_); }
 void FoxgloveServer::Defer(std::function<void()> work) { impl_->Defer(std::move(work)); }
 std::uint32_t FoxgloveServer::Advertise(const FoxgloveChannel& channel) {
   return impl_->Advertise(channel);

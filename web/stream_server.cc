@@ -1,31 +1,21 @@
 #include "web/stream_server.h"
 
-#include <nlohmann/json.hpp>
-
 #include <chrono>
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
 #include <vector>
 
 #include "web/request_rules.h"
-
-// websocketpp over standalone Asio (Debian's libasio-dev), with C++11's
-// standard library for its threads and functions.
-#define ASIO_STANDALONE
-#define _WEBSOCKETPP_CPP11_STL_
-#include <websocketpp/config/asio_no_tls.hpp>
-#include <websocketpp/server.hpp>
+#include "web/websocket_server.h"
 
 namespace sandbox::web {
 namespace {
 
-using Server = websocketpp::server<websocketpp::config::asio>;
-using Handle = websocketpp::connection_hdl;
 using Clock = std::chrono::steady_clock;
-namespace http_status = websocketpp::http::status_code;
 
 }  // namespace
 
@@ -35,12 +25,6 @@ class StreamServer::Impl {
     if (!std::filesystem::is_regular_file(options.page_dir / "index.html")) {
       throw ServerError("--web: no page at " + (options.page_dir / "index.html").string());
     }
-    server_.clear_access_channels(websocketpp::log::alevel::all);
-    server_.clear_error_channels(websocketpp::log::elevel::all);
-    server_.init_asio();
-    server_.set_reuse_addr(true);
-    server_.set_max_message_size(options.max_message_bytes);
-    server_.set_max_http_body_size(options.max_message_bytes);
     server_.set_validate_handler([this](Handle h) { return Validate(h); });
     server_.set_http_handler([this](Handle h) { ServeFile(h); });
     server_.set_open_handler([this](Handle h) {
@@ -66,20 +50,7 @@ class StreamServer::Impl {
       }
     });
 
-    asio::error_code ec;
-    const asio::ip::address address = asio::ip::make_address(options.address, ec);
-    if (ec) throw ServerError("--web: '" + options.address + "' is no IP address");
-    if (options.port < 0 || options.port > 65535) {
-      throw ServerError("--web: port " + std::to_string(options.port) + " is out of 0-65535");
-    }
-    server_.listen(asio::ip::tcp::endpoint(address, std::uint16_t(options.port)), ec);
-    if (ec) {
-      throw ServerError("--web: cannot listen on " + options.address + ":" +
-                        std::to_string(options.port) + ": " + ec.message());
-    }
-    server_.start_accept(ec);
-    if (ec) throw ServerError("--web: cannot accept on " + options.address + ": " + ec.message());
-    port_ = server_.get_local_endpoint(ec).port();
+    port_ = Listen(server_, options, "--web");
     timer_ = std::make_unique<asio::steady_timer>(server_.get_io_service());
     ArmTimer();
     thread_ = std::thread([this] { server_.run(); });
@@ -168,9 +139,8 @@ class StreamServer::Impl {
   struct Counts {
     std::atomic<std::int64_t> clients{0}, connections{0}, http_requests{0}, not_found{0},
         refused_origin{0}, refused_full{0}, failed{0}, messages_dropped{0}, commands{0},
-        commands_refused{0}, closed_oversized{0}, camera_frames{0},
-        closed_protocol{0}, dropped_slow{0}, states_published{0}, states_sent{0}, states_skipped{0},
-        bytes_sent{0};
+        commands_refused{0}, closed_oversized{0}, camera_frames{0}, closed_protocol{0},
+        dropped_slow{0}, states_published{0}, states_sent{0}, states_skipped{0}, bytes_sent{0};
   };
 
   bool Validate(Handle h) {
@@ -324,12 +294,7 @@ StreamServer::StreamServer(const ServerOptions& options)
     : impl_(std::make_unique<Impl>(options)), port_(impl_->port()), address_(options.address) {}
 StreamServer::~StreamServer() = default;
 
-std::string StreamServer::url() const {
-  // Bound to every address: this machine's own is one of them.
-  std::string host = address_ == "0.0.0.0" ? "127.0.0.1" : address_ == "::" ? "::1" : address_;
-  if (host.find(':') != std::string::npos) host = "[" + host + "]";
-  return "http://" + host + ":" + std::to_string(port_) + "/";
-}
+std::string StreamServer::url() const { return ServerUrl("http", address_, port_); }
 void StreamServer::SetCameraFrame(const CameraFrame& frame) { impl_->SetCameraFrame(frame); }
 
 std::string EncodeCameraFrame(const CameraFrame& frame) {
