@@ -80,7 +80,7 @@ void LogWriter::Fail(int error_number) {
 
 bool LogWriter::Write(const std::string& channel, const void* data, unsigned size,
                       std::int64_t utime) {
-  if (file_ == nullptr || failed()) return false;
+  if (file_ == nullptr || !error_.empty()) return false;
   unsigned char header[28];
   PutBigEndian(kLogSync, 4, header);
   PutBigEndian(std::uint64_t(events_), 8, header + 4);
@@ -99,12 +99,12 @@ bool LogWriter::Write(const std::string& channel, const void* data, unsigned siz
 }
 
 bool LogWriter::Close() {
-  if (file_ == nullptr) return !failed();
+  if (file_ == nullptr) return error_.empty();
   errno = 0;
   if (std::fflush(file_) != 0) Fail(errno);
   if (std::fclose(file_) != 0) Fail(errno);
   file_ = nullptr;
-  return !failed();
+  return error_.empty();
 }
 
 LcmLink::LcmLink(const std::string& url)

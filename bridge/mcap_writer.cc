@@ -138,7 +138,7 @@ std::uint16_t McapWriter::ChannelId(const std::string& topic, std::uint16_t sche
 }
 
 void McapWriter::Add(const Event& event) {
-  if (!error().empty()) return;
+  if (failed_) return;
   // Room for the message's channel and its views' (two more at most).
   if (channel_ids_.size() > 0xffff - 3 || schema_ids_.size() > 0xffff - 3) {
     return Fail("over 65532 channels or schemas");
@@ -257,7 +257,7 @@ void McapWriter::Finish() {
 }
 
 void McapWriter::Put(const std::string& bytes) {
-  if (file_ == nullptr || !error().empty()) return;
+  if (file_ == nullptr || failed_) return;
   errno = 0;
   if (std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size()) {
     return Fail(std::strerror(errno != 0 ? errno : EIO));
@@ -268,6 +268,7 @@ void McapWriter::Put(const std::string& bytes) {
 
 void McapWriter::Fail(const std::string& why) {
   std::lock_guard<std::mutex> lock(mutex_);
+  failed_ = true;
   if (error_.empty()) {
     error_ =
         "cannot write '" + path_ + "' after " + std::to_string(messages_) + " messages: " + why;

@@ -14,6 +14,7 @@
 // kMaxQueuedBytes are queued (the disk is slower than the run: nothing is
 // dropped).
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -98,6 +99,7 @@ class McapWriter final : public EventWriter {
   bool closing_{false};
   std::int64_t events_{0};
   std::string error_;
+  std::atomic<bool> failed_{false};  // error_ is set (read without the lock)
   std::thread thread_;
 
   // The writer's thread only.

@@ -100,26 +100,18 @@ class FoxgloveServer::Impl {
       asio::error_code ec;
       const Server::connection_ptr con = server_.get_con_from_hdl(handle, ec);
       if (ec) continue;
-      if (con->get_buffered_amount() > options_.max_queued_bytes) {
+      if (bool drop = false;
+          !client.backlog.Admit(con->get_buffered_amount(), options_, now, &drop)) {
         ++counts_.messages_skipped;
-        if (!client.behind) client.behind = true, client.behind_since = now;
-        if (std::chrono::duration<double>(now - client.behind_since).count() >
-            options_.slow_timeout_s) {
-          slow.push_back(handle);
-        }
+        if (drop) slow.push_back(handle);
         continue;
       }
-      client.behind = false;
       for (int i = 0; i < 4; ++i) frame[std::size_t(1 + i)] = char(subscription->second >> (8 * i));
       if (con->send(frame.data(), frame.size(), websocketpp::frame::opcode::binary)) continue;
       ++counts_.messages_sent;
       counts_.bytes_sent += std::int64_t(frame.size());
     }
-    for (const Handle& handle : slow) {
-      asio::error_code ec;
-      ++counts_.dropped_slow;
-      server_.close(handle, websocketpp::close::status::policy_violation, "too slow", ec);
-    }
+    counts_.dropped_slow += DropSlow(server_, slow);
   }
 
   bool HasClients() const { return counts_.clients > 0; }
@@ -146,8 +138,7 @@ class FoxgloveServer::Impl {
   struct Client {
     std::map<std::uint32_t, std::uint32_t> subscriptions;  // subscription id -> channel
     std::map<std::uint32_t, std::uint32_t> by_channel;     // channel -> subscription id
-    bool behind{false};
-    Clock::time_point behind_since;
+    Backlog backlog;
   };
   struct Counts {
     std::atomic<std::int64_t> clients{0}, connections{0}, refused_origin{0}, refused_protocol{0},

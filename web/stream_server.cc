@@ -132,8 +132,7 @@ class StreamServer::Impl {
   struct Client {
     std::map<std::string, std::int64_t> camera_sequence;  // the last frame sent of each
     bool level_sent{false};
-    bool behind{false};
-    Clock::time_point behind_since;
+    Backlog backlog;
   };
   // ServerCounts, as atomics (written on the server's thread, read anywhere).
   struct Counts {
@@ -252,16 +251,12 @@ class StreamServer::Impl {
         }
       }
       if (state.text.empty()) continue;
-      if (con->get_buffered_amount() > options_.max_queued_bytes) {
+      if (bool drop = false;
+          !client.backlog.Admit(con->get_buffered_amount(), options_, now, &drop)) {
         ++counts_.states_skipped;
-        if (!client.behind) client.behind = true, client.behind_since = now;
-        if (std::chrono::duration<double>(now - client.behind_since).count() >
-            options_.slow_timeout_s) {
-          slow.push_back(handle);
-        }
+        if (drop) slow.push_back(handle);
         continue;
       }
-      client.behind = false;
       con->send(state.text, websocketpp::frame::opcode::text);
       if (!state.binary.empty()) {
         con->send(state.binary.data(), state.binary.size(), websocketpp::frame::opcode::binary);
@@ -269,11 +264,7 @@ class StreamServer::Impl {
       ++counts_.states_sent;
       counts_.bytes_sent += std::int64_t(state.text.size() + state.binary.size());
     }
-    for (const Handle& handle : slow) {
-      asio::error_code ec;
-      ++counts_.dropped_slow;
-      server_.close(handle, websocketpp::close::status::policy_violation, "too slow", ec);
-    }
+    counts_.dropped_slow += DropSlow(server_, slow);
   }
 
   const ServerOptions options_;

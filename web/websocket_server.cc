@@ -25,6 +25,26 @@ int Listen(Server& server, const ServerOptions& options, const std::string& opti
   return server.get_local_endpoint(ec).port();
 }
 
+bool Backlog::Admit(std::size_t buffered, const ServerOptions& options,
+                    std::chrono::steady_clock::time_point now, bool* drop) {
+  *drop = false;
+  if (buffered <= options.max_queued_bytes) {
+    behind = false;
+    return true;
+  }
+  if (!behind) behind = true, since = now;
+  *drop = std::chrono::duration<double>(now - since).count() > options.slow_timeout_s;
+  return false;
+}
+
+std::int64_t DropSlow(Server& server, const std::vector<Handle>& slow) {
+  for (const Handle& handle : slow) {
+    asio::error_code ec;
+    server.close(handle, websocketpp::close::status::policy_violation, "too slow", ec);
+  }
+  return std::int64_t(slow.size());
+}
+
 std::string ServerUrl(const std::string& scheme, const std::string& address, int port) {
   // Bound to every address: this machine's own is one of them.
   std::string host = address == "0.0.0.0" ? "127.0.0.1" : address == "::" ? "::1" : address;
