@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "bridge/foxglove_views.h"
+
 namespace sandbox::bridge {
 
 // Events in, one at a time. Write errors are kept, not thrown: the first one
@@ -20,6 +22,23 @@ class EventWriter {
   // writing has failed.
   virtual bool Write(const std::string& channel, const void* data, unsigned size,
                      std::int64_t utime) = 0;
+  // Appends an input the run received: as Write(), without the Foxglove views
+  // (the robot's frame comes from its STATE, in the world's convention).
+  virtual bool WriteInput(const std::string& channel, const void* data, unsigned size,
+                          std::int64_t utime) {
+    return Write(channel, data, size, utime);
+  }
+  // Appends a message in one of Foxglove's schemas that no LCM message
+  // carries (a robot's link frames, a camera image, the scene), made by
+  // `make` on the writer's own time; formats without such channels (LCM
+  // logs) skip it and return true.
+  virtual bool WriteView(MakeView /*make*/, std::int64_t /*utime*/) { return true; }
+  // Whether WriteView() keeps what it is given (the caller may skip making it).
+  virtual bool TakesViews() const { return false; }
+  // Whether the run's inputs go in too, beside what it publishes (MCAP: a
+  // recording to review; an LCM log holds outputs alone, so that playing it
+  // onto a network never drives another run).
+  virtual bool TakesInputs() const { return false; }
   // Finishes the file; false when that or any earlier write failed.
   virtual bool Close() = 0;
   // Empty while everything was written, else what failed and where.

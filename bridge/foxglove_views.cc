@@ -5,41 +5,83 @@
 #include <cstring>
 #include <nlohmann/json.hpp>
 
+#include "bridge/foxglove_json.h"
 #include "bridge/lcm_types.h"
 #include "sandbox_msgs/lidar_scan_t.hpp"
 #include "sandbox_msgs/robot_pose_t.hpp"
 #include "sandbox_msgs/robot_state_t.hpp"
 #include "sandbox_msgs/scan_face_t.hpp"
 
+namespace sandbox::bridge::foxglove_json {
+
+const std::string& TimeSchema() {
+  static const std::string schema =
+      R"({"type":"object","properties":{"sec":{"type":"integer","minimum":0},"nsec":{"type":"integer","minimum":0,"maximum":999999999}}})";
+  return schema;
+}
+
+const std::string& Vector3Schema() {
+  static const std::string schema =
+      R"({"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"},"z":{"type":"number"}}})";
+  return schema;
+}
+
+const std::string& QuaternionSchema() {
+  static const std::string schema =
+      R"({"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"},"z":{"type":"number"},"w":{"type":"number"}}})";
+  return schema;
+}
+
+const std::string& PoseSchema() {
+  static const std::string schema = R"({"type":"object","properties":{"position":)" +
+                                    Vector3Schema() + R"(,"orientation":)" + QuaternionSchema() + "}}";
+  return schema;
+}
+
+const std::string& FrameTransformSchema() {
+  static const std::string schema =
+      R"({"title":"foxglove.FrameTransform","description":"A transform between two reference frames in 3D space","type":"object","properties":{"timestamp":)" +
+      TimeSchema() +
+      R"(,"parent_frame_id":{"type":"string"},"child_frame_id":{"type":"string"},"translation":)" +
+      Vector3Schema() + R"(,"rotation":)" + QuaternionSchema() + "}}";
+  return schema;
+}
+
+nlohmann::json Time(std::int64_t utime) {
+  const std::int64_t sec = utime >= 0 ? utime / 1'000'000 : 0;
+  return {{"sec", sec}, {"nsec", utime >= 0 ? (utime % 1'000'000) * 1000 : 0}};
+}
+
+std::string WithBase64(const nlohmann::json& message, const char* field, const void* bytes,
+                       std::size_t size) {
+  std::string text = message.dump();
+  const std::string key = std::string("\"") + field + "\":\"";
+  const std::size_t at = text.find(key);
+  gchar* base64 = g_base64_encode(static_cast<const guchar*>(bytes), size);
+  text.insert(at + key.size(), base64);
+  g_free(base64);
+  return text;
+}
+
+}  // namespace sandbox::bridge::foxglove_json
+
 namespace sandbox::bridge {
 namespace {
 
 using nlohmann::json;
 
-// The JSON schemas: the fields of Foxglove's schemas this file fills in.
-const std::string kTime =
-    R"({"type":"object","properties":{"sec":{"type":"integer","minimum":0},"nsec":{"type":"integer","minimum":0,"maximum":999999999}}})";
-const std::string kVector3 =
-    R"({"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"},"z":{"type":"number"}}})";
-const std::string kQuaternion =
-    R"({"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"},"z":{"type":"number"},"w":{"type":"number"}}})";
-const std::string kFrameTransformSchema =
-    R"({"title":"foxglove.FrameTransform","description":"A transform between two reference frames in 3D space","type":"object","properties":{"timestamp":)" +
-    kTime +
-    R"(,"parent_frame_id":{"type":"string"},"child_frame_id":{"type":"string"},"translation":)" +
-    kVector3 + R"(,"rotation":)" + kQuaternion + "}}";
-const std::string kPointCloudSchema =
-    R"({"title":"foxglove.PointCloud","description":"A collection of N-dimensional points, which may contain additional fields with information like normals, intensity, etc.","type":"object","properties":{"timestamp":)" +
-    kTime + R"(,"frame_id":{"type":"string"},"pose":{"type":"object","properties":{"position":)" +
-    kVector3 + R"(,"orientation":)" + kQuaternion +
-    R"(}},"point_stride":{"type":"integer","minimum":0},"fields":{"type":"array","items":{"type":"object","properties":{"name":{"type":"string"},"offset":{"type":"integer","minimum":0},"type":{"type":"integer","description":"1 UINT8, 2 INT8, 3 UINT16, 4 INT16, 5 UINT32, 6 INT32, 7 FLOAT32, 8 FLOAT64"}}}},"data":{"type":"string","contentEncoding":"base64"}}})";
+using foxglove_json::Time;
+
+const std::string& PointCloudSchema() {
+  static const std::string schema =
+      R"({"title":"foxglove.PointCloud","description":"A collection of N-dimensional points, which may contain additional fields with information like normals, intensity, etc.","type":"object","properties":{"timestamp":)" +
+      foxglove_json::TimeSchema() + R"(,"frame_id":{"type":"string"},"pose":)" +
+      foxglove_json::PoseSchema() +
+      R"(,"point_stride":{"type":"integer","minimum":0},"fields":{"type":"array","items":{"type":"object","properties":{"name":{"type":"string"},"offset":{"type":"integer","minimum":0},"type":{"type":"integer","description":"1 UINT8, 2 INT8, 3 UINT16, 4 INT16, 5 UINT32, 6 INT32, 7 FLOAT32, 8 FLOAT64"}}}},"data":{"type":"string","contentEncoding":"base64"}}})";
+  return schema;
+}
 
 enum NumericType { kInt8 = 2, kInt32 = 6, kFloat32 = 7 };
-
-json Time(std::int64_t utime) {
-  const std::int64_t sec = utime >= 0 ? utime / 1'000'000 : 0;
-  return {{"sec", sec}, {"nsec", utime >= 0 ? (utime % 1'000'000) * 1000 : 0}};
-}
 
 // Decodes an LCM message, or false.
 template <typename Message>
@@ -54,7 +96,8 @@ FoxgloveView Transform(const std::string& channel, const std::string& robot, std
                   {"child_frame_id", robot},
                   {"translation", {{"x", position[0]}, {"y", position[1]}, {"z", position[2]}}},
                   {"rotation", {{"x", wxyz[1]}, {"y", wxyz[2]}, {"z", wxyz[3]}, {"w", wxyz[0]}}}};
-  return {channel + "/tf", "foxglove.FrameTransform", &kFrameTransformSchema, message.dump()};
+  return {channel + "/tf", "foxglove.FrameTransform", &foxglove_json::FrameTransformSchema(),
+          message.dump()};
 }
 
 // A point cloud's fields, packed point after point.
@@ -78,14 +121,8 @@ class Points {
                     {"point_stride", stride_},
                     {"fields", fields_},
                     {"data", ""}};
-    // The data goes in after: base64 needs no escaping, and the JSON writer's
-    // escape check on it was a fifth of a recording's work.
-    std::string text = message.dump();
-    const std::size_t at = text.find(R"("data":")");
-    gchar* base64 = g_base64_encode(reinterpret_cast<const guchar*>(data_.data()), data_.size());
-    text.insert(at + 8, base64);
-    g_free(base64);
-    return {topic, "foxglove.PointCloud", &kPointCloudSchema, std::move(text)};
+    std::string text = foxglove_json::WithBase64(message, "data", data_.data(), data_.size());
+    return {topic, "foxglove.PointCloud", &PointCloudSchema(), std::move(text)};
   }
 
  private:

@@ -8,6 +8,7 @@
 // base64, as Foxglove's JSON schemas say. Threads: any (no state).
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,10 @@ struct FoxgloveView {
   const std::string* schema{nullptr};  // its JSON schema
   std::string json;                    // the message
 };
+
+// A view made when (and where) it is needed: on a recording's writer thread
+// or the live server's thread, never on the loop's.
+using MakeView = std::function<FoxgloveView()>;
 
 // Whether the message is of a type with a view (a look at its fingerprint).
 bool HasFoxgloveView(const std::uint8_t* data, std::size_t size);

@@ -275,6 +275,7 @@ LatestInput::~LatestInput() {
 }
 
 void LatestInput::OnMessage(const void* data, unsigned size, std::int64_t receive_utime) {
+  link_.RecordInput(channel_, data, size, receive_utime);
   ++received_;
   last_receive_utime_ = receive_utime;
   const auto* bytes = static_cast<const std::uint8_t*>(data);

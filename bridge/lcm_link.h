@@ -93,6 +93,22 @@ class LcmLink {
   // write error is kept in record_error() and stops the recording.
   void RecordTo(const std::string& path);
   void set_record_utime(std::int64_t utime) { record_utime_ = utime; }
+  // Also writes a Foxglove view no LCM message carries (a link frame, a
+  // camera image) to the recording, when it takes them (an MCAP file).
+  bool RecordsViews() const { return record_ && record_->TakesViews(); }
+  void RecordView(MakeView make, std::int64_t utime) {
+    if (RecordsViews()) record_->WriteView(std::move(make), utime);
+  }
+  // Also writes an input message as it arrives (before it is checked) to a
+  // recording that takes inputs (MCAP), stamped with its receive time, or
+  // with the time set by set_input_utime() (a replayed event's own).
+  void RecordInput(const std::string& channel, const void* data, unsigned size,
+                   std::int64_t receive_utime) {
+    if (record_ && record_->TakesInputs()) {
+      record_->WriteInput(channel, data, size, input_utime_ >= 0 ? input_utime_ : receive_utime);
+    }
+  }
+  void set_input_utime(std::int64_t utime) { input_utime_ = utime; }  // < 0: the receive time
   // Closes the recording (flushing it); false when any of it could not be written.
   bool FinishRecording();
   // Empty while the recording (if any) is whole.
@@ -107,6 +123,7 @@ class LcmLink {
   std::unique_ptr<Impl> impl_;
   std::unique_ptr<EventWriter> record_;
   std::int64_t record_utime_{0};
+  std::int64_t input_utime_{-1};
   PublishTap tap_;
 };
 

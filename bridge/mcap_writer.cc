@@ -53,11 +53,26 @@ McapWriter::~McapWriter() { Close(); }
 
 bool McapWriter::Write(const std::string& channel, const void* data, unsigned size,
                        std::int64_t utime) {
+  return Queue({channel, std::string(static_cast<const char*>(data), size), utime, true, {}});
+}
+
+bool McapWriter::WriteInput(const std::string& channel, const void* data, unsigned size,
+                            std::int64_t utime) {
+  return Queue({channel, std::string(static_cast<const char*>(data), size), utime, false, {}});
+}
+
+bool McapWriter::WriteView(MakeView make, std::int64_t utime) {
+  if (!options_.foxglove_views) return true;
+  return Queue({{}, {}, utime, false, std::move(make)});
+}
+
+bool McapWriter::Queue(Event event) {
+  const std::size_t bytes = event.data.size() + event.channel.size();
   std::unique_lock<std::mutex> lock(mutex_);
   changed_.wait(lock, [&] { return queued_bytes_ < kMaxQueuedBytes || closing_; });
   if (closing_ || !error_.empty()) return false;
-  queue_.push_back({channel, std::string(static_cast<const char*>(data), size), utime});
-  queued_bytes_ += size + channel.size();
+  queue_.push_back(std::move(event));
+  queued_bytes_ += bytes;
   ++events_;
   // The writer's thread looks every kWritePeriod: no wake-up (a system call)
   // a message unless much is waiting.
@@ -143,12 +158,19 @@ void McapWriter::Add(const Event& event) {
   if (channel_ids_.size() > 0xffff - 3 || schema_ids_.size() > 0xffff - 3) {
     return Fail("over 65532 channels or schemas");
   }
+  const std::uint64_t time = std::uint64_t(event.utime) * 1000;  // nanoseconds
+  if (event.make) {  // a view given as one
+    const FoxgloveView view = event.make();
+    const std::uint16_t schema = SchemaId(view.schema_name, "jsonschema", *view.schema);
+    AddMessage(ChannelId(view.topic, schema, "json"), time, view.json);
+    if (chunk_.size() >= options_.chunk_bytes) FinishChunk();
+    return;
+  }
   const auto* bytes = reinterpret_cast<const std::uint8_t*>(event.data.data());
   const LcmType* type = LcmTypeOf(bytes, event.data.size());
   const std::uint16_t schema = type ? SchemaId(type->full_name(), "lcm", type->schema) : 0;
-  const std::uint64_t time = std::uint64_t(event.utime) * 1000;  // nanoseconds
   AddMessage(ChannelId(event.channel, schema, "lcm"), time, event.data);
-  if (options_.foxglove_views) {
+  if (options_.foxglove_views && event.with_views) {
     for (const FoxgloveView& view : FoxgloveViewsOf(event.channel, bytes, event.data.size())) {
       const std::uint16_t view_schema = SchemaId(view.schema_name, "jsonschema", *view.schema);
       AddMessage(ChannelId(view.topic, view_schema, "json"), time, view.json);

@@ -57,6 +57,11 @@ class McapWriter final : public EventWriter {
 
   bool Write(const std::string& channel, const void* data, unsigned size,
              std::int64_t utime) override;
+  bool WriteInput(const std::string& channel, const void* data, unsigned size,
+                  std::int64_t utime) override;
+  bool WriteView(MakeView make, std::int64_t utime) override;
+  bool TakesViews() const override { return options_.foxglove_views; }
+  bool TakesInputs() const override { return true; }
   bool Close() override;
   std::string error() const override;
   std::int64_t events() const override;
@@ -66,6 +71,8 @@ class McapWriter final : public EventWriter {
     std::string channel;
     std::string data;
     std::int64_t utime;
+    bool with_views{true};  // an LCM message's Foxglove views too (not for inputs)
+    MakeView make;          // a view given as one (WriteView): made on the writer's thread
   };
   struct ChannelKey {
     std::string topic;
@@ -75,6 +82,7 @@ class McapWriter final : public EventWriter {
     }
   };
 
+  bool Queue(Event event);
   void Run();  // the writer's thread
   void Add(const Event& event);
   void AddMessage(std::uint16_t channel, std::uint64_t time, std::string_view data);

@@ -33,6 +33,7 @@ std::vector<RecordedRobot> RecordedRobots(const std::vector<RobotBridgeConfig>& 
 struct LogEvent {
   std::string channel;
   std::vector<std::uint8_t> data;
+  std::int64_t utime{-1};  // its time, for a recording of the inputs; < 0: when it arrives
 };
 
 class StatesAsInputs {

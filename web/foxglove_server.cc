@@ -87,11 +87,26 @@ class FoxgloveServer::Impl {
     return channel < subscribers_.size() && subscribers_[channel] > 0;
   }
 
-  void Send(std::uint32_t channel, std::uint64_t time_ns, const std::string& payload) {
+  static std::string MessageData(std::uint64_t time_ns, const std::string& payload) {
     std::string frame(1 + 4 + 8, '\0');
-    frame[0] = 1;  // MessageData
+    frame[0] = 1;  // MessageData; the subscription id (1..4) is set per client
     for (int i = 0; i < 8; ++i) frame[std::size_t(5 + i)] = char((time_ns >> (8 * i)) & 0xff);
-    frame += payload;
+    return frame + payload;
+  }
+
+  void Latch(std::uint32_t channel, std::uint64_t time_ns, std::string payload) {
+    auto message = std::make_shared<LatchedMessage>(LatchedMessage{time_ns, std::move(payload)});
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      latched_[channel] = message;
+    }
+    if (counts_.clients == 0) return;
+    asio::post(server_.get_io_service(),
+               [this, channel, message] { Send(channel, message->time_ns, message->payload); });
+  }
+
+  void Send(std::uint32_t channel, std::uint64_t time_ns, const std::string& payload) {
+    std::string frame = MessageData(time_ns, payload);
     const Clock::time_point now = Clock::now();
     std::vector<Handle> slow;
     for (auto& [handle, client] : clients_) {
@@ -217,7 +232,7 @@ class FoxgloveServer::Impl {
         const FoxgloveRequest request = ParseFoxgloveRequest(message->get_payload());
         if (request.op == FoxgloveRequest::Op::kSubscribe) {
           for (const auto& [id, channel] : request.subscribe)
-            problem += Subscribe(&client, id, channel);
+            problem += Subscribe(h, &client, id, channel);
         } else if (request.op == FoxgloveRequest::Op::kUnsubscribe) {
           for (const std::uint32_t id : request.unsubscribe) Unsubscribe(&client, id);
         } else {
@@ -232,7 +247,7 @@ class FoxgloveServer::Impl {
     SendText(h, nlohmann::json{{"op", "status"}, {"level", 1}, {"message", problem}}.dump());
   }
 
-  std::string Subscribe(Client* client, std::uint32_t id, std::uint32_t channel) {
+  std::string Subscribe(Handle h, Client* client, std::uint32_t id, std::uint32_t channel) {
     std::lock_guard<std::mutex> lock(mutex_);
     if (channel >= channels_.size()) return "no channel " + std::to_string(channel) + "; ";
     if (client->subscriptions.count(id) || client->by_channel.count(channel)) {
@@ -242,6 +257,13 @@ class FoxgloveServer::Impl {
     client->by_channel[channel] = id;
     ++subscribers_[channel];
     ++counts_.subscriptions;
+    if (const auto latched = latched_.find(channel); latched != latched_.end()) {
+      std::string frame = MessageData(latched->second->time_ns, latched->second->payload);
+      for (int i = 0; i < 4; ++i) frame[std::size_t(1 + i)] = char(id >> (8 * i));
+      asio::error_code ec;
+      server_.send(h, frame.data(), frame.size(), websocketpp::frame::opcode::binary, ec);
+      if (!ec) ++counts_.messages_sent, counts_.bytes_sent += std::int64_t(frame.size());
+    }
     return "";
   }
 
@@ -268,8 +290,9 @@ class FoxgloveServer::Impl {
   int port_{0};
   std::map<Handle, Client, std::owner_less<Handle>> clients_;  // server thread only
   mutable std::mutex mutex_;
-  std::vector<FoxgloveChannel> channels_;  // by id
-  std::vector<int> subscribers_;           // by channel
+  std::vector<FoxgloveChannel> channels_;                                   // by id
+  std::vector<int> subscribers_;                                            // by channel
+  std::map<std::uint32_t, std::shared_ptr<const LatchedMessage>> latched_;  // by channel
   Counts counts_;
 };
 
@@ -281,6 +304,9 @@ std::string FoxgloveServer::url() const { return ServerUrl("ws", address_, port_
 void FoxgloveServer::Defer(std::function<void()> work) { impl_->Defer(std::move(work)); }
 std::uint32_t FoxgloveServer::Advertise(const FoxgloveChannel& channel) {
   return impl_->Advertise(channel);
+}
+void FoxgloveServer::Latch(std::uint32_t channel, std::uint64_t time_ns, std::string payload) {
+  impl_->Latch(channel, time_ns, std::move(payload));
 }
 bool FoxgloveServer::Subscribed(std::uint32_t channel) const { return impl_->Subscribed(channel); }
 void FoxgloveServer::Send(std::uint32_t channel, std::uint64_t time_ns,

@@ -31,6 +31,13 @@ struct FoxgloveChannel {
   std::string schema;
 };
 
+// A channel's last message, sent to each client as it subscribes (the
+// scene: written once, needed by every client that comes later).
+struct LatchedMessage {
+  std::uint64_t time_ns{0};
+  std::string payload;
+};
+
 struct FoxgloveCounts {
   std::int64_t clients{0};           // connected now
   std::int64_t connections{0};       // WebSockets opened
@@ -71,6 +78,8 @@ class FoxgloveServer {
   // subscribers; one too far behind skips it.
   void Send(std::uint32_t channel, std::uint64_t time_ns, const std::string& payload);
   bool HasClients() const;
+  // Any thread: the channel's message now and for every later subscriber.
+  void Latch(std::uint32_t channel, std::uint64_t time_ns, std::string payload);
 
   FoxgloveCounts counts() const;
 
