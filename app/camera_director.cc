@@ -53,6 +53,7 @@ int CameraDirector::Direct(const Shot& shot, FramePipeline* frames, bool write, 
     job.camera = run.camera->spec.name;
     job.tick = shot.tick;
     job.time_s = shot.t_s;
+    job.utime = shot.utime;
     job.view = view;
     job.settings = run.camera->look;
     if (shown) job.settings.images |= render::kColorImage;  // the live view shows colour

@@ -31,6 +31,7 @@ class CameraDirector {
   struct Shot {
     double t_s{0.0};
     std::int64_t tick{0};
+    std::int64_t utime{0};                        // the tick's clock, as inputs are stamped
     std::vector<scene::RobotState*> robots;       // skinned when a frame is due
     std::vector<const bridge::RobotFeed*> feeds;  // steering and camera choice
     const scene::CollisionWorld* world{nullptr};

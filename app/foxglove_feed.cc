@@ -26,16 +26,42 @@ void FoxgloveFeed::Convert(const std::string& channel, const std::string& bytes,
   const auto* data = reinterpret_cast<const std::uint8_t*>(bytes.data());
   std::vector<std::uint32_t>& ids = views_[channel];
   for (const bridge::FoxgloveView& view : bridge::FoxgloveViewsOf(channel, data, bytes.size())) {
-    auto it = ids_.find(view.topic);
-    if (it == ids_.end()) {
-      it = ids_.emplace(view.topic, server_.Advertise({view.topic, "json", view.schema_name,
-                                                       "jsonschema", *view.schema}))
-               .first;
-      ids.push_back(it->second);
-    }
-    if (server_.Subscribed(it->second)) {
-      server_.Send(it->second, std::uint64_t(std::max<std::int64_t>(utime, 0)) * 1000, view.json);
-    }
+    Send(view, utime, &ids);
+  }
+}
+
+void FoxgloveFeed::PublishView(const std::string& topic, bridge::MakeView make,
+                               std::int64_t utime) {
+  if (!server_.HasClients()) return;
+  server_.Defer([this, topic, make = std::move(make), utime] {
+    const auto known = ids_.find(topic);
+    if (known != ids_.end() && !server_.Subscribed(known->second)) return;
+    Send(make(), utime, nullptr);
+  });
+}
+
+void FoxgloveFeed::Latch(const bridge::FoxgloveView& view, std::int64_t utime) {
+  auto it = latched_ids_.find(view.topic);
+  if (it == latched_ids_.end()) {
+    it = latched_ids_
+             .emplace(view.topic, server_.Advertise({view.topic, "json", view.schema_name,
+                                                     "jsonschema", *view.schema}))
+             .first;
+  }
+  server_.Latch(it->second, std::uint64_t(std::max<std::int64_t>(utime, 0)) * 1000, view.json);
+}
+
+void FoxgloveFeed::Send(const bridge::FoxgloveView& view, std::int64_t utime,
+                        std::vector<std::uint32_t>* ids) {
+  auto it = ids_.find(view.topic);
+  if (it == ids_.end()) {
+    it = ids_.emplace(view.topic, server_.Advertise({view.topic, "json", view.schema_name,
+                                                     "jsonschema", *view.schema}))
+             .first;
+    if (ids != nullptr) ids->push_back(it->second);
+  }
+  if (server_.Subscribed(it->second)) {
+    server_.Send(it->second, std::uint64_t(std::max<std::int64_t>(utime, 0)) * 1000, view.json);
   }
 }
 

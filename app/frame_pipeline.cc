@@ -80,6 +80,15 @@ void FramePipeline::Finish() {
   write_thread_.join();
 }
 
+render::Lens FrameIntrinsics(const render::CameraView& view) {
+  if (view.lens) return *view.lens;
+  render::Lens lens;
+  const double f = 0.5 * view.height / std::tan(0.5 * view.fov_y_rad);
+  lens.fx = lens.fy = f, lens.cx = 0.5 * view.width - 0.5;
+  lens.cy = 0.5 * view.height - 0.5;
+  return lens;
+}
+
 void FramePipeline::Submit(RenderJob job) {
   {
     std::unique_lock<std::mutex> lock(mutex_);
@@ -129,7 +138,7 @@ void FramePipeline::RenderLoop() {
       ++failed_;
       continue;
     }
-    Encoded item{job.camera, job.tick, job.time_s, {}, job.robot_pose, job.view};
+    Encoded item{job.camera, job.tick, job.time_s, job.utime, {}, job.robot_pose, job.view};
     std::vector<const scene::RobotState*> robots;
     for (const scene::RobotState& state : job.robots) robots.push_back(&state);
     try {
@@ -275,13 +284,9 @@ void FramePipeline::Write(const Encoded& item) {
     // A pinhole: square pixels, one focal length from the vertical field of
     // view; pixel centres at whole coordinates, as OpenCV's camera matrix has
     // them. A lens: its own, and its coefficients (OpenCV's).
-    render::Lens lens;
-    const double f = 0.5 * item.view.height / std::tan(0.5 * item.view.fov_y_rad);
-    lens.fx = lens.fy = f, lens.cx = 0.5 * item.view.width - 0.5;
-    lens.cy = 0.5 * item.view.height - 0.5;
-    if (item.view.lens) lens = *item.view.lens;
-    row << "," << lens.fx << "," << lens.fy << "," << lens.cx << "," << lens.cy << ","
-        << depth_file << "," << segmentation_file << "," << normals_file << ","
+    const render::Lens lens = FrameIntrinsics(item.view);
+    row << "," << lens.fx << "," << lens.fy << "," << lens.cx << "," << lens.cy << "," << depth_file
+        << "," << segmentation_file << "," << normals_file << ","
         << (item.view.lens ? lens.ModelName() : "pinhole");
     for (const double k : {lens.k1, lens.k2, lens.k3, lens.k4, lens.p1, lens.p2}) row << "," << k;
     // The row is the frame's last part: a frame whose row cannot be written is removed.
@@ -290,9 +295,9 @@ void FramePipeline::Write(const Encoded& item) {
     ++written_;
     if (config_.written) {
       const bool color = !config_.image_format.empty() && (kinds & render::kColorImage);
-      config_.written(item.camera, item.tick, item.view, item.frame,
-                      color ? dir / (name.str() + "." + config_.image_format)
-                            : std::filesystem::path());
+      config_.written(
+          item.camera, item.tick, item.utime, item.view, item.frame,
+          color ? dir / (name.str() + "." + config_.image_format) : std::filesystem::path());
     }
   } catch (const std::exception& e) {
     Fail(e.what());

@@ -55,8 +55,9 @@ struct FramePipelineConfig {
   std::function<void(const std::string& camera, const render::Frame& frame)> show;
   // Called on the encoder thread after each frame is written, with its
   // colour image's file (empty when none was written: a video only).
-  std::function<void(const std::string& camera, std::int64_t tick, const render::CameraView& view,
-                     const render::Frame& frame, const std::filesystem::path& color_file)>
+  std::function<void(const std::string& camera, std::int64_t tick, std::int64_t utime,
+                     const render::CameraView& view, const render::Frame& frame,
+                     const std::filesystem::path& color_file)>
       written;
 };
 
@@ -65,6 +66,7 @@ struct RenderJob {
   std::string camera;
   std::int64_t tick{0};
   double time_s{0.0};
+  std::int64_t utime{0};  // the tick's clock, as inputs are stamped
   render::CameraView view;
   render::RenderSettings settings;  // the look and the image kinds
   std::vector<scene::RobotState> robots;
@@ -75,6 +77,11 @@ struct RenderJob {
   bool write{true};                                             // to the output folder
   bool show{false};  // to FramePipelineConfig::show (the live view)
 };
+
+// A frame's intrinsics as the index has them: a lens's own, else a pinhole's
+// (square pixels, the focal length from the vertical field of view, pixel
+// centres at whole coordinates; no distortion).
+render::Lens FrameIntrinsics(const render::CameraView& view);
 
 class FramePipeline {
  public:
@@ -102,6 +109,7 @@ class FramePipeline {
     std::string camera;
     std::int64_t tick;
     double time_s;
+    std::int64_t utime;
     render::Frame frame;
     Eigen::Isometry3d robot_pose;
     render::CameraView view;

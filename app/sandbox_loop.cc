@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -68,6 +69,20 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
     robot.outputs = std::make_unique<bridge::RobotOutputs>(
         link_, config.channel_prefix,
         config.state_in_pose_convention ? config.pose : bridge::Translation{});
+    robot.foxglove_frame = config.channel_prefix;
+    const scene::RobotModel& model = level_.robots[r];
+    std::set<int> link_nodes;  // its links (a description's), bones and skin joints
+    for (const std::string& name : model.links) link_nodes.insert(model.FindNode(name));
+    for (const scene::Bone& bone : model.bones) link_nodes.insert(bone.node);
+    for (const scene::SkinJoint& joint : model.joints) link_nodes.insert(joint.node);
+    for (const int node : link_nodes) {
+      if (node < 0) continue;
+      const std::string& name = model.nodes[std::size_t(node)].name;
+      robot.foxglove_links.emplace_back(
+          bridge::FoxgloveLinkFrame(config.channel_prefix,
+                                    name.empty() ? "node" + std::to_string(node) : name),
+          node);
+    }
   }
   std::vector<std::string> prefixes;
   for (const bridge::RobotBridgeConfig& config : loaded_.bridges) {
@@ -105,11 +120,12 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
         live_view_->Show(frame, camera);
       };
     }
-    if (options_.web_port >= 0) {
-      config.written = [this](const std::string& camera, std::int64_t tick,
+    if (options_.web_port >= 0 || link_.RecordsViews() || foxglove_) {
+      config.written = [this](const std::string& camera, std::int64_t tick, std::int64_t utime,
                               const render::CameraView& view, const render::Frame& frame,
                               const std::filesystem::path& color_file) {
         ShowCameraFrame(camera, tick, view, frame, color_file);
+        if (WantsFoxgloveViews()) EmitFoxgloveCamera(camera, utime, view, frame, color_file);
       };
     }
     frames_ = std::make_unique<FramePipeline>(level_, config);
@@ -267,9 +283,11 @@ bool SandboxLoop::Step(const std::vector<bridge::LogEvent>& events) {
 
 void SandboxLoop::Arrive(const std::vector<bridge::LogEvent>& events) {
   for (const bridge::LogEvent& event : events) {
+    link_.set_input_utime(event.utime);  // a recording stamps the input with its own time
     link_.Inject(event.channel, event.data.data(), unsigned(event.data.size()));
     link_.Drain();
   }
+  link_.set_input_utime(-1);
 }
 
 void SandboxLoop::Tick(double wall_s, double drain_budget_s, TickRecord* record) {
@@ -281,6 +299,7 @@ void SandboxLoop::Tick(double wall_s, double drain_budget_s, TickRecord* record)
   if (terrain_) StreamTerrain(t);
   if (options_.sensors) RunDueSensors(t, now);  // 3, and 4: their outputs
   if (options_.publish) PublishStates(now);     // 4
+  if (foxglove_feed_ || link_.RecordsViews()) EmitFoxgloveTick(now);
   WriteDueScans(t);
   DirectCameras(t, record);                            // 5
   if (options_.publish) PublishStatusIfDue(t, now);    // 4
@@ -330,6 +349,7 @@ bool SandboxLoop::NextLockstepInput(double wall_s, bool* wait) {
     log_feed_.clear();
     const std::string refused = log_states_->Translate(channel, data, &log_feed_);
     if (!refused.empty()) reject_log_.Note(channel, refused);
+    for (bridge::LogEvent& event : log_feed_) event.utime = utime;
     Arrive(log_feed_);
   }
   for (const std::string& prefix : log_states_->TakeNewRobotsFromStates()) {
@@ -464,6 +484,7 @@ void SandboxLoop::DirectCameras(double t, TickRecord* record) {
   }
   shot_.t_s = t;
   shot_.tick = tick_;
+  shot_.utime = tick_utime_;
   if (terrain_) shot_.terrain = terrain_->drawn();
   record->frames += cameras_.Direct(shot_, frames_.get(), write_frames_, live_view_ != nullptr);
 }

@@ -43,6 +43,7 @@
 #include "app/stop_request.h"
 #include "app/tick_pacer.h"
 #include "app/tick_stats.h"
+#include "bridge/foxglove_messages.h"
 #include "bridge/lcm_link.h"
 #include "bridge/outputs.h"
 #include "bridge/recorded_states.h"
@@ -112,6 +113,8 @@ class SandboxLoop {
     std::unique_ptr<bridge::RobotOutputs> outputs;
     sensors::PoseHistory history;  // its poses, as far back as its sensors need
     int face_sensor{-1};           // its first face scanner in sensors_ (STATE's face frames)
+    std::string foxglove_frame;    // its frame in Foxglove: the channel prefix
+    std::vector<std::pair<std::string, int>> foxglove_links;  // frame id, node
   };
   // Lock-step: makes the next pose available (reading the replayed log up to
   // it). False: stop (the log has ended); *wait: nothing yet, try again.
@@ -187,9 +190,26 @@ class SandboxLoop {
   bool write_frames_{false};
   std::unique_ptr<FramePipeline> frames_;
   std::unique_ptr<web::StreamServer> web_;  // the browser view (--web)
-  // The live Foxglove server (--foxglove) and what feeds it (sandbox_loop_web.cc).
-  // The server goes first (its thread may still run the feed's work).
+  // The live Foxglove server (--foxglove) and what feeds it, and the
+  // Foxglove views no LCM message carries, to it and to an MCAP recording
+  // (sandbox_loop_foxglove.cc). The server goes first (its thread may still
+  // run the feed's work).
   void StartFoxglove();
+  bool WantsFoxgloveViews() const;  // a recording takes them or a client is there
+  // Any thread: a view to the recording and the live server, made by `make`
+  // on their threads.
+  void EmitFoxgloveView(const std::string& topic, bridge::MakeView make, std::int64_t utime);
+  // After a tick's STATEs: the scene (first tick; latched for later
+  // clients), and while wanted each robot's link frames and the movable
+  // actors' frames.
+  void EmitFoxgloveTick(std::int64_t utime);
+  std::vector<bridge::SceneMesh> FoxgloveScene() const;
+  // On the frame pipeline's encoder thread: a written frame as an image, its
+  // calibration and its optical frame.
+  void EmitFoxgloveCamera(const std::string& camera, std::int64_t utime,
+                          const render::CameraView& view, const render::Frame& frame,
+                          const std::filesystem::path& color_file);
+  bool foxglove_scene_sent_{false};
   std::unique_ptr<FoxgloveFeed> foxglove_feed_;
   std::unique_ptr<web::FoxgloveServer> foxglove_;
   static constexpr double kWebSamplesHz = 5.0;                   // scan samples sent so often

@@ -16,19 +16,6 @@ namespace sandbox::app {
 
 using Clock = std::chrono::steady_clock;
 
-void SandboxLoop::StartFoxglove() {
-  if (options_.foxglove_port < 0) return;
-  web::ServerOptions server;
-  server.address = options_.foxglove_address;
-  server.port = options_.foxglove_port;
-  try {
-    foxglove_ = std::make_unique<web::FoxgloveServer>(server);
-  } catch (const std::exception& e) {
-    throw CommandError(e.what());
-  }
-  foxglove_feed_ = std::make_unique<FoxgloveFeed>(*foxglove_);
-}
-
 void SandboxLoop::ShowCameraFrame(const std::string& camera, std::int64_t tick,
                                   const render::CameraView& view, const render::Frame& frame,
                                   const std::filesystem::path& color_file) {

@@ -276,6 +276,7 @@ class Lockstep {
       std::copy(pose.orientation.begin(), pose.orientation.end(), message.orientation);
       events.push_back({robots_[r].pose, Encode(message)});
     }
+    for (bridge::LogEvent& event : events) event.utime = utime;  // as a recording stamps them
     Outputs published = Tick(std::move(events));
     for (const auto& [r, pose] : sent) {
       robots_[r].last = pose;

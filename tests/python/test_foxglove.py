@@ -79,7 +79,8 @@ def test_a_foxglove_client_decodes_the_runs_poses_and_face_scans(tmp_path):
             (states if channel == "ELAHA/STATE" else faces)[message.utime] = message
     transforms = clouds = 0
     for event in seen:
-        if event["event"] != "message":
+        if event["event"] != "message" or event["schemaName"] not in (
+                "foxglove.FrameTransform", "foxglove.PointCloud"):
             continue
         stamp = event["message"]["timestamp"]
         utime = stamp["sec"] * 10**6 + stamp["nsec"] // 1000
