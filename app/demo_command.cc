@@ -48,7 +48,7 @@ const char* kUsage =
     "                ports are out of the browser's reach (docs/reference/web.md)\n"
     "  --web-control the page may steer the cameras (pan, tilt, zoom, overlay)\n"
     "  --record      every message the run publishes to FILE: MCAP for a name ending in\n"
-    "                .mcap, else an LCM log\n"
+    "                .mcap (with the inputs and Foxglove's schemas), else an LCM log\n"
     "  --foxglove    a live Foxglove WebSocket server on this port, as sandbox run --foxglove\n";
 
 bool InNamespace() {
