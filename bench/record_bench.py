@@ -4,7 +4,8 @@
 recording, with an LCM log and with MCAP (zstd), in turns; each run's
 mean tick against the unrecorded run's (target for MCAP: at most 1.05x), the
 files' sizes against the LCM log's (target: at most 0.7x); the demo at its
-rate (100 Hz, cameras on) without and with a recording; and the writer
+rate (100 Hz, cameras on) without and with a recording (MCAP also holds the
+inputs, link frames, the scene and each camera frame written); and the writer
 thread's own work a tick (`sandbox convert` of the LCM log, timed).
 
 usage: PYTHONPATH=build/python bench/record_bench.py [ROUNDS]   (default 5)
@@ -50,11 +51,13 @@ def mean_tick_ms(inputs, record):
 
 
 def demo_tick_ms(folder, record):
-    """The demo in-process (100 Hz, cameras writing frames and videos, scans): its mean tick."""
+    """The demo in-process (100 Hz, cameras writing frames and videos, scans): its mean
+    tick, and the sizes of the camera frames it wrote."""
     args = [SANDBOX, "demo", "--in-process", "--duration", "15", "--out", str(folder / "demo")]
     done = subprocess.run(args + (["--record", str(record)] if record else []),
                           capture_output=True, text=True, check=True)
-    return float(re.search(r"mean tick ([0-9.]+) ms", done.stdout).group(1))
+    images = [p.stat().st_size for p in (folder / "demo").rglob("*.jpg") if p.name != "overview.jpg"]
+    return float(re.search(r"mean tick ([0-9.]+) ms", done.stdout).group(1)), images
 
 
 def main():
@@ -88,14 +91,24 @@ def main():
         demo_ticks = {kind: [] for kind in demo}
         for _ in range(max(2, rounds // 2)):
             for kind, record in demo.items():
-                demo_ticks[kind].append(demo_tick_ms(folder, record))
+                tick, images = demo_tick_ms(folder, record)
+                demo_ticks[kind].append(tick)
+                if kind == "MCAP zstd":
+                    mcap_images = images  # the frames the last MCAP run wrote, and recorded
         print("the demo at its rate (in-process, 15 s, 100 Hz, cameras and scans on), "
               "%d rounds in turns (median):" % max(2, rounds // 2))
         demo_reference = statistics.median(demo_ticks["none"])
+        demo_log_bytes = demo["LCM log"].stat().st_size
         for kind, record in demo.items():
             tick = statistics.median(demo_ticks[kind])
-            print("%-12s %14.3f %10.3f %14d" % (kind, tick, tick / demo_reference,
-                                                record.stat().st_size if record else 0))
+            size = record.stat().st_size if record else 0
+            print("%-12s %14.3f %10.3f %14d %10s" % (kind, tick, tick / demo_reference, size,
+                                                     "%.3f" % (size / demo_log_bytes) if record else "-"))
+        # The MCAP file also holds each camera frame the demo wrote (the LCM log has none).
+        print("  the demo's MCAP holds its %d camera frames (%d bytes of JPEG as written); "
+              "without them %.3f of the LCM log" % (
+                  len(mcap_images), sum(mcap_images),
+                  (demo["MCAP zstd"].stat().st_size - sum(mcap_images)) / demo_log_bytes))
         print("the writer's thread, a tick (sandbox convert of the LCM log, best of %d):" % rounds)
         for compression in ("zstd", "lz4"):
             best = float("inf")

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "bridge/event_log.h"
+#include "bridge/foxglove_messages.h"
 #include "bridge/foxglove_views.h"
 #include "bridge/lcm_link.h"
 #include "bridge/mcap_reader.h"
@@ -282,6 +283,69 @@ TEST(FoxgloveViewsTest, ALidarSweepIsAPointCloudWithItsIdsAndIntensities) {
   EXPECT_EQ(bare["point_stride"], 17);
   // A message that is not a sandbox type, or does not decode: no view.
   EXPECT_TRUE(FoxgloveViewsOf("R/LIDAR", bytes.data(), bytes.size() - 1).empty());
+}
+
+}  // namespace
+}  // namespace sandbox::bridge
+
+namespace sandbox::bridge {
+namespace {
+
+// A scene's triangle list written by hand (not through the JSON library):
+// still JSON, names escaped, every point and index in order.
+TEST(FoxgloveViewsTest, ASceneUpdateIsJsonWithEveryPointAndIndex) {
+  SceneMesh mesh;
+  mesh.id = "actor/\"quoted\"\n/0";
+  mesh.frame_id = "world";
+  mesh.X_FE.translation() = Eigen::Vector3d(1, 2, 3);
+  mesh.vertices = {{0.f, 0.f, 0.f}, {1.5f, -2.25f, 1e-7f}, {3.f, 1e6f, -0.1f}};
+  mesh.indices = {0, 1, 2};
+  const FoxgloveView view = SceneUpdate("scene", {mesh, SceneMesh{}}, 2'500'000);
+  const auto scene = nlohmann::json::parse(view.json);
+  ASSERT_EQ(scene["entities"].size(), 2u);
+  const auto& entity = scene["entities"][0];
+  EXPECT_EQ(entity["id"], mesh.id);
+  EXPECT_EQ(entity["timestamp"]["sec"], 2);
+  EXPECT_EQ(entity["timestamp"]["nsec"], 500'000'000);
+  const auto& triangles = entity["triangles"][0];
+  EXPECT_EQ(triangles["pose"]["position"]["z"], 3.0);
+  ASSERT_EQ(triangles["points"].size(), 3u);
+  for (std::size_t v = 0; v < 3; ++v) {  // shortest round-trip floats: exact
+    EXPECT_EQ(triangles["points"][v]["x"].get<float>(), mesh.vertices[v].x());
+    EXPECT_EQ(triangles["points"][v]["y"].get<float>(), mesh.vertices[v].y());
+    EXPECT_EQ(triangles["points"][v]["z"].get<float>(), mesh.vertices[v].z());
+  }
+  EXPECT_EQ(triangles["indices"], nlohmann::json({0, 1, 2}));
+  EXPECT_TRUE(scene["entities"][1]["triangles"][0]["points"].empty());
+}
+
+// In a recording, an input is written as it came, without the views a
+// published message of its type gets; a view given as one is made by the
+// writer and lands on its own channel.
+TEST(McapTest, InputsGetNoViewsAndGivenViewsTheirOwnChannels) {
+  testing::TempDir dir;
+  const std::string path = (dir.path() / "run.mcap").string();
+  sandbox_msgs::robot_pose_t pose{};
+  pose.utime = 10;
+  pose.orientation[0] = 1;
+  std::vector<std::uint8_t> bytes(std::size_t(pose.getEncodedSize()));
+  pose.encode(bytes.data(), 0, int(bytes.size()));
+  {
+    McapWriter writer(path);
+    ASSERT_TRUE(writer.TakesInputs() && writer.TakesViews());
+    writer.WriteInput("R/POSE", bytes.data(), unsigned(bytes.size()), 10);
+    writer.Write("R/POSE", bytes.data(), unsigned(bytes.size()), 20);
+    writer.WriteView([] { return FrameTransforms("R/links", "R", {{"R/a", {}}}, 30); }, 30);
+    ASSERT_TRUE(writer.Close());
+  }
+  const std::unique_ptr<EventReader> reader = OpenEventReader(path);
+  std::string channel;
+  std::vector<std::uint8_t> data;
+  std::int64_t utime = 0;
+  std::vector<std::int64_t> times;
+  while (reader->Next(&channel, &data, &utime)) times.push_back(utime);
+  EXPECT_EQ(times, (std::vector<std::int64_t>{10, 20}));  // the LCM messages, in order
+  EXPECT_EQ(reader->skipped(), 2);  // the JSON views: the published pose's, the given one
 }
 
 }  // namespace
