@@ -40,15 +40,16 @@ void FoxgloveFeed::PublishView(const std::string& topic, bridge::MakeView make,
   });
 }
 
-void FoxgloveFeed::Latch(const bridge::FoxgloveView& view, std::int64_t utime) {
-  auto it = latched_ids_.find(view.topic);
+void FoxgloveFeed::Latch(const std::string& topic, const std::string& schema_name,
+                         const std::string& schema, bridge::MakeView make, std::int64_t utime) {
+  auto it = latched_ids_.find(topic);
   if (it == latched_ids_.end()) {
     it = latched_ids_
-             .emplace(view.topic, server_.Advertise({view.topic, "json", view.schema_name,
-                                                     "jsonschema", *view.schema}))
+             .emplace(topic, server_.Advertise({topic, "json", schema_name, "jsonschema", schema}))
              .first;
   }
-  server_.Latch(it->second, std::uint64_t(std::max<std::int64_t>(utime, 0)) * 1000, view.json);
+  server_.Latch(it->second, std::uint64_t(std::max<std::int64_t>(utime, 0)) * 1000,
+                [make = std::move(make)] { return make().json; });
 }
 
 void FoxgloveFeed::Send(const bridge::FoxgloveView& view, std::int64_t utime,

@@ -27,8 +27,10 @@ class FoxgloveFeed {
   void PublishView(const std::string& topic, bridge::MakeView make, std::int64_t utime);
   bool HasClients() const { return server_.HasClients(); }
   // The loop's thread: a view every client gets when it subscribes, also
-  // later (the scene). A topic latched again replaces its message.
-  void Latch(const bridge::FoxgloveView& view, std::int64_t utime);
+  // later (the scene), made on the server's thread when first wanted. A
+  // topic latched again replaces its message.
+  void Latch(const std::string& topic, const std::string& schema_name, const std::string& schema,
+             bridge::MakeView make, std::int64_t utime);
 
  private:
   // The server's thread.

@@ -41,10 +41,16 @@ void SandboxLoop::EmitFoxgloveTick(std::int64_t utime) {
   if (!foxglove_scene_sent_) {
     // Once: recorded at the first tick, latched for every client of the server.
     foxglove_scene_sent_ = true;
-    const auto scene = std::make_shared<const bridge::FoxgloveView>(
-        bridge::SceneUpdate("scene", FoxgloveScene(), utime));
-    link_.RecordView([scene] { return *scene; }, utime);
-    if (foxglove_feed_) foxglove_feed_->Latch(*scene, utime);
+    // The meshes copied here; their JSON is made where it is written.
+    const auto meshes = std::make_shared<const std::vector<bridge::SceneMesh>>(FoxgloveScene());
+    const bridge::MakeView scene = [meshes, utime] {
+      return bridge::SceneUpdate("scene", *meshes, utime);
+    };
+    link_.RecordView(scene, utime);
+    if (foxglove_feed_) {
+      foxglove_feed_->Latch("scene", "foxglove.SceneUpdate", bridge::SceneUpdateSchema(), scene,
+                            utime);
+    }
   }
   if (!WantsFoxgloveViews()) return;
   for (const RobotRun& robot : robots_) {

@@ -36,6 +36,8 @@ const std::string& CameraCalibrationSchema() {
   return schema;
 }
 
+}  // namespace
+
 const std::string& SceneUpdateSchema() {
   static const std::string color =
       R"({"type":"object","properties":{"r":{"type":"number"},"g":{"type":"number"},"b":{"type":"number"},"a":{"type":"number"}}})";
@@ -57,6 +59,8 @@ const std::string& SceneUpdateSchema() {
       R"(,"texts":)" + empty + R"(,"models":)" + empty + "}}}}}";
   return schema;
 }
+
+namespace {
 
 json Vector(const Eigen::Vector3d& v) { return {{"x", v.x()}, {"y", v.y()}, {"z", v.z()}}; }
 

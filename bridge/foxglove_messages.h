@@ -61,7 +61,9 @@ struct SceneMesh {
   std::vector<std::uint32_t> indices;  // three a triangle
   float rgba[4]{0.7f, 0.7f, 0.7f, 1.0f};
 };
-// foxglove.SceneUpdate adding (or replacing) the entities, never expiring.
+// foxglove.SceneUpdate adding (or replacing) the entities, never expiring;
+// its JSON schema.
+const std::string& SceneUpdateSchema();
 FoxgloveView SceneUpdate(const std::string& topic, const std::vector<SceneMesh>& meshes,
                          std::int64_t utime);
 

@@ -94,15 +94,25 @@ class FoxgloveServer::Impl {
     return frame + payload;
   }
 
-  void Latch(std::uint32_t channel, std::uint64_t time_ns, std::string payload) {
-    auto message = std::make_shared<LatchedMessage>(LatchedMessage{time_ns, std::move(payload)});
+  void Latch(std::uint32_t channel, std::uint64_t time_ns, std::function<std::string()> make) {
+    auto message = std::make_shared<LatchedMessage>();
+    message->time_ns = time_ns;
+    message->make = std::move(make);
     {
       std::lock_guard<std::mutex> lock(mutex_);
       latched_[channel] = message;
     }
     if (counts_.clients == 0) return;
-    asio::post(server_.get_io_service(),
-               [this, channel, message] { Send(channel, message->time_ns, message->payload); });
+    asio::post(server_.get_io_service(), [this, channel, message] {
+      if (!Subscribed(channel)) return;
+      Send(channel, message->time_ns, Made(message.get()));
+    });
+  }
+
+  // The server's thread: a latched message's payload, made once.
+  static const std::string& Made(LatchedMessage* message) {
+    if (!message->made) message->payload = message->make(), message->made = true;
+    return message->payload;
   }
 
   void Send(std::uint32_t channel, std::uint64_t time_ns, const std::string& payload) {
@@ -258,7 +268,7 @@ class FoxgloveServer::Impl {
     ++subscribers_[channel];
     ++counts_.subscriptions;
     if (const auto latched = latched_.find(channel); latched != latched_.end()) {
-      std::string frame = MessageData(latched->second->time_ns, latched->second->payload);
+      std::string frame = MessageData(latched->second->time_ns, Made(latched->second.get()));
       for (int i = 0; i < 4; ++i) frame[std::size_t(1 + i)] = char(id >> (8 * i));
       asio::error_code ec;
       server_.send(h, frame.data(), frame.size(), websocketpp::frame::opcode::binary, ec);
@@ -290,9 +300,9 @@ class FoxgloveServer::Impl {
   int port_{0};
   std::map<Handle, Client, std::owner_less<Handle>> clients_;  // server thread only
   mutable std::mutex mutex_;
-  std::vector<FoxgloveChannel> channels_;                                   // by id
-  std::vector<int> subscribers_;                                            // by channel
-  std::map<std::uint32_t, std::shared_ptr<const LatchedMessage>> latched_;  // by channel
+  std::vector<FoxgloveChannel> channels_;                             // by id
+  std::vector<int> subscribers_;                                      // by channel
+  std::map<std::uint32_t, std::shared_ptr<LatchedMessage>> latched_;  // by channel
   Counts counts_;
 };
 
@@ -305,8 +315,9 @@ void FoxgloveServer::Defer(std::function<void()> work) { impl_->Defer(std::move(
 std::uint32_t FoxgloveServer::Advertise(const FoxgloveChannel& channel) {
   return impl_->Advertise(channel);
 }
-void FoxgloveServer::Latch(std::uint32_t channel, std::uint64_t time_ns, std::string payload) {
-  impl_->Latch(channel, time_ns, std::move(payload));
+void FoxgloveServer::Latch(std::uint32_t channel, std::uint64_t time_ns,
+                           std::function<std::string()> make) {
+  impl_->Latch(channel, time_ns, std::move(make));
 }
 bool FoxgloveServer::Subscribed(std::uint32_t channel) const { return impl_->Subscribed(channel); }
 void FoxgloveServer::Send(std::uint32_t channel, std::uint64_t time_ns,

@@ -32,10 +32,13 @@ struct FoxgloveChannel {
 };
 
 // A channel's last message, sent to each client as it subscribes (the
-// scene: written once, needed by every client that comes later).
+// scene: written once, needed by every client that comes later), made on
+// the server's thread when first needed.
 struct LatchedMessage {
   std::uint64_t time_ns{0};
-  std::string payload;
+  std::function<std::string()> make;
+  std::string payload;  // made
+  bool made{false};
 };
 
 struct FoxgloveCounts {
@@ -78,8 +81,9 @@ class FoxgloveServer {
   // subscribers; one too far behind skips it.
   void Send(std::uint32_t channel, std::uint64_t time_ns, const std::string& payload);
   bool HasClients() const;
-  // Any thread: the channel's message now and for every later subscriber.
-  void Latch(std::uint32_t channel, std::uint64_t time_ns, std::string payload);
+  // Any thread: the channel's message now and for every later subscriber,
+  // made by `make` on the server's thread when a client first wants it.
+  void Latch(std::uint32_t channel, std::uint64_t time_ns, std::function<std::string()> make);
 
   FoxgloveCounts counts() const;
 
