@@ -160,6 +160,10 @@ SandboxLoop::SandboxLoop(const RunOptions& options, RunHooks hooks, std::ostream
       throw CommandError(e.what());
     }
   }
+  // The scene's meshes copied before the loop starts (its JSON is made where it is written).
+  if (foxglove_ || link_.RecordsViews()) {
+    foxglove_scene_ = std::make_shared<const std::vector<bridge::SceneMesh>>(FoxgloveScene());
+  }
 }
 
 SandboxLoop::~SandboxLoop() {

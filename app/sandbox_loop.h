@@ -209,6 +209,7 @@ class SandboxLoop {
   void EmitFoxgloveCamera(const std::string& camera, std::int64_t utime,
                           const render::CameraView& view, const render::Frame& frame,
                           const std::filesystem::path& color_file);
+  std::shared_ptr<const std::vector<bridge::SceneMesh>> foxglove_scene_;  // made at the start
   bool foxglove_scene_sent_{false};
   std::unique_ptr<FoxgloveFeed> foxglove_feed_;
   std::unique_ptr<web::FoxgloveServer> foxglove_;

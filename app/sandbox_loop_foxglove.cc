@@ -41,9 +41,7 @@ void SandboxLoop::EmitFoxgloveTick(std::int64_t utime) {
   if (!foxglove_scene_sent_) {
     // Once: recorded at the first tick, latched for every client of the server.
     foxglove_scene_sent_ = true;
-    // The meshes copied here; their JSON is made where it is written.
-    const auto meshes = std::make_shared<const std::vector<bridge::SceneMesh>>(FoxgloveScene());
-    const bridge::MakeView scene = [meshes, utime] {
+    const bridge::MakeView scene = [meshes = foxglove_scene_, utime] {
       return bridge::SceneUpdate("scene", *meshes, utime);
     };
     link_.RecordView(scene, utime);
