@@ -104,11 +104,17 @@ def main():
             size = record.stat().st_size if record else 0
             print("%-12s %14.3f %10.3f %14d %10s" % (kind, tick, tick / demo_reference, size,
                                                      "%.3f" % (size / demo_log_bytes) if record else "-"))
-        # The MCAP file also holds each camera frame the demo wrote (the LCM log has none).
+        # The MCAP file also holds each camera frame the demo wrote (the LCM log has
+        # none), its link frames and scene; its LCM messages alone (its inputs too),
+        # with their views, are what `sandbox convert` keeps of it.
+        messages = folder / "demo-messages.mcap"
+        subprocess.run([SANDBOX, "convert", str(demo["MCAP zstd"]), str(folder / "d.lcmlog")],
+                       check=True, capture_output=True)
+        subprocess.run([SANDBOX, "convert", str(folder / "d.lcmlog"), str(messages)],
+                       check=True, capture_output=True)
         print("  the demo's MCAP holds its %d camera frames (%d bytes of JPEG as written); "
-              "without them %.3f of the LCM log" % (
-                  len(mcap_images), sum(mcap_images),
-                  (demo["MCAP zstd"].stat().st_size - sum(mcap_images)) / demo_log_bytes))
+              "its messages alone (outputs and inputs, sandbox convert): %.3f of the LCM log" % (
+                  len(mcap_images), sum(mcap_images), messages.stat().st_size / demo_log_bytes))
         print("the writer's thread, a tick (sandbox convert of the LCM log, best of %d):" % rounds)
         for compression in ("zstd", "lz4"):
             best = float("inf")

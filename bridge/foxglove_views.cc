@@ -81,7 +81,7 @@ const std::string& PointCloudSchema() {
   return schema;
 }
 
-enum NumericType { kInt8 = 2, kInt32 = 6, kFloat32 = 7 };
+enum NumericType { kInt32 = 6, kFloat32 = 7 };
 
 // Decodes an LCM message, or false.
 template <typename Message>
@@ -164,11 +164,11 @@ std::vector<FoxgloveView> FoxgloveViewsOf(const std::string& channel, const std:
     const bool ids = face.num_surface == face.num_points;
     Points points;
     for (const char* axis : {"x", "y", "z"}) points.Field(axis, kFloat32, 4);
-    points.Field("occupancy", kInt8, 1);
     if (ids) points.Field("surface", kInt32, 4);
+    // The occupied samples: a free or unvisited cell is no surface to show.
     for (int k = 0; k < face.num_points; ++k) {
+      if (face.occupancy[std::size_t(k)] != 1) continue;
       for (int a = 0; a < 3; ++a) points.Put(face.xyz[std::size_t(3 * k + a)]);
-      points.Put(face.occupancy[std::size_t(k)]);
       if (ids) points.Put(face.surface[std::size_t(k)]);
     }
     return {points.View(channel + "/points", face.utime, face.origin)};
@@ -181,13 +181,13 @@ std::vector<FoxgloveView> FoxgloveViewsOf(const std::string& channel, const std:
     Points points;
     for (const char* axis : {"x", "y", "z"}) points.Field(axis, kFloat32, 4);
     points.Field("range", kFloat32, 4);
-    points.Field("hit", kInt8, 1);
     if (ids) points.Field("surface", kInt32, 4);
     if (intensity) points.Field("intensity", kFloat32, 4);
+    // The returns: a beam that hit nothing has no point.
     for (int i = 0; i < scan.num_beams; ++i) {
+      if (scan.hit[std::size_t(i)] == 0) continue;
       for (int a = 0; a < 3; ++a) points.Put(scan.xyz[std::size_t(3 * i + a)]);
       points.Put(scan.range_m[std::size_t(i)]);
-      points.Put(scan.hit[std::size_t(i)]);
       if (ids) points.Put(scan.surface[std::size_t(i)]);
       if (intensity) points.Put(scan.intensity[std::size_t(i)]);
     }

@@ -144,7 +144,8 @@ def check_transform(tf, state):
 
 
 def check_cloud(cloud, face):
-    """A foxglove.PointCloud (JSON, parsed) against the scan_face_t it shows."""
+    """A foxglove.PointCloud (JSON, parsed) against the scan_face_t it shows: its occupied
+    samples."""
     assert cloud["frame_id"] == "world"
     assert cloud["timestamp"]["sec"] * 10**6 + cloud["timestamp"]["nsec"] // 1000 == face.utime
     assert [cloud["pose"]["position"][a] for a in "xyz"] == list(face.origin)
@@ -153,27 +154,30 @@ def check_cloud(cloud, face):
     dtype = np.dtype({"names": list(fields), "formats": [kinds[t] for _, t in fields.values()],
                       "offsets": [o for o, _ in fields.values()], "itemsize": cloud["point_stride"]})
     points = np.frombuffer(base64.b64decode(cloud["data"]), dtype=dtype)
-    assert len(points) == face.num_points > 0
+    occupied = np.asarray(face.occupancy) == 1  # a point a sample that hit, in order
+    assert len(points) == occupied.sum()
     xyz = np.stack([points["x"], points["y"], points["z"]], axis=1)
-    assert np.array_equal(xyz, np.asarray(face.xyz, np.float32).reshape(-1, 3), equal_nan=True)
-    assert np.array_equal(points["occupancy"], face.occupancy)
-    assert np.array_equal(points["surface"], face.surface)
+    assert np.array_equal(xyz, np.asarray(face.xyz, np.float32).reshape(-1, 3)[occupied])
+    assert np.array_equal(points["surface"], np.asarray(face.surface)[occupied])
+    return len(points)
 
 
 def test_poses_and_face_scans_are_also_foxglove_frame_transforms_and_point_clouds(runs):
     """Each STATE's pose as the FrameTransform world -> ELAHA, each face scan as a
-    PointCloud in world whose points, occupancy and hit ids are the scan's, at the same time."""
+    PointCloud in world whose points and hit ids are the scan's occupied samples', at the
+    same time."""
     mcap = read_mcap(runs / "run.mcap")
     assert mcap["channels"]["ELAHA/STATE/tf"]["schema"] == "foxglove.FrameTransform"
     assert mcap["channels"]["ELAHA/STATE/tf"]["schema_encoding"] == "jsonschema"
     assert mcap["channels"]["ELAHA/SCAN_FACE/points"]["schema"] == "foxglove.PointCloud"
     views = {(topic, time): message for topic, time, _, message in mcap["views"]}
-    transforms = clouds = 0
+    transforms = clouds = points = 0
     for channel, utime, data in lcm_events(runs / "run.lcmlog"):
         if channel == "ELAHA/STATE":
             check_transform(views[("ELAHA/STATE/tf", str(utime * 1000))], sandbox.decode(data))
             transforms += 1
         elif channel == "ELAHA/SCAN_FACE":
-            check_cloud(views[("ELAHA/SCAN_FACE/points", str(utime * 1000))], sandbox.decode(data))
+            points += check_cloud(views[("ELAHA/SCAN_FACE/points", str(utime * 1000))],
+                                  sandbox.decode(data))
             clouds += 1
-    assert transforms == 40 and clouds == 40
+    assert transforms == 40 and clouds == 40 and points > 1000
