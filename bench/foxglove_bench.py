@@ -122,8 +122,8 @@ def main():
     for kind in kinds:
         rate = statistics.median(rates[kind])
         print("%-20s %12.1f %8.3f" % (kind, rate, rate / reference))
-    print("the client received %d messages a run (median; a pose and a face scan a step "
-          "after it subscribed)" % statistics.median(received))
+    print("the client received %d messages a run (median; a pose, a face scan and the link "
+          "frames a step after it subscribed, and the scene)" % statistics.median(received))
 
 
 if __name__ == "__main__":
