@@ -110,6 +110,14 @@ def test_a_replay_of_mcap_inputs_equals_the_replay_of_the_lcm_log(runs):
     assert (runs / "from-mcap.lcmlog").read_bytes() == (runs / "run.lcmlog").read_bytes()
 
 
+def test_a_recording_replays_from_its_own_inputs_to_the_same_outputs(runs):
+    """The recorded inputs (POSE, BONES, with their own times) come before their tick's
+    STATE: the replay takes them, not the states, and publishes what the run did."""
+    replayed = program("run", "--replay", runs / "run.mcap", "--record", runs / "again.lcmlog")
+    assert "holds what a run applied" not in replayed.stderr + replayed.stdout
+    assert (runs / "again.lcmlog").read_bytes() == (runs / "run.lcmlog").read_bytes()
+
+
 def test_a_damaged_file_is_refused_naming_it_and_the_offset(runs):
     bytes_ = bytearray((runs / "run.mcap").read_bytes())
     bytes_[200] ^= 0xFF  # inside the first chunk, which starts at byte 32
