@@ -197,8 +197,9 @@ class SandboxLoop {
   void StartFoxglove();
   bool WantsFoxgloveViews() const;  // a recording takes them or a client is there
   // Any thread: a view to the recording and the live server, made by `make`
-  // on their threads.
-  void EmitFoxgloveView(const std::string& topic, bridge::MakeView make, std::int64_t utime);
+  // on their threads from about `bytes` of data it holds.
+  void EmitFoxgloveView(const std::string& topic, bridge::MakeView make, std::int64_t utime,
+                        std::size_t bytes);
   // After a tick's STATEs: the scene (first tick; latched for later
   // clients), and while wanted each robot's link frames and the movable
   // actors' frames.

@@ -32,8 +32,8 @@ bool SandboxLoop::WantsFoxgloveViews() const {
 }
 
 void SandboxLoop::EmitFoxgloveView(const std::string& topic, bridge::MakeView make,
-                                   std::int64_t utime) {
-  link_.RecordView(make, utime);
+                                   std::int64_t utime, std::size_t bytes) {
+  link_.RecordView(make, utime, bytes);
   if (foxglove_feed_) foxglove_feed_->PublishView(topic, std::move(make), utime);
 }
 
@@ -44,7 +44,11 @@ void SandboxLoop::EmitFoxgloveTick(std::int64_t utime) {
     const bridge::MakeView scene = [meshes = foxglove_scene_, utime] {
       return bridge::SceneUpdate("scene", *meshes, utime);
     };
-    link_.RecordView(scene, utime);
+    std::size_t bytes = 0;
+    for (const bridge::SceneMesh& mesh : *foxglove_scene_) {
+      bytes += 12 * mesh.vertices.size() + 4 * mesh.indices.size();
+    }
+    link_.RecordView(scene, utime, bytes);
     if (foxglove_feed_) {
       foxglove_feed_->Latch("scene", "foxglove.SceneUpdate", bridge::SceneUpdateSchema(), scene,
                             utime);
@@ -65,7 +69,7 @@ void SandboxLoop::EmitFoxgloveTick(std::int64_t utime) {
         [topic, parent = robot.foxglove_frame, links, utime] {
           return bridge::FrameTransforms(topic, parent, *links, utime);
         },
-        utime);
+        utime, links->size() * sizeof(bridge::NamedPose));
   }
   auto actors = std::make_shared<std::vector<bridge::NamedPose>>();
   for (std::size_t a = 0; a < level_.actors.size(); ++a) {
@@ -77,7 +81,7 @@ void SandboxLoop::EmitFoxgloveTick(std::int64_t utime) {
     EmitFoxgloveView(
         "actors/tf",
         [actors, utime] { return bridge::FrameTransforms("actors/tf", "world", *actors, utime); },
-        utime);
+        utime, actors->size() * sizeof(bridge::NamedPose));
   }
 }
 
@@ -178,20 +182,20 @@ void SandboxLoop::EmitFoxgloveCamera(const std::string& camera, std::int64_t uti
       [topic, optical, X_WO, utime] {
         return bridge::FrameTransforms(topic + "/tf", "world", {{optical, X_WO}}, utime);
       },
-      utime);
+      utime, sizeof(bridge::NamedPose));
   EmitFoxgloveView(
       topic + "/calibration",
       [topic, optical, intrinsics, utime] {
         return bridge::CameraCalibration(topic + "/calibration", optical, intrinsics, utime);
       },
-      utime);
+      utime, sizeof(intrinsics));
   auto image = std::make_shared<const std::string>(std::move(bytes));
   EmitFoxgloveView(
       topic + "/image",
       [topic, optical, format, image, utime] {
         return bridge::CompressedImage(topic + "/image", optical, format, *image, utime);
       },
-      utime);
+      utime, image->size());
 }
 
 }  // namespace sandbox::app

@@ -4,6 +4,7 @@
 // by its first bytes when reading. Threads: the caller's (a writer may keep a
 // thread of its own behind Write()).
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -30,9 +31,11 @@ class EventWriter {
   }
   // Appends a message in one of Foxglove's schemas that no LCM message
   // carries (a robot's link frames, a camera image, the scene), made by
-  // `make` on the writer's own time; formats without such channels (LCM
-  // logs) skip it and return true.
-  virtual bool WriteView(MakeView /*make*/, std::int64_t /*utime*/) { return true; }
+  // `make` on the writer's own time from about `bytes` of data it holds;
+  // formats without such channels (LCM logs) skip it and return true.
+  virtual bool WriteView(MakeView /*make*/, std::int64_t /*utime*/, std::size_t /*bytes*/) {
+    return true;
+  }
   // Whether WriteView() keeps what it is given (the caller may skip making it).
   virtual bool TakesViews() const { return false; }
   // Whether the run's inputs go in too, beside what it publishes (MCAP: a

@@ -96,8 +96,8 @@ class LcmLink {
   // Also writes a Foxglove view no LCM message carries (a link frame, a
   // camera image) to the recording, when it takes them (an MCAP file).
   bool RecordsViews() const { return record_ && record_->TakesViews(); }
-  void RecordView(MakeView make, std::int64_t utime) {
-    if (RecordsViews()) record_->WriteView(std::move(make), utime);
+  void RecordView(MakeView make, std::int64_t utime, std::size_t bytes) {
+    if (RecordsViews()) record_->WriteView(std::move(make), utime, bytes);
   }
   // Also writes an input message as it arrives (before it is checked) to a
   // recording that takes inputs (MCAP), stamped with its receive time, or

@@ -61,13 +61,13 @@ bool McapWriter::WriteInput(const std::string& channel, const void* data, unsign
   return Queue({channel, std::string(static_cast<const char*>(data), size), utime, false, {}});
 }
 
-bool McapWriter::WriteView(MakeView make, std::int64_t utime) {
+bool McapWriter::WriteView(MakeView make, std::int64_t utime, std::size_t bytes) {
   if (!options_.foxglove_views) return true;
-  return Queue({{}, {}, utime, false, std::move(make)});
+  return Queue({{}, {}, utime, false, std::move(make), bytes});
 }
 
 bool McapWriter::Queue(Event event) {
-  const std::size_t bytes = event.data.size() + event.channel.size();
+  const std::size_t bytes = event.data.size() + event.channel.size() + event.view_bytes;
   std::unique_lock<std::mutex> lock(mutex_);
   changed_.wait(lock, [&] { return queued_bytes_ < kMaxQueuedBytes || closing_; });
   if (closing_ || !error_.empty()) return false;
@@ -159,7 +159,7 @@ void McapWriter::Add(const Event& event) {
     return Fail("over 65532 channels or schemas");
   }
   const std::uint64_t time = std::uint64_t(event.utime) * 1000;  // nanoseconds
-  if (event.make) {  // a view given as one
+  if (event.make) {                                              // a view given as one
     const FoxgloveView view = event.make();
     const std::uint16_t schema = SchemaId(view.schema_name, "jsonschema", *view.schema);
     AddMessage(ChannelId(view.topic, schema, "json"), time, view.json);

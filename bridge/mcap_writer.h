@@ -59,7 +59,7 @@ class McapWriter final : public EventWriter {
              std::int64_t utime) override;
   bool WriteInput(const std::string& channel, const void* data, unsigned size,
                   std::int64_t utime) override;
-  bool WriteView(MakeView make, std::int64_t utime) override;
+  bool WriteView(MakeView make, std::int64_t utime, std::size_t bytes) override;
   bool TakesViews() const override { return options_.foxglove_views; }
   bool TakesInputs() const override { return true; }
   bool Close() override;
@@ -71,8 +71,9 @@ class McapWriter final : public EventWriter {
     std::string channel;
     std::string data;
     std::int64_t utime;
-    bool with_views{true};  // an LCM message's Foxglove views too (not for inputs)
-    MakeView make;          // a view given as one (WriteView): made on the writer's thread
+    bool with_views{true};      // an LCM message's Foxglove views too (not for inputs)
+    MakeView make;              // a view given as one (WriteView): made on the writer's thread
+    std::size_t view_bytes{0};  // what `make` holds, counted against kMaxQueuedBytes
   };
   struct ChannelKey {
     std::string topic;

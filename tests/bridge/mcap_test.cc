@@ -333,7 +333,7 @@ TEST(McapTest, InputsGetNoViewsAndGivenViewsTheirOwnChannels) {
     ASSERT_TRUE(writer.TakesInputs() && writer.TakesViews());
     writer.WriteInput("R/POSE", bytes.data(), unsigned(bytes.size()), 10);
     writer.Write("R/POSE", bytes.data(), unsigned(bytes.size()), 20);
-    writer.WriteView([] { return FrameTransforms("R/links", "R", {{"R/a", {}}}, 30); }, 30);
+    writer.WriteView([] { return FrameTransforms("R/links", "R", {{"R/a", {}}}, 30); }, 30, 64);
     ASSERT_TRUE(writer.Close());
   }
   const std::unique_ptr<EventReader> reader = OpenEventReader(path);
