@@ -7,6 +7,8 @@
 
 #include "bridge/foxglove_json.h"
 #include "bridge/lcm_types.h"
+#include "sandbox_msgs/gnss_t.hpp"
+#include "sandbox_msgs/ground_map_t.hpp"
 #include "sandbox_msgs/lidar_scan_t.hpp"
 #include "sandbox_msgs/robot_pose_t.hpp"
 #include "sandbox_msgs/robot_state_t.hpp"
@@ -34,7 +36,8 @@ const std::string& QuaternionSchema() {
 
 const std::string& PoseSchema() {
   static const std::string schema = R"({"type":"object","properties":{"position":)" +
-                                    Vector3Schema() + R"(,"orientation":)" + QuaternionSchema() + "}}";
+                                    Vector3Schema() + R"(,"orientation":)" + QuaternionSchema() +
+                                    "}}";
   return schema;
 }
 
@@ -78,6 +81,23 @@ const std::string& PointCloudSchema() {
       foxglove_json::TimeSchema() + R"(,"frame_id":{"type":"string"},"pose":)" +
       foxglove_json::PoseSchema() +
       R"(,"point_stride":{"type":"integer","minimum":0},"fields":{"type":"array","items":{"type":"object","properties":{"name":{"type":"string"},"offset":{"type":"integer","minimum":0},"type":{"type":"integer","description":"1 UINT8, 2 INT8, 3 UINT16, 4 INT16, 5 UINT32, 6 INT32, 7 FLOAT32, 8 FLOAT64"}}}},"data":{"type":"string","contentEncoding":"base64"}}})";
+  return schema;
+}
+
+const std::string& LocationFixSchema() {
+  static const std::string schema =
+      R"({"title":"foxglove.LocationFix","description":"A navigation satellite fix for any Global Navigation Satellite System","type":"object","properties":{"timestamp":)" +
+      foxglove_json::TimeSchema() +
+      R"(,"frame_id":{"type":"string"},"latitude":{"type":"number"},"longitude":{"type":"number"},"altitude":{"type":"number"},"position_covariance":{"type":"array","items":{"type":"number"}},"position_covariance_type":{"type":"integer","description":"0 UNKNOWN, 1 APPROXIMATED, 2 DIAGONAL_KNOWN, 3 KNOWN"}}})";
+  return schema;
+}
+
+const std::string& GridSchema() {
+  static const std::string schema =
+      R"({"title":"foxglove.Grid","description":"A 2D grid of data","type":"object","properties":{"timestamp":)" +
+      foxglove_json::TimeSchema() + R"(,"frame_id":{"type":"string"},"pose":)" +
+      foxglove_json::PoseSchema() +
+      R"(,"column_count":{"type":"integer","minimum":0},"cell_size":{"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"}}},"row_stride":{"type":"integer","minimum":0},"cell_stride":{"type":"integer","minimum":0},"fields":{"type":"array","items":{"type":"object","properties":{"name":{"type":"string"},"offset":{"type":"integer","minimum":0},"type":{"type":"integer","description":"6 INT32, 7 FLOAT32"}}}},"data":{"type":"string","contentEncoding":"base64"}}})";
   return schema;
 }
 
@@ -141,7 +161,8 @@ std::string RobotOf(const std::string& channel) {
 bool HasFoxgloveView(const std::uint8_t* data, std::size_t size) {
   const LcmType* type = LcmTypeOf(data, size);
   return type != nullptr && (type->name == "robot_state_t" || type->name == "robot_pose_t" ||
-                             type->name == "scan_face_t" || type->name == "lidar_scan_t");
+                             type->name == "scan_face_t" || type->name == "lidar_scan_t" ||
+                             type->name == "gnss_t" || type->name == "ground_map_t");
 }
 
 std::vector<FoxgloveView> FoxgloveViewsOf(const std::string& channel, const std::uint8_t* data,
@@ -192,6 +213,52 @@ std::vector<FoxgloveView> FoxgloveViewsOf(const std::string& channel, const std:
       if (intensity) points.Put(scan.intensity[std::size_t(i)]);
     }
     return {points.View(channel + "/points", scan.utime, scan.origin)};
+  }
+  if (type->name == "gnss_t") {  // a LocationFix a fix, at the time it was taken
+    sandbox_msgs::gnss_t gnss;
+    if (!Decode(data, size, &gnss)) return {};
+    std::vector<FoxgloveView> fixes;
+    for (int i = 0; i < gnss.num_fixes; ++i) {
+      const json fix = {{"timestamp", Time(gnss.fix_utime[std::size_t(i)])},
+                        {"frame_id", gnss.sensor},
+                        {"latitude", gnss.latitude_deg[std::size_t(i)]},
+                        {"longitude", gnss.longitude_deg[std::size_t(i)]},
+                        {"altitude", gnss.height_m[std::size_t(i)]},
+                        {"position_covariance", std::vector<double>(9, 0.0)},
+                        {"position_covariance_type", 0}};
+      fixes.push_back({channel + "/fix", "foxglove.LocationFix", &LocationFixSchema(), fix.dump()});
+    }
+    return fixes;
+  }
+  if (type->name == "ground_map_t") {  // a Grid whose cells are centred on the map's points
+    sandbox_msgs::ground_map_t map;
+    if (!Decode(data, size, &map) || map.n <= 0 || map.num_points != map.n * map.n) return {};
+    const bool ids = map.num_surface == map.num_points;
+    json fields = json::array({{{"name", "height"}, {"offset", 0}, {"type", int(kFloat32)}}});
+    if (ids) fields.push_back({{"name", "surface"}, {"offset", 4}, {"type", int(kInt32)}});
+    const int stride = ids ? 8 : 4;
+    std::string cells;
+    cells.reserve(std::size_t(map.num_points * stride));
+    for (int k = 0; k < map.num_points; ++k) {
+      cells.append(reinterpret_cast<const char*>(&map.height[std::size_t(k)]), 4);
+      if (ids) cells.append(reinterpret_cast<const char*>(&map.surface[std::size_t(k)]), 4);
+    }
+    const double half = map.resolution_m / 2.0;
+    const json grid = {
+        {"timestamp", Time(map.utime)},
+        {"frame_id", "world"},
+        {"pose",
+         {{"position",
+           {{"x", map.corner[0] - half}, {"y", map.corner[1] - half}, {"z", map.origin_z}}},
+          {"orientation", {{"x", 0.0}, {"y", 0.0}, {"z", 0.0}, {"w", 1.0}}}}},
+        {"column_count", map.n},
+        {"cell_size", {{"x", map.resolution_m}, {"y", map.resolution_m}}},
+        {"row_stride", map.n * stride},
+        {"cell_stride", stride},
+        {"fields", fields},
+        {"data", ""}};
+    return {{channel + "/grid", "foxglove.Grid", &GridSchema(),
+             foxglove_json::WithBase64(grid, "data", cells.data(), cells.size())}};
   }
   return {};
 }

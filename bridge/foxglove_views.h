@@ -2,9 +2,10 @@
 // The sandbox's messages as Foxglove's well-known schemas, for MCAP
 // recordings that Foxglove and Lichtblick show without knowing LCM: a robot's
 // pose (robot_state_t, robot_pose_t) as foxglove.FrameTransform from "world"
-// to the robot, face scans (scan_face_t) and lidar sweeps (lidar_scan_t) as
-// foxglove.PointCloud in "world" with their hit ids, intensities and
-// occupancy as fields. JSON encoding (schema encoding "jsonschema"), bytes as
+// to the robot, face scans (scan_face_t, their occupied samples) and lidar
+// sweeps (lidar_scan_t, their returns) as foxglove.PointCloud in "world" with
+// their hit ids and intensities as fields, GNSS fixes (gnss_t) as
+// foxglove.LocationFix, ground maps (ground_map_t) as foxglove.Grid. JSON encoding (schema encoding "jsonschema"), bytes as
 // base64, as Foxglove's JSON schemas say. Threads: any (no state).
 
 #include <cstdint>

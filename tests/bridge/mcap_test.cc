@@ -8,6 +8,7 @@
 #include <glib.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -22,6 +23,8 @@
 #include "bridge/lcm_link.h"
 #include "bridge/mcap_reader.h"
 #include "bridge/mcap_writer.h"
+#include "sandbox_msgs/gnss_t.hpp"
+#include "sandbox_msgs/ground_map_t.hpp"
 #include "sandbox_msgs/lidar_scan_t.hpp"
 #include "sandbox_msgs/robot_pose_t.hpp"
 #include "tests/test_util.h"
@@ -288,6 +291,85 @@ TEST(FoxgloveViewsTest, ALidarSweepIsAPointCloudWithItsIdsAndIntensities) {
 
 namespace sandbox::bridge {
 namespace {
+
+template <typename Message>
+std::vector<std::uint8_t> Bytes(Message message) {
+  std::vector<std::uint8_t> bytes(std::size_t(message.getEncodedSize()));
+  message.encode(bytes.data(), 0, int(bytes.size()));
+  return bytes;
+}
+
+// Each fix of a GNSS message a LocationFix at the time it was taken.
+TEST(FoxgloveViewsTest, GnssFixesAreLocationFixes) {
+  sandbox_msgs::gnss_t gnss{};
+  gnss.utime = 5'000'000;
+  gnss.sensor = "rx";
+  gnss.num_fixes = 2;
+  gnss.fix_utime = {4'800'000, 4'900'000};
+  gnss.latitude_deg = {47.25, 47.5};
+  gnss.longitude_deg = {8.5, -8.75};
+  gnss.height_m = {500.0, 501.5};
+  gnss.num_ned = 6;
+  gnss.velocity_ned.assign(6, 0.0);
+  const std::vector<std::uint8_t> bytes = Bytes(gnss);
+  const std::vector<FoxgloveView> views = FoxgloveViewsOf("W/GNSS", bytes.data(), bytes.size());
+  ASSERT_EQ(views.size(), 2u);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(views[std::size_t(i)].topic, "W/GNSS/fix");
+    EXPECT_EQ(views[std::size_t(i)].schema_name, "foxglove.LocationFix");
+    const auto fix = nlohmann::json::parse(views[std::size_t(i)].json);
+    EXPECT_EQ(fix["frame_id"], "rx");
+    EXPECT_EQ(fix["timestamp"]["sec"], 4);
+    EXPECT_EQ(fix["timestamp"]["nsec"], i == 0 ? 800'000'000 : 900'000'000);
+    EXPECT_EQ(fix["latitude"], gnss.latitude_deg[std::size_t(i)]);
+    EXPECT_EQ(fix["longitude"], gnss.longitude_deg[std::size_t(i)]);
+    EXPECT_EQ(fix["altitude"], gnss.height_m[std::size_t(i)]);
+  }
+}
+
+// A ground map a Grid: cell (r, c) centred on the map's point (r, c).
+TEST(FoxgloveViewsTest, AGroundMapIsAGridCentredOnItsPoints) {
+  sandbox_msgs::ground_map_t map{};
+  map.utime = 7;
+  map.n = 2;
+  map.resolution_m = 0.5;
+  map.corner[0] = 10.0, map.corner[1] = -4.0;
+  map.origin_z = 100.0;
+  map.num_points = 4;
+  map.height = {1.f, 2.f, std::nanf(""), 4.f};
+  map.num_surface = 4;
+  map.surface = {3, 3, 0, 9};
+  const std::vector<std::uint8_t> bytes = Bytes(map);
+  const std::vector<FoxgloveView> views = FoxgloveViewsOf("W/GROUND", bytes.data(), bytes.size());
+  ASSERT_EQ(views.size(), 1u);
+  EXPECT_EQ(views[0].topic, "W/GROUND/grid");
+  const auto grid = nlohmann::json::parse(views[0].json);
+  EXPECT_EQ(grid["column_count"], 2);
+  EXPECT_EQ(grid["cell_size"]["x"], 0.5);
+  EXPECT_EQ(grid["pose"]["position"]["x"], 9.75);  // the cell around x = 10 starts at 9.75
+  EXPECT_EQ(grid["pose"]["position"]["y"], -4.25);
+  EXPECT_EQ(grid["pose"]["position"]["z"], 100.0);
+  const int stride = grid["cell_stride"];
+  ASSERT_EQ(stride, 8);
+  EXPECT_EQ(grid["row_stride"], 16);
+  gsize size = 0;
+  guchar* raw = g_base64_decode(grid["data"].get<std::string>().c_str(), &size);
+  std::vector<std::uint8_t> data(raw, raw + size);
+  g_free(raw);
+  ASSERT_EQ(size, 32u);
+  for (int k = 0; k < 4; ++k) {
+    float height;
+    std::int32_t surface;
+    std::memcpy(&height, data.data() + 8 * k, 4);
+    std::memcpy(&surface, data.data() + 8 * k + 4, 4);
+    if (k == 2) {
+      EXPECT_TRUE(std::isnan(height));
+    } else {
+      EXPECT_EQ(height, map.height[std::size_t(k)]);
+    }
+    EXPECT_EQ(surface, map.surface[std::size_t(k)]);
+  }
+}
 
 // A scene's triangle list written by hand (not through the JSON library):
 // still JSON, names escaped, every point and index in order.
