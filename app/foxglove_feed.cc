@@ -5,6 +5,14 @@
 #include "bridge/foxglove_views.h"
 
 namespace sandbox::app {
+namespace {
+
+// Foxglove's time stamps: nanoseconds, none before the epoch.
+std::uint64_t Nanoseconds(std::int64_t utime) {
+  return std::uint64_t(std::max<std::int64_t>(utime, 0)) * 1000;
+}
+
+}  // namespace
 
 void FoxgloveFeed::Published(const std::string& channel, const void* data, unsigned size,
                              std::int64_t utime) {
@@ -48,8 +56,7 @@ void FoxgloveFeed::Latch(const std::string& topic, const std::string& schema_nam
              .emplace(topic, server_.Advertise({topic, "json", schema_name, "jsonschema", schema}))
              .first;
   }
-  server_.Latch(it->second, std::uint64_t(std::max<std::int64_t>(utime, 0)) * 1000,
-                [make = std::move(make)] { return make().json; });
+  server_.Latch(it->second, Nanoseconds(utime), [make = std::move(make)] { return make().json; });
 }
 
 void FoxgloveFeed::Send(const bridge::FoxgloveView& view, std::int64_t utime,
@@ -62,7 +69,7 @@ void FoxgloveFeed::Send(const bridge::FoxgloveView& view, std::int64_t utime,
     if (ids != nullptr) ids->push_back(it->second);
   }
   if (server_.Subscribed(it->second)) {
-    server_.Send(it->second, std::uint64_t(std::max<std::int64_t>(utime, 0)) * 1000, view.json);
+    server_.Send(it->second, Nanoseconds(utime), view.json);
   }
 }
 

@@ -8,6 +8,7 @@
 #include <mutex>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 #include <stdexcept>
 #include <vector>
 
@@ -129,6 +130,23 @@ void WriteColor(const render::Frame& frame, const std::string& path) {
   cv::Mat bgr;
   cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
   Write(bgr, path);
+}
+
+std::string CompressedColor(const render::Frame& frame, const std::filesystem::path& color_file,
+                            bool png_too, std::string* format) {
+  const std::filesystem::path kind = color_file.extension();
+  if (kind == ".jpg" || (png_too && kind == ".png")) {
+    std::ifstream in(color_file, std::ios::binary);
+    std::ostringstream read;
+    read << in.rdbuf();
+    std::string bytes = read.str();
+    if (!bytes.empty()) {
+      *format = kind == ".png" ? "png" : "jpeg";
+      return bytes;
+    }
+  }
+  *format = "jpeg";
+  return EncodeJpeg(frame);
 }
 
 std::string EncodeJpeg(const render::Frame& frame, int quality) {

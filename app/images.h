@@ -2,6 +2,7 @@
 // Images through OpenCV: texture decoding for the renderer, and frame writing.
 
 #include <cstdint>
+#include <filesystem>
 #include <string>
 
 #include "scene/load_limits.h"
@@ -25,6 +26,11 @@ bool ImageHeaderSize(const std::uint8_t* data, std::size_t size, std::uint32_t* 
 void WriteColor(const render::Frame& frame, const std::string& path);
 // The colour image as a JPEG file's bytes (OpenCV's encoder), in memory.
 std::string EncodeJpeg(const render::Frame& frame, int quality = 85);
+// A written frame's colour as compressed bytes: the file itself when it is a
+// JPEG (or, with `png_too`, a PNG), else the frame encoded as JPEG; *format
+// says which ("jpeg" or "png").
+std::string CompressedColor(const render::Frame& frame, const std::filesystem::path& color_file,
+                            bool png_too, std::string* format);
 // Writes depth as a 16-bit PNG in millimetres (0: nothing within range).
 void WriteDepthMillimetres(const render::Frame& frame, const std::string& path);
 // Writes depth as a NumPy .npy file: float32 metres, shape (height, width),

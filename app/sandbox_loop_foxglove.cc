@@ -4,8 +4,6 @@
 // camera frames. The views of LCM messages (poses, scans) are made from the
 // messages themselves (bridge/foxglove_views.h).
 
-#include <fstream>
-#include <sstream>
 #include <unordered_map>
 
 #include "app/command_line.h"
@@ -157,15 +155,8 @@ void SandboxLoop::EmitFoxgloveCamera(const std::string& camera, std::int64_t uti
   if (frame.rgb.empty()) return;
   const std::string topic = "camera/" + camera, optical = topic;
   // The image as written (its JPEG or PNG), else encoded (a video only).
-  std::string bytes, format = "jpeg";
-  if (color_file.extension() == ".jpg" || color_file.extension() == ".png") {
-    std::ifstream in(color_file, std::ios::binary);
-    std::ostringstream read;
-    read << in.rdbuf();
-    bytes = read.str();
-    if (color_file.extension() == ".png") format = "png";
-  }
-  if (bytes.empty()) bytes = EncodeJpeg(frame), format = "jpeg";
+  std::string format;
+  std::string bytes = CompressedColor(frame, color_file, true, &format);
   const render::Lens lens = FrameIntrinsics(view);
   bridge::Intrinsics intrinsics;
   intrinsics.width = frame.width, intrinsics.height = frame.height;

@@ -25,13 +25,8 @@ void SandboxLoop::ShowCameraFrame(const std::string& camera, std::int64_t tick,
   if (now < due) return;
   due = now + std::chrono::milliseconds(int(1000.0 / kWebCameraHz));
   web::CameraFrame shown{camera, tick, view.X_WC, view.fov_y_rad, frame.width, frame.height, {}};
-  if (color_file.extension() == ".jpg") {  // the writer's own JPEG
-    std::ifstream in(color_file, std::ios::binary);
-    std::ostringstream bytes;
-    bytes << in.rdbuf();
-    shown.jpeg = bytes.str();
-  }
-  if (shown.jpeg.empty()) shown.jpeg = EncodeJpeg(frame);
+  std::string format;
+  shown.jpeg = CompressedColor(frame, color_file, false, &format);  // the writer's own JPEG
   web_->SetCameraFrame(shown);
 }
 
