@@ -68,7 +68,9 @@ class Builder {
   };
 
   // The subtree over a range: a leaf of up to four triangles, or a node over
-  // up to four groups, each made by splitting the largest group in two.
+  // up to four groups, each made by splitting in two the group of more than
+  // four triangles whose box has the largest area (as Embree's builders do:
+  // the group rays meet most often).
   std::int32_t Subtree(const Range& range, int* depth) {
     if (range.size() <= std::size_t(kLeafSize)) {
       *depth = 1;
@@ -78,11 +80,15 @@ class Builder {
     int count = 1;
     groups[0] = range;
     while (count < TriangleBvh::kWidth) {
-      int largest = 0;
-      for (int g = 1; g < count; ++g) {
-        if (groups[std::size_t(g)].size() > groups[std::size_t(largest)].size()) largest = g;
+      int largest = -1;
+      for (int g = 0; g < count; ++g) {
+        if (groups[std::size_t(g)].size() <= std::size_t(kLeafSize)) continue;
+        if (largest < 0 ||
+            groups[std::size_t(g)].box.HalfArea() > groups[std::size_t(largest)].box.HalfArea()) {
+          largest = g;
+        }
       }
-      if (groups[std::size_t(largest)].size() <= std::size_t(kLeafSize)) break;
+      if (largest < 0) break;
       Range second;
       Split(&groups[std::size_t(largest)], &second);
       groups[std::size_t(count++)] = second;
