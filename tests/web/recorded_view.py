@@ -88,8 +88,10 @@ def main():
             assert int(match.group(1)) == len(expected), match.group(0)
             with Chromium() as browser:
                 browser.go(match.group(2))
+                wait_for_player(browser)
                 for tick in (1500, 3):
-                    browser.run("window.sandboxControl.player({seek: %d})" % tick)
+                    assert browser.run(
+                        "return window.sandboxControl.player({seek: %d})" % tick)
                     p = wait_for("tick %d of the recorded log" % tick, lambda: browser.run(
                         "const v = window.sandboxView; return v.tick === %d && v.robots.ELAHA "
                         "&& v.robots.ELAHA.p" % tick))
@@ -104,11 +106,17 @@ def main():
         shutil.rmtree(work, ignore_errors=True)
 
 
+def wait_for_player(browser):
+    """Until the page shows the level and a tick of the recording (it is connected: its
+    player commands are sent, not dropped)."""
+    wait_for("the level and the player", lambda: browser.run(
+        "const v = window.sandboxView; return v.levelLoaded && v.recordedTicks && v.tick >= 0"))
+
+
 def play(browser, url, expected):
     """The player driven as a user would (see the top)."""
     browser.go(url)
-    wait_for("the level and the player", lambda: browser.run(
-        "const v = window.sandboxView; return v.levelLoaded && v.recordedTicks && v.tick >= 0"))
+    wait_for_player(browser)
 
     def shown():
         return browser.run("const v = window.sandboxView; return [v.tick, v.robots.ELAHA.p, "
@@ -120,7 +128,7 @@ def play(browser, url, expected):
                         "s.dispatchEvent(new Event('input')); "
                         "s.dispatchEvent(new Event('change'))" % tick)
         else:
-            browser.run("window.sandboxControl.player({seek: %d})" % tick)
+            assert browser.run("return window.sandboxControl.player({seek: %d})" % tick)
         return wait_for("tick %d shown" % tick, lambda: (lambda s: s if s[0] == tick else None)(
             shown()))
 
@@ -132,7 +140,7 @@ def play(browser, url, expected):
         assert slider == tick, (tick, slider)
         checked += 1
     # Play at 4x: about 400 ticks a second of wall time (100 Hz log).
-    browser.run("window.sandboxControl.player({speed: 4, play: true})")
+    assert browser.run("return window.sandboxControl.player({speed: 4, play: true})")
     start = time.monotonic()
     wait_for("playing", lambda: browser.run("return window.sandboxView.playing"))
     first = shown()[0]
@@ -141,13 +149,14 @@ def play(browser, url, expected):
     elapsed = time.monotonic() - start
     assert second > first + 100, (first, second)
     assert second - 977 <= 4 * 100 * elapsed + 50, (second, elapsed)
-    browser.run("window.sandboxControl.player({play: false})")
+    assert browser.run("return window.sandboxControl.player({play: false})")
     wait_for("paused", lambda: not browser.run("return window.sandboxView.playing"))
     time.sleep(0.3)
     held = shown()[0]
     time.sleep(1.0)
     assert shown()[0] == held, "paused, yet moved on"
-    browser.run("window.sandboxControl.player({seek: -5})")  # refused, counted
+    # Sent, and refused and counted by the sandbox.
+    assert browser.run("return window.sandboxControl.player({seek: -5})")
     errors = browser.script_errors()
     assert not errors, errors
     print("recorded view: %d jumps (2 by command, 3 by the slider) showed the log's pose "

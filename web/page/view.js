@@ -211,16 +211,18 @@ function levelInfo(info) {
 const slider = document.getElementById('slider'), tickInput = document.getElementById('tick');
 const playButton = document.getElementById('play'), speedSelect = document.getElementById('speed');
 let socket = null, sliding = false;
+// Sends a message to the sandbox; false (nothing sent) until the page is connected.
+function send(message) {
+  if (!socket || socket.readyState !== WebSocket.OPEN) return false;
+  socket.send(JSON.stringify(message));
+  return true;
+}
 function command(fields) {
-  if (socket && socket.readyState === WebSocket.OPEN) {
-    socket.send(JSON.stringify(Object.assign({ type: 'player' }, fields)));
-  }
+  return send(Object.assign({ type: 'player' }, fields));
 }
 control.player = command;
 // Steers the cameras as the live view's keys do (sandbox run --web-control).
-control.steer = (key) => {
-  if (socket && socket.readyState === WebSocket.OPEN) socket.send(JSON.stringify({ type: 'camera', key }));
-};
+control.steer = (key) => send({ type: 'camera', key });
 for (const button of document.querySelectorAll('#steer button')) {
   button.addEventListener('click', () => control.steer(button.dataset.key));
 }
