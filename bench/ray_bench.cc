@@ -61,6 +61,9 @@ const char* Name(EmbreeMode mode) {
 // reference for hits); without it, its fastest mode (the reference for speed).
 // Embree's device configuration (`--isa`: "max_isa=avx2", say); empty: its defaults.
 std::string embree_config;
+// The cases run (`--only`): both, or "face" or "lidar" alone.
+std::string only_cases;
+bool Runs(const char* cases) { return only_cases.empty() || only_cases == cases; }
 
 class EmbreeScene {
  public:
@@ -413,8 +416,11 @@ void RunLevel(const char* name, const fs::path& file, const Eigen::Isometry3d& X
   sensors::RayBatch face_rays;
   std::vector<sensors::RayGrid> face_grids;
   face.GridRays(0, X_WS, &face_rays, &face_grids);
-  Compare(name, "face scan", world, embree, face_rays, seconds, show);
-  Compare(name, "face, grid", world, embree, face_rays, seconds, show, &face_grids);
+  if (Runs("face")) {
+    Compare(name, "face scan", world, embree, face_rays, seconds, show);
+    Compare(name, "face, grid", world, embree, face_rays, seconds, show, &face_grids);
+  }
+  if (!Runs("lidar")) return;
   const sensors::Lidar lidar16(sensors::LidarConfig::Uniform(16, -15, 15, 1024, 100.0));
   const sensors::RayBatch rays16 = lidar16.Rays(X_WLidar, X_WLidar);
   Compare(name, "lidar 16x1024", world, embree, rays16, seconds, show);
@@ -508,6 +514,9 @@ int main(int argc, char** argv) {
       const bool avx2 = std::strcmp(argv[++i], "avx2") == 0;
       setenv("SANDBOX_RAY_KERNEL", avx2 ? "avx2" : "sse2", 1);
       embree_config = avx2 ? "max_isa=avx2" : "max_isa=sse2";
+    } else if (std::strcmp(argv[i], "--only") == 0 && more &&
+               (std::strcmp(argv[i + 1], "face") == 0 || std::strcmp(argv[i + 1], "lidar") == 0)) {
+      only_cases = argv[++i];
     } else {
       level = nullptr, posed = false, argc = -1;
       break;
@@ -517,9 +526,11 @@ int main(int argc, char** argv) {
     std::fprintf(stderr,
                  "usage: bench_rays [--seconds S] [--level FILE --at x,y,z[,yaw_deg] "
                  "[--resolution R] [--half-extent E]] [--show N] [--isa avx2|sse2]\n"
+                 "                  [--only face|lidar]\n"
                  "  without --level: the sample level and a generated 1M-triangle terrain\n"
                  "  --show N: print the first N rays that disagree with watertight Embree\n"
-                 "  --isa avx2|sse2: as on a CPU with no wider set (ours and Embree's kernels)\n");
+                 "  --isa avx2|sse2: as on a CPU with no wider set (ours and Embree's kernels)\n"
+                 "  --only face|lidar: the face scans or the lidar sweeps alone\n");
     return 2;
   }
   std::printf("%s\nray kernel: %s%s%s\n", bench::Machine().c_str(), sensors::RayCaster::kernel(),
@@ -535,7 +546,7 @@ int main(int argc, char** argv) {
       const fs::path sample = fs::path(SANDBOX_SOURCE_DIR) / "assets/sample/level.toml";
       const Eigen::Isometry3d over_valley(Eigen::Translation3d(20, -25, 22) *
                                           Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()));
-      RunHighResolution(sample, over_valley, std::max(seconds, 1.0));
+      if (Runs("face")) RunHighResolution(sample, over_valley, std::max(seconds, 1.0));
       RunLevel("sample", sample, over_valley, face_case, seconds, show);
       const fs::path dir = fs::temp_directory_path() / "sandbox-bench-rays";
       const fs::path million = bench::WriteMillionTriangleLevel(dir);
