@@ -3,8 +3,6 @@
 // rest of the loop is in sandbox_loop.cc.
 
 #include <chrono>
-#include <fstream>
-#include <sstream>
 
 #include "app/command_line.h"
 #include "app/images.h"
