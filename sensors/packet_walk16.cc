@@ -93,24 +93,24 @@ inline __mmask16 MeetsCornerBox16(const V16& low, const V16& high, const V16& o,
                             _CMP_LE_OS);
 }
 
-// HitLanes4 (fused), sixteen lanes: the lanes hit closer than their t_max
-// (or at it, in `ties`) take the distance; the (unnormalised) normals in *normal.
-inline __mmask16 HitLanes16(const V16 c[3], const V16& o, const V16& d, const V16& box_inverse,
-                            __mmask16 lanes, __mmask16 ties, __m512* t_max, V16* normal) {
-  const V16 v0 = Sub(c[0], o), v1 = Sub(c[1], o), v2 = Sub(c[2], o);
-  const V16 e0 = Sub(v2, v0), e1 = Sub(v0, v1), e2 = Sub(v1, v2);
-  const __m512 u = Dot(Cross(e0, Add(v2, v0)), d);
-  const __m512 v = Dot(Cross(e1, Add(v0, v1)), d);
-  const __m512 w = Dot(Cross(e2, Add(v1, v2)), d);
+// The lanes of `lanes` whose ray passes inside or on the triangle's three
+// edges (u, v, w: the edges' signed volumes with the ray).
+SANDBOX_KERNEL_INLINE __mmask16 InsideEdges16(__m512 u, __m512 v, __m512 w, __mmask16 lanes) {
   const __m512 eps = Mul(Set(std::numeric_limits<float>::epsilon()), Abs(Add(Add(u, v), w)));
   const __m512 low = Min(Min(u, v), w);
   const __m512 high = Max(Max(u, v), w);
-  __mmask16 hit = lanes & (_mm512_cmp_ps_mask(low, Sub(_mm512_setzero_ps(), eps), _CMP_GE_OS) |
-                           _mm512_cmp_ps_mask(high, eps, _CMP_LE_OS));
-  if (hit == 0) return hit;
-  const V16 n = StableNormal(e0, e1, e2);
+  return lanes & (_mm512_cmp_ps_mask(low, Sub(_mm512_setzero_ps(), eps), _CMP_GE_OS) |
+                  _mm512_cmp_ps_mask(high, eps, _CMP_LE_OS));
+}
+
+// The rest of the test for the lanes in `hit`: the plane's distance (n its
+// normal, depth twice the dot of corner 0 from the origin with n), then the
+// triangle's box; those closer than their t_max (or at it, in `ties`) take it.
+SANDBOX_KERNEL_INLINE __mmask16 HitPlane16(__mmask16 hit, const V16 c[3], const V16& n,
+                                           __m512 depth, const V16& o, const V16& d,
+                                           const V16& box_inverse, __mmask16 ties, __m512* t_max,
+                                           V16* normal) {
   const __m512 den = Mul(Set(2.0f), Dot(n, d));
-  const __m512 depth = Mul(Set(2.0f), Dot(v0, n));
   const __m512 t = _mm512_div_ps(depth, den);
   hit &= _mm512_cmp_ps_mask(den, _mm512_setzero_ps(), _CMP_NEQ_UQ);
   hit &= _mm512_cmp_ps_mask(t, _mm512_setzero_ps(), _CMP_GE_OS);
@@ -128,34 +128,123 @@ inline __mmask16 HitLanes16(const V16 c[3], const V16& o, const V16& d, const V1
   return hit;
 }
 
+// HitLanes4 (fused), sixteen lanes: the lanes hit closer than their t_max
+// (or at it, in `ties`) take the distance; the (unnormalised) normals in *normal.
+SANDBOX_KERNEL_INLINE __mmask16 HitLanes16(const V16 c[3], const V16& o, const V16& d,
+                                           const V16& box_inverse, __mmask16 lanes, __mmask16 ties,
+                                           __m512* t_max, V16* normal) {
+  const V16 v0 = Sub(c[0], o), v1 = Sub(c[1], o), v2 = Sub(c[2], o);
+  const V16 e0 = Sub(v2, v0), e1 = Sub(v0, v1), e2 = Sub(v1, v2);
+  const __m512 u = Dot(Cross(e0, Add(v2, v0)), d);
+  const __m512 v = Dot(Cross(e1, Add(v0, v1)), d);
+  const __m512 w = Dot(Cross(e2, Add(v1, v2)), d);
+  const __mmask16 hit = InsideEdges16(u, v, w, lanes);
+  if (hit == 0) return hit;
+  const V16 n = StableNormal(e0, e1, e2);
+  return HitPlane16(hit, c, n, Mul(Set(2.0f), Dot(v0, n)), o, d, box_inverse, ties, t_max, normal);
+}
+
+// What HitLanes16 computes from the corners and the origin alone, for the
+// triangles of a leaf at once (a lane a triangle), when every lane of the
+// packet starts at one origin: per lane, the same operations on the same
+// values, so the same bits. Per lane then only the products with the
+// direction are left (HitShared16).
+struct LeafShared {
+  alignas(64) float corner[3][3][16];      // [corner][axis][triangle], Bullet frame
+  alignas(64) float edge_cross[3][3][16];  // Cross(e_k, sum_k): [edge][axis][triangle]
+  alignas(64) float normal[3][16];         // StableNormal(e0, e1, e2)
+  alignas(64) float depth[16];             // 2 Dot(v0, normal)
+};
+
+// Fills *shared for the leaf's triangles (lanes past `count` repeat the last).
+SANDBOX_KERNEL_INLINE void ShareLeaf(const Target& target, const scene::TriangleBvh::Leaves& leaf,
+                                     const V16& origin, LeafShared* shared) {
+  constexpr int kLanes = scene::TriangleBvh::kWidth;
+  static_assert(kLanes <= 16, "a leaf's triangles fit in a vector");
+  const __mmask16 in_leaf = __mmask16((1u << kLanes) - 1u);
+  V16 c[3];
+  for (int k = 0; k < 3; ++k) {
+    if (target.identity) {
+      c[k] = {_mm512_maskz_loadu_ps(in_leaf, leaf.corner[3 * k]),
+              _mm512_maskz_loadu_ps(in_leaf, leaf.corner[3 * k + 1]),
+              _mm512_maskz_loadu_ps(in_leaf, leaf.corner[3 * k + 2])};
+      continue;
+    }
+    alignas(64) float placed[3][16] = {};
+    for (int i = 0; i < kLanes; ++i) {
+      Eigen::Vector3f corner[3];
+      LeafCorners(target, leaf, i, corner);
+      for (int a = 0; a < 3; ++a) placed[a][i] = corner[k][a];
+    }
+    c[k] = {_mm512_load_ps(placed[0]), _mm512_load_ps(placed[1]), _mm512_load_ps(placed[2])};
+  }
+  const V16 v0 = Sub(c[0], origin), v1 = Sub(c[1], origin), v2 = Sub(c[2], origin);
+  const V16 e0 = Sub(v2, v0), e1 = Sub(v0, v1), e2 = Sub(v1, v2);
+  const V16 cross[3] = {Cross(e0, Add(v2, v0)), Cross(e1, Add(v0, v1)), Cross(e2, Add(v1, v2))};
+  const V16 n = StableNormal(e0, e1, e2);
+  auto store = [](float* to, const V16& v) {
+    _mm512_store_ps(to, v.x), _mm512_store_ps(to + 16, v.y), _mm512_store_ps(to + 32, v.z);
+  };
+  for (int k = 0; k < 3; ++k)
+    store(shared->corner[k][0], c[k]), store(shared->edge_cross[k][0], cross[k]);
+  store(shared->normal[0], n);
+  _mm512_store_ps(shared->depth, Mul(Set(2.0f), Dot(v0, n)));
+}
+
+// HitLanes16 for triangle i of a shared leaf.
+SANDBOX_KERNEL_INLINE __mmask16 HitShared16(const LeafShared& shared, int i, const V16& o,
+                                            const V16& d, const V16& box_inverse, __mmask16 lanes,
+                                            __mmask16 ties, __m512* t_max, V16* normal) {
+  auto lane = [&](const float(*v)[16]) { return V16{Set(v[0][i]), Set(v[1][i]), Set(v[2][i])}; };
+  const __m512 u = Dot(lane(shared.edge_cross[0]), d);
+  const __m512 v = Dot(lane(shared.edge_cross[1]), d);
+  const __m512 w = Dot(lane(shared.edge_cross[2]), d);
+  const __mmask16 hit = InsideEdges16(u, v, w, lanes);
+  if (hit == 0) return hit;
+  const V16 c[3] = {lane(shared.corner[0]), lane(shared.corner[1]), lane(shared.corner[2])};
+  return HitPlane16(hit, c, lane(shared.normal), Set(shared.depth[i]), o, d, box_inverse, ties,
+                    t_max, normal);
+}
+
 struct Packet16 {
   V16 o, d;         // Bullet frame
   V16 box_inverse;  // CornerBoxInverse(d)
   __m512 t_max;
   __mmask16 active;  // lanes that hold a ray
+  bool one_origin;   // every lane's o the same, bit for bit (a still lidar's sweep)
   // Each lane's nearest hit so far: its surface and normal (Bullet frame, unnormalised).
   alignas(64) std::int32_t surface[16];
   alignas(64) float reflectivity[16];  // Target::ReflectivityOf the part hit
   alignas(64) float normal[3][16];
 };
 
-// HitLanes16 for the packet's lanes against one triangle (corners in the
-// Bullet frame) of `part` of `target`.
-inline void HitCorners16(const Eigen::Vector3f corner[3], int surface_id, const Target& target,
-                         int part, Packet16* packet, __mmask16 lanes, __m512* t_max) {
-  V16 c[3];
-  for (int k = 0; k < 3; ++k) c[k] = {Set(corner[k].x()), Set(corner[k].y()), Set(corner[k].z())};
-  V16 n;
-  const __mmask16 ties =
-      _mm512_cmpgt_epi32_mask(_mm512_load_si512(packet->surface), _mm512_set1_epi32(surface_id));
-  const __mmask16 hit =
-      HitLanes16(c, packet->o, packet->d, packet->box_inverse, lanes, ties, t_max, &n);
+// The packet's nearest hits so far take those of `hit` (found by HitLanes16
+// or HitShared16, normal n) on a triangle of `part` of `target`.
+SANDBOX_KERNEL_INLINE void TakeHits16(__mmask16 hit, const V16& n, int surface_id,
+                                      const Target& target, int part, Packet16* packet) {
   if (hit == 0) return;
   _mm512_mask_store_epi32(packet->surface, hit, _mm512_set1_epi32(surface_id));
   _mm512_mask_store_ps(packet->reflectivity, hit, Set(target.ReflectivityOf(part)));
   _mm512_mask_store_ps(packet->normal[0], hit, n.x);
   _mm512_mask_store_ps(packet->normal[1], hit, n.y);
   _mm512_mask_store_ps(packet->normal[2], hit, n.z);
+}
+// The lanes that keep their hit on a tie with `surface_id` (a smaller id wins).
+SANDBOX_KERNEL_INLINE __mmask16 Ties16(const Packet16& packet, int surface_id) {
+  return _mm512_cmpgt_epi32_mask(_mm512_load_si512(packet.surface), _mm512_set1_epi32(surface_id));
+}
+
+// HitLanes16 for the packet's lanes against one triangle (corners in the
+// Bullet frame) of `part` of `target`.
+SANDBOX_KERNEL_INLINE void HitCorners16(const Eigen::Vector3f corner[3], int surface_id,
+                                        const Target& target, int part, Packet16* packet,
+                                        __mmask16 lanes, __m512* t_max) {
+  V16 c[3];
+  for (int k = 0; k < 3; ++k) c[k] = {Set(corner[k].x()), Set(corner[k].y()), Set(corner[k].z())};
+  V16 n;
+  const __mmask16 hit = HitLanes16(c, packet->o, packet->d, packet->box_inverse, lanes,
+                                   Ties16(*packet, surface_id), t_max, &n);
+  TakeHits16(hit, n, surface_id, target, part, packet);
 }
 
 // The lanes whose rays enter the box [lo, hi] (Bullet frame) before their t_max.
@@ -203,6 +292,12 @@ inline V16 Deinterleave(const float* xyz) {
   return v;
 }
 inline V16 Splat(const Eigen::Vector3f& v) { return {Set(v.x()), Set(v.y()), Set(v.z())}; }
+// Whether every lane of x holds the same bits (+0 and -0 differ).
+inline bool SameInEveryLane(__m512 x) {
+  const __m512i bits = _mm512_castps_si512(x);
+  const __m512i first = _mm512_maskz_permutexvar_epi32(0xFFFF, _mm512_setzero_si512(), bits);
+  return _mm512_cmpeq_epi32_mask(bits, first) == 0xFFFF;
+}
 
 // x with every component of magnitude under 1e-30 moved to +-1e-30 (the
 // inverse stays finite).
@@ -280,6 +375,18 @@ void WalkWide16(const Target& target, const __m512 inverse_B[3], Packet16* packe
     const __mmask16 lanes = __mmask16(entry.lanes());
     if (entry.ref() < 0) {
       const scene::TriangleBvh::Leaves& leaf = bvh.leaves[std::size_t(-1 - entry.ref())];
+      if (packet->one_origin) {
+        LeafShared shared;
+        ShareLeaf(target, leaf, packet->o, &shared);
+        for (int i = 0; i < leaf.count; ++i) {
+          const int surface_id = target.SurfaceOf(leaf.part[i]);
+          V16 n;
+          const __mmask16 hit = HitShared16(shared, i, packet->o, packet->d, packet->box_inverse,
+                                            lanes, Ties16(*packet, surface_id), &t_max, &n);
+          TakeHits16(hit, n, surface_id, target, leaf.part[i], packet);
+        }
+        continue;
+      }
       for (int i = 0; i < leaf.count; ++i) {
         Eigen::Vector3f corner[3];
         LeafCorners(target, leaf, i, corner);
@@ -364,6 +471,8 @@ void CastRays(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t
       packet.t_max = _mm512_load_ps(lane[6]);
       packet.active = active;
     }
+    packet.one_origin =
+        SameInEveryLane(packet.o.x) && SameInEveryLane(packet.o.y) && SameInEveryLane(packet.o.z);
     const __m512 inverse[3] = {_mm512_div_ps(Set(1.0f), AwayFromZero16(packet.d.x)),
                                _mm512_div_ps(Set(1.0f), AwayFromZero16(packet.d.y)),
                                _mm512_div_ps(Set(1.0f), AwayFromZero16(packet.d.z))};

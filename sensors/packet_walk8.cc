@@ -97,24 +97,23 @@ inline __m256 MeetsCornerBox8(const V8& low, const V8& high, const V8& o, const 
   return Cmp<_CMP_LE_OS>(Mul(t_enter, Set(1.0f - slack)), Mul(t_exit, Set(1.0f + slack)));
 }
 
-// HitLanes4 (fused), eight lanes: the lanes hit closer than their t_max (or
-// at it, in `ties`) take the distance; the (unnormalised) normals in *normal.
-inline __m256 HitLanes8(const V8 c[3], const V8& o, const V8& d, const V8& box_inverse,
-                        __m256 lanes, __m256 ties, __m256* t_max, V8* normal) {
-  const V8 v0 = Sub(c[0], o), v1 = Sub(c[1], o), v2 = Sub(c[2], o);
-  const V8 e0 = Sub(v2, v0), e1 = Sub(v0, v1), e2 = Sub(v1, v2);
-  const __m256 u = Dot(Cross(e0, Add(v2, v0)), d);
-  const __m256 v = Dot(Cross(e1, Add(v0, v1)), d);
-  const __m256 w = Dot(Cross(e2, Add(v1, v2)), d);
+// The lanes of `lanes` whose ray passes inside or on the triangle's three
+// edges (u, v, w: the edges' signed volumes with the ray).
+SANDBOX_KERNEL_INLINE __m256 InsideEdges8(__m256 u, __m256 v, __m256 w, __m256 lanes) {
   const __m256 eps = Mul(Set(std::numeric_limits<float>::epsilon()), Abs(Add(Add(u, v), w)));
   const __m256 low = Min(Min(u, v), w);
   const __m256 high = Max(Max(u, v), w);
-  __m256 hit = And(
-      lanes, Or(Cmp<_CMP_GE_OS>(low, Sub(_mm256_setzero_ps(), eps)), Cmp<_CMP_LE_OS>(high, eps)));
-  if (Bits(hit) == 0) return hit;
-  const V8 n = StableNormal(e0, e1, e2);
+  return And(lanes,
+             Or(Cmp<_CMP_GE_OS>(low, Sub(_mm256_setzero_ps(), eps)), Cmp<_CMP_LE_OS>(high, eps)));
+}
+
+// The rest of the test for the lanes in `hit`: the plane's distance (n its
+// normal, depth twice the dot of corner 0 from the origin with n), then the
+// triangle's box; those closer than their t_max (or at it, in `ties`) take it.
+SANDBOX_KERNEL_INLINE __m256 HitPlane8(__m256 hit, const V8 c[3], const V8& n, __m256 depth,
+                                       const V8& o, const V8& d, const V8& box_inverse, __m256 ties,
+                                       __m256* t_max, V8* normal) {
   const __m256 den = Mul(Set(2.0f), Dot(n, d));
-  const __m256 depth = Mul(Set(2.0f), Dot(v0, n));
   const __m256 t = _mm256_div_ps(depth, den);
   hit = And(hit, Cmp<_CMP_NEQ_UQ>(den, _mm256_setzero_ps()));
   hit = And(hit, Cmp<_CMP_GE_OS>(t, _mm256_setzero_ps()));
@@ -131,29 +130,95 @@ inline __m256 HitLanes8(const V8 c[3], const V8& o, const V8& d, const V8& box_i
   return hit;
 }
 
+// HitLanes4 (fused), eight lanes: the lanes hit closer than their t_max (or
+// at it, in `ties`) take the distance; the (unnormalised) normals in *normal.
+SANDBOX_KERNEL_INLINE __m256 HitLanes8(const V8 c[3], const V8& o, const V8& d,
+                                       const V8& box_inverse, __m256 lanes, __m256 ties,
+                                       __m256* t_max, V8* normal) {
+  const V8 v0 = Sub(c[0], o), v1 = Sub(c[1], o), v2 = Sub(c[2], o);
+  const V8 e0 = Sub(v2, v0), e1 = Sub(v0, v1), e2 = Sub(v1, v2);
+  const __m256 u = Dot(Cross(e0, Add(v2, v0)), d);
+  const __m256 v = Dot(Cross(e1, Add(v0, v1)), d);
+  const __m256 w = Dot(Cross(e2, Add(v1, v2)), d);
+  const __m256 hit = InsideEdges8(u, v, w, lanes);
+  if (Bits(hit) == 0) return hit;
+  const V8 n = StableNormal(e0, e1, e2);
+  return HitPlane8(hit, c, n, Mul(Set(2.0f), Dot(v0, n)), o, d, box_inverse, ties, t_max, normal);
+}
+
+// packet_walk16.cc's LeafShared, ShareLeaf and HitShared16, eight lanes.
+struct LeafShared {
+  alignas(32) float corner[3][3][8];      // [corner][axis][triangle], Bullet frame
+  alignas(32) float edge_cross[3][3][8];  // Cross(e_k, sum_k): [edge][axis][triangle]
+  alignas(32) float normal[3][8];         // StableNormal(e0, e1, e2)
+  alignas(32) float depth[8];             // 2 Dot(v0, normal)
+};
+
+SANDBOX_KERNEL_INLINE void ShareLeaf(const Target& target, const scene::TriangleBvh::Leaves& leaf,
+                                     const V8& origin, LeafShared* shared) {
+  constexpr int kLanes = scene::TriangleBvh::kWidth;
+  static_assert(kLanes == 4, "a leaf's triangles fill half a vector");
+  V8 c[3];
+  for (int k = 0; k < 3; ++k) {
+    if (target.identity) {
+      auto load = [&](int a) {
+        return _mm256_setr_m128(_mm_loadu_ps(leaf.corner[3 * k + a]), _mm_setzero_ps());
+      };
+      c[k] = {load(0), load(1), load(2)};
+      continue;
+    }
+    alignas(32) float placed[3][8] = {};
+    for (int i = 0; i < kLanes; ++i) {
+      Eigen::Vector3f corner[3];
+      LeafCorners(target, leaf, i, corner);
+      for (int a = 0; a < 3; ++a) placed[a][i] = corner[k][a];
+    }
+    c[k] = {_mm256_load_ps(placed[0]), _mm256_load_ps(placed[1]), _mm256_load_ps(placed[2])};
+  }
+  const V8 v0 = Sub(c[0], origin), v1 = Sub(c[1], origin), v2 = Sub(c[2], origin);
+  const V8 e0 = Sub(v2, v0), e1 = Sub(v0, v1), e2 = Sub(v1, v2);
+  const V8 cross[3] = {Cross(e0, Add(v2, v0)), Cross(e1, Add(v0, v1)), Cross(e2, Add(v1, v2))};
+  const V8 n = StableNormal(e0, e1, e2);
+  auto store = [](float* to, const V8& v) {
+    _mm256_store_ps(to, v.x), _mm256_store_ps(to + 8, v.y), _mm256_store_ps(to + 16, v.z);
+  };
+  for (int k = 0; k < 3; ++k) {
+    store(shared->corner[k][0], c[k]), store(shared->edge_cross[k][0], cross[k]);
+  }
+  store(shared->normal[0], n);
+  _mm256_store_ps(shared->depth, Mul(Set(2.0f), Dot(v0, n)));
+}
+
+SANDBOX_KERNEL_INLINE __m256 HitShared8(const LeafShared& shared, int i, const V8& o, const V8& d,
+                                        const V8& box_inverse, __m256 lanes, __m256 ties,
+                                        __m256* t_max, V8* normal) {
+  auto lane = [&](const float(*v)[8]) { return V8{Set(v[0][i]), Set(v[1][i]), Set(v[2][i])}; };
+  const __m256 u = Dot(lane(shared.edge_cross[0]), d);
+  const __m256 v = Dot(lane(shared.edge_cross[1]), d);
+  const __m256 w = Dot(lane(shared.edge_cross[2]), d);
+  const __m256 hit = InsideEdges8(u, v, w, lanes);
+  if (Bits(hit) == 0) return hit;
+  const V8 c[3] = {lane(shared.corner[0]), lane(shared.corner[1]), lane(shared.corner[2])};
+  return HitPlane8(hit, c, lane(shared.normal), Set(shared.depth[i]), o, d, box_inverse, ties,
+                   t_max, normal);
+}
+
 struct Packet8 {
   V8 o, d;         // Bullet frame
   V8 box_inverse;  // CornerBoxInverse(d)
   __m256 t_max;
-  int active;  // lanes that hold a ray, a bit a lane
+  int active;       // lanes that hold a ray, a bit a lane
+  bool one_origin;  // every lane's o the same, bit for bit (a still lidar's sweep)
   // Each lane's nearest hit so far: its surface and normal (Bullet frame, unnormalised).
   alignas(32) std::int32_t surface[8];
   alignas(32) float reflectivity[8];  // Target::ReflectivityOf the part hit
   alignas(32) float normal[3][8];
 };
 
-// HitLanes8 for the packet's lanes against one triangle (corners in the
-// Bullet frame) of `part` of `target`.
-inline void HitCorners8(const Eigen::Vector3f corner[3], int surface_id, const Target& target,
-                        int part, Packet8* packet, __m256 lanes, __m256* t_max) {
-  V8 c[3];
-  for (int k = 0; k < 3; ++k) c[k] = {Set(corner[k].x()), Set(corner[k].y()), Set(corner[k].z())};
-  V8 n;
-  const __m256 ties = _mm256_castsi256_ps(
-      _mm256_cmpgt_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(packet->surface)),
-                         _mm256_set1_epi32(surface_id)));
-  const __m256 hit =
-      HitLanes8(c, packet->o, packet->d, packet->box_inverse, lanes, ties, t_max, &n);
+// The packet's nearest hits so far take those of `hit` (found by HitLanes8
+// or HitShared8, normal n) on a triangle of `part` of `target`.
+SANDBOX_KERNEL_INLINE void TakeHits8(__m256 hit, const V8& n, int surface_id, const Target& target,
+                                     int part, Packet8* packet) {
   if (Bits(hit) == 0) return;
   const __m256i hit_i = _mm256_castps_si256(hit);
   _mm256_maskstore_epi32(packet->surface, hit_i, _mm256_set1_epi32(surface_id));
@@ -161,6 +226,25 @@ inline void HitCorners8(const Eigen::Vector3f corner[3], int surface_id, const T
   _mm256_maskstore_ps(packet->normal[0], hit_i, n.x);
   _mm256_maskstore_ps(packet->normal[1], hit_i, n.y);
   _mm256_maskstore_ps(packet->normal[2], hit_i, n.z);
+}
+// The lanes that keep their hit on a tie with `surface_id` (a smaller id wins).
+SANDBOX_KERNEL_INLINE __m256 Ties8(const Packet8& packet, int surface_id) {
+  return _mm256_castsi256_ps(
+      _mm256_cmpgt_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(packet.surface)),
+                         _mm256_set1_epi32(surface_id)));
+}
+
+// HitLanes8 for the packet's lanes against one triangle (corners in the
+// Bullet frame) of `part` of `target`.
+SANDBOX_KERNEL_INLINE void HitCorners8(const Eigen::Vector3f corner[3], int surface_id,
+                                       const Target& target, int part, Packet8* packet,
+                                       __m256 lanes, __m256* t_max) {
+  V8 c[3];
+  for (int k = 0; k < 3; ++k) c[k] = {Set(corner[k].x()), Set(corner[k].y()), Set(corner[k].z())};
+  V8 n{};
+  const __m256 hit = HitLanes8(c, packet->o, packet->d, packet->box_inverse, lanes,
+                               Ties8(*packet, surface_id), t_max, &n);
+  TakeHits8(hit, n, surface_id, target, part, packet);
 }
 
 // The lanes whose rays enter the box [lo, hi] (Bullet frame) before their
@@ -195,6 +279,12 @@ inline V8 Deinterleave(const float* xyz) {
           _mm256_permutevar8x32_ps(z, _mm256_setr_epi32(2, 5, 0, 3, 6, 1, 4, 7))};
 }
 inline V8 Splat(const Eigen::Vector3f& v) { return {Set(v.x()), Set(v.y()), Set(v.z())}; }
+// Whether every lane of x holds the same bits (+0 and -0 differ).
+inline bool SameInEveryLane(__m256 x) {
+  const __m256i bits = _mm256_castps_si256(x);
+  const __m256i first = _mm256_permutevar8x32_epi32(bits, _mm256_setzero_si256());
+  return _mm256_movemask_epi8(_mm256_cmpeq_epi32(bits, first)) == -1;
+}
 
 // x with every component of magnitude under 1e-30 moved to +-1e-30 (the
 // inverse stays finite).
@@ -260,6 +350,18 @@ void WalkWide8(const Target& target, const __m256 inverse_B[3], Packet8* packet)
     if (entry.ref() < 0) {
       const __m256 lanes = LaneMask(lane_bits);
       const scene::TriangleBvh::Leaves& leaf = bvh.leaves[std::size_t(-1 - entry.ref())];
+      if (packet->one_origin) {
+        LeafShared shared;
+        ShareLeaf(target, leaf, packet->o, &shared);
+        for (int i = 0; i < leaf.count; ++i) {
+          const int surface_id = target.SurfaceOf(leaf.part[i]);
+          V8 n{};
+          const __m256 hit = HitShared8(shared, i, packet->o, packet->d, packet->box_inverse, lanes,
+                                        Ties8(*packet, surface_id), &t_max, &n);
+          TakeHits8(hit, n, surface_id, target, leaf.part[i], packet);
+        }
+        continue;
+      }
       for (int i = 0; i < leaf.count; ++i) {
         Eigen::Vector3f corner[3];
         LeafCorners(target, leaf, i, corner);
@@ -342,6 +444,8 @@ void CastRays(const RayBatch& rays, const Eigen::Vector3f& origin_B, std::size_t
       packet.t_max = _mm256_load_ps(lane[6]);
       packet.active = active;
     }
+    packet.one_origin =
+        SameInEveryLane(packet.o.x) && SameInEveryLane(packet.o.y) && SameInEveryLane(packet.o.z);
     const __m256 inverse[3] = {_mm256_div_ps(Set(1.0f), AwayFromZero8(packet.d.x)),
                                _mm256_div_ps(Set(1.0f), AwayFromZero8(packet.d.y)),
                                _mm256_div_ps(Set(1.0f), AwayFromZero8(packet.d.z))};
@@ -417,7 +521,7 @@ void HitPairs(GridBand* band) {
     const __m256i ray_surface = _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), surface, cell,
                                                             _mm256_castps_si256(lanes), 4);
     const __m256 ties = _mm256_castsi256_ps(_mm256_cmpgt_epi32(ray_surface, pair_surface));
-    V8 n;
+    V8 n{};
     const int hit = Bits(HitLanes8(c, o, d, box_inverse, lanes, ties, &t_max, &n));
     if (hit == 0) continue;
     alignas(32) float t_hit[8], nx[8], ny[8], nz[8];

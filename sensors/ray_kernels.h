@@ -22,6 +22,11 @@
 #include "sensors/ray_caster.h"
 #include "sensors/ray_targets.h"
 
+// A kernel's per-triangle steps, inlined into its walk whatever the
+// compiler's count of their callers (an out-of-line call passes the lanes
+// through memory).
+#define SANDBOX_KERNEL_INLINE inline __attribute__((always_inline))
+
 namespace sandbox::sensors {
 
 // Whether the ray, up to t, meets the triangle's own bounding box (with two

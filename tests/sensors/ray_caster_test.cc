@@ -239,6 +239,77 @@ TEST_F(RayCasterTest, OneCasterFollowsEveryChangeOfTheWorld) {
   }
 }
 
+// Rays that all start at one point (a still lidar's sweep: the wide kernels
+// share each triangle's work between a packet's rays then) get the same bits
+// as when each shares its packet with rays from elsewhere: on the terrain,
+// the buildings and a bent robot (objects placed off the identity), and
+// along rays aimed at the triangles' corners.
+TEST_F(RayCasterTest, RaysFromOnePointGetTheHitsTheyGetAmongRaysFromElsewhere) {
+  scene::CollisionWorld world(*level_);
+  scene::RobotState robot(level_->robots[0]);
+  Eigen::Isometry3d X_WB = Eigen::Isometry3d::Identity();
+  X_WB.translation() = Vector3d(10, 5, 25);
+  ASSERT_TRUE(robot.SetPose(X_WB));
+  std::vector<double> bones(std::size_t(level_->robots[0].num_values), 0.0);
+  for (int b = 1; b <= 20; ++b) bones[std::size_t(2 * b)] = 0.15;
+  ASSERT_TRUE(robot.SetBones(bones));
+  robot.Update();
+  world.UpdateRobot(0, robot);
+  std::mt19937 random(29);
+  std::uniform_real_distribution<float> unit(-1.f, 1.f);
+  const std::vector<Vector3d> points = {{10, 5, 31}, {4, -3, 26}, {-40, 60, 8}, {120, -90, 40}};
+  RayCaster caster(2);
+  int hits = 0, robot_hits = 0;
+  for (const Vector3d& point : points) {
+    RayBatch alone;
+    alone.origin_W = point;
+    // Rays in every direction, and rays through grid points of the valley
+    // floor and the robot's box, where edges and corners lie.
+    for (int i = 0; i < 4000; ++i) {
+      Vector3f d(unit(random), unit(random), unit(random));
+      if (d.norm() < 0.1f) d = -Vector3f::UnitZ();
+      alone.direction.push_back(d.normalized());
+    }
+    for (int x = -20; x <= 20; ++x) {
+      for (int y = -20; y <= 20; ++y) {
+        const Vector3f to =
+            (Vector3d(10 + 0.5 * x, 5 + 0.5 * y, 24 + 0.1 * ((x + y) % 7)) - point).cast<float>();
+        if (to.norm() > 1e-3f) alone.direction.push_back(to.normalized());
+        const Vector3f down = (Vector3d(4.0 * x, 4.0 * y, 0.0) - point).cast<float>();
+        alone.direction.push_back(down.normalized());
+      }
+    }
+    alone.start.assign(alone.direction.size(), Vector3f::Zero());
+    alone.length_m.assign(alone.direction.size(), 400.f);
+    // Each ray again, with one from elsewhere after it.
+    RayBatch mixed;
+    mixed.origin_W = point;
+    for (std::size_t i = 0; i < alone.size(); ++i) {
+      for (const Vector3f& start : {Vector3f::Zero().eval(), Vector3f(0.37f, -0.21f, 0.5f)}) {
+        mixed.start.push_back(start);
+        mixed.direction.push_back(alone.direction[i]);
+        mixed.length_m.push_back(alone.length_m[i]);
+      }
+    }
+    RayHits one_point, among_others;
+    caster.Cast(world, alone, {}, &one_point);
+    caster.Cast(world, mixed, {}, &among_others);
+    for (std::size_t i = 0; i < alone.size(); ++i) {
+      const std::size_t j = 2 * i;
+      ASSERT_EQ(one_point.surface[i], among_others.surface[j]) << "ray " << i;
+      ASSERT_EQ(one_point.distance_m[i], among_others.distance_m[j]) << "ray " << i;
+      ASSERT_EQ(one_point.normal_W[i], among_others.normal_W[j]) << "ray " << i;
+      if (one_point.surface[i] == RayHits::kNoHit) continue;
+      ++hits;
+      const scene::SurfaceEntry* entry = world.surface_ids().Find(one_point.surface[i]);
+      robot_hits += entry != nullptr && entry->robot == 0;
+    }
+  }
+  // The rays meet the world and the robot's pieces.
+  EXPECT_GT(hits, 10000);
+  EXPECT_GT(robot_hits, 300);
+}
+
 }  // namespace
 }  // namespace sandbox::sensors
 
