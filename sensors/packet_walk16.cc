@@ -4,7 +4,9 @@
 // for fma, operation for operation, sixteen lanes wide: the same bits in
 // every lane). Built once, with -mavx512f -mavx512dq (namespace avx512).
 // Its own code, not packet_walk4.cc's made wide: its masks are registers of
-// their own and it loads sixteen rays by permutes (docs/decisions/005).
+// their own and it loads sixteen rays by permutes (docs/decisions/005). A
+// packet whose rays start at one point tests a leaf's triangles from terms
+// computed once for the leaf (ShareLeaf).
 
 #include <Eigen/Core>
 #include <algorithm>

@@ -3,7 +3,9 @@
 // triangle test, operation for operation, eight lanes wide (the same bits in
 // every lane). Built once, with -mavx2 -mfma (namespace avx2). AVX2 has no
 // mask registers: a lane mask is a compare's result (all bits set) in the
-// arithmetic and its movemask (a bit a lane) in the walk's entries.
+// arithmetic and its movemask (a bit a lane) in the walk's entries. A
+// packet whose rays start at one point tests a leaf's triangles from terms
+// computed once for the leaf (ShareLeaf).
 
 #include <Eigen/Core>
 #include <algorithm>
