@@ -165,20 +165,25 @@ SANDBOX_KERNEL_INLINE void ShareLeaf(const Target& target, const scene::Triangle
   static_assert(kLanes <= 16, "a leaf's triangles fit in a vector");
   const __mmask16 in_leaf = __mmask16((1u << kLanes) - 1u);
   V16 c[3];
-  for (int k = 0; k < 3; ++k) {
-    if (target.identity) {
+  if (target.identity) {
+    for (int k = 0; k < 3; ++k) {
       c[k] = {_mm512_maskz_loadu_ps(in_leaf, leaf.corner[3 * k]),
               _mm512_maskz_loadu_ps(in_leaf, leaf.corner[3 * k + 1]),
               _mm512_maskz_loadu_ps(in_leaf, leaf.corner[3 * k + 2])};
-      continue;
     }
-    alignas(64) float placed[3][16] = {};
+  } else {
+    alignas(64) float placed[3][3][16] = {};  // [corner][axis][triangle]
     for (int i = 0; i < kLanes; ++i) {
       Eigen::Vector3f corner[3];
       LeafCorners(target, leaf, i, corner);
-      for (int a = 0; a < 3; ++a) placed[a][i] = corner[k][a];
+      for (int k = 0; k < 3; ++k) {
+        for (int a = 0; a < 3; ++a) placed[k][a][i] = corner[k][a];
+      }
     }
-    c[k] = {_mm512_load_ps(placed[0]), _mm512_load_ps(placed[1]), _mm512_load_ps(placed[2])};
+    for (int k = 0; k < 3; ++k) {
+      c[k] = {_mm512_load_ps(placed[k][0]), _mm512_load_ps(placed[k][1]),
+              _mm512_load_ps(placed[k][2])};
+    }
   }
   const V16 v0 = Sub(c[0], origin), v1 = Sub(c[1], origin), v2 = Sub(c[2], origin);
   const V16 e0 = Sub(v2, v0), e1 = Sub(v0, v1), e2 = Sub(v1, v2);

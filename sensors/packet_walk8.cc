@@ -161,21 +161,26 @@ SANDBOX_KERNEL_INLINE void ShareLeaf(const Target& target, const scene::Triangle
   constexpr int kLanes = scene::TriangleBvh::kWidth;
   static_assert(kLanes == 4, "a leaf's triangles fill half a vector");
   V8 c[3];
-  for (int k = 0; k < 3; ++k) {
-    if (target.identity) {
+  if (target.identity) {
+    for (int k = 0; k < 3; ++k) {
       auto load = [&](int a) {
         return _mm256_setr_m128(_mm_loadu_ps(leaf.corner[3 * k + a]), _mm_setzero_ps());
       };
       c[k] = {load(0), load(1), load(2)};
-      continue;
     }
-    alignas(32) float placed[3][8] = {};
+  } else {
+    alignas(32) float placed[3][3][8] = {};  // [corner][axis][triangle]
     for (int i = 0; i < kLanes; ++i) {
       Eigen::Vector3f corner[3];
       LeafCorners(target, leaf, i, corner);
-      for (int a = 0; a < 3; ++a) placed[a][i] = corner[k][a];
+      for (int k = 0; k < 3; ++k) {
+        for (int a = 0; a < 3; ++a) placed[k][a][i] = corner[k][a];
+      }
     }
-    c[k] = {_mm256_load_ps(placed[0]), _mm256_load_ps(placed[1]), _mm256_load_ps(placed[2])};
+    for (int k = 0; k < 3; ++k) {
+      c[k] = {_mm256_load_ps(placed[k][0]), _mm256_load_ps(placed[k][1]),
+              _mm256_load_ps(placed[k][2])};
+    }
   }
   const V8 v0 = Sub(c[0], origin), v1 = Sub(c[1], origin), v2 = Sub(c[2], origin);
   const V8 e0 = Sub(v2, v0), e1 = Sub(v0, v1), e2 = Sub(v1, v2);
